@@ -45,4 +45,7 @@ struct TetMesh {
   int nodes_per_face() const { return order == 1 ? 3 : 6; }
 };
 
+/// The node of named point `id`, -1 when the mesh has no such point.
+int named_node(const TetMesh& mesh, const std::string& id);
+
 }  // namespace tt::mesh
