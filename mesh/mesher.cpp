@@ -1,0 +1,303 @@
+#include "mesh/mesher.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <Eigen/Geometry>
+#include <map>
+#include <sstream>
+#include <unordered_map>
+
+#include "core/errors.hpp"
+#include "mesh/extrusion.hpp"
+#include "mesh/tetgen/tetgen_adapter.hpp"
+
+namespace tt::mesh {
+namespace {
+
+using Eigen::Vector3d;
+constexpr double kPi = 3.14159265358979323846;
+
+/// Outward faces of a positively oriented tet, as local corner indices.
+constexpr int kFaceCorners[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+/// VTK's mid-edge node order of the quadratic tetra.
+constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}};
+
+int edge_slot(int a, int b) {
+  for (int e = 0; e < 6; ++e)
+    if ((kTetEdges[e][0] == a && kTetEdges[e][1] == b) || (kTetEdges[e][0] == b && kTetEdges[e][1] == a))
+      return 4 + e;
+  return -1;
+}
+
+struct FaceGeometry {
+  Vector3d centroid, normal;
+  std::array<Vector3d, 3> corners;
+};
+
+FaceGeometry face_geometry(const TetMesh& m, int f) {
+  FaceGeometry g;
+  for (int k = 0; k < 3; ++k) g.corners[k] = m.nodes.row(m.faces(f, k)).transpose();
+  g.centroid = (g.corners[0] + g.corners[1] + g.corners[2]) / 3.0;
+  g.normal = (g.corners[1] - g.corners[0]).cross(g.corners[2] - g.corners[0]).normalized();
+  return g;
+}
+
+bool contains(const std::vector<int>& list, int v) {
+  return std::find(list.begin(), list.end(), v) != list.end();
+}
+
+bool selector_matches(const core::FaceSelector& s, const TetMesh& m, int f, const FaceGeometry& g,
+                      double tol, int circle_segments) {
+  using Side = core::FaceSelector::Side;
+  const bool interface = m.face_other_tet[f] >= 0;
+  if (s.side == Side::exterior && interface) return false;
+  if (s.side == Side::interface && !interface) return false;
+  const int r0 = core::index_of(m.tet_region[m.face_tet[f]]);
+  const int r1 = interface ? core::index_of(m.tet_region[m.face_other_tet[f]]) : -1;
+  if (!s.bodies.empty()) {
+    const bool a = contains(s.bodies, r0) && (s.other_bodies.empty() || contains(s.other_bodies, r1));
+    const bool b = interface && contains(s.bodies, r1) &&
+                   (s.other_bodies.empty() || contains(s.other_bodies, r0));
+    if (!a && !b) return false;
+  } else if (!s.other_bodies.empty()) {
+    if (!contains(s.other_bodies, r0) && !contains(s.other_bodies, r1)) return false;
+  }
+  if (s.plane) {
+    const Vector3d n = s.plane->head<3>();
+    for (const auto& c : g.corners)
+      if (std::abs(n.dot(c) - (*s.plane)[3]) > tol) return false;
+  }
+  if (s.on_cylinder) {
+    if (std::abs(g.normal.z()) > 1e-6) return false;
+    const double r = s.on_cylinder->radius;
+    const double rf = faceted_radius(r, circle_segments);
+    const double r_in = rf * std::cos(kPi / circle_segments);
+    for (const auto& c : g.corners) {
+      const double d = (c.head<2>() - s.on_cylinder->axis).norm();
+      if (d < std::min(r, r_in) - tol || d > std::max(r, rf) + tol) return false;
+    }
+    const double dc = (g.centroid.head<2>() - s.on_cylinder->axis).norm();
+    if (dc < std::min(r, r_in) - tol) return false;
+  }
+  if (s.within_min && (g.centroid.array() < s.within_min->array() - tol).any()) return false;
+  if (s.within_max && (g.centroid.array() > s.within_max->array() + tol).any()) return false;
+  return true;
+}
+
+}  // namespace
+
+TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
+                      const std::vector<int>& point_vertex) {
+  TetMesh m;
+  m.order = spec.mesh.order;
+  const int nt = static_cast<int>(lin.tets.size());
+  const int nc = static_cast<int>(lin.nodes.size());
+  m.corner_count = nc;
+  for (const auto& b : spec.bodies) m.region_names.push_back(b.name);
+  m.tets.resize(nt, m.order == 1 ? 4 : 10);
+  m.tet_region.resize(nt);
+  for (int t = 0; t < nt; ++t) {
+    for (int k = 0; k < 4; ++k) m.tets(t, k) = lin.tets[t][k];
+    m.tet_region[t] = core::RegionId{lin.region[t]};
+  }
+  std::vector<Vector3d> nodes = lin.nodes;
+  if (m.order == 2) {
+    std::unordered_map<long long, int> mid;
+    mid.reserve(static_cast<size_t>(nt) * 2);
+    for (int t = 0; t < nt; ++t) {
+      for (int e = 0; e < 6; ++e) {
+        const int a = m.tets(t, kTetEdges[e][0]), b = m.tets(t, kTetEdges[e][1]);
+        const long long key = static_cast<long long>(std::min(a, b)) * nc + std::max(a, b);
+        auto [it, fresh] = mid.emplace(key, static_cast<int>(nodes.size()));
+        if (fresh) nodes.push_back(0.5 * (nodes[a] + nodes[b]));
+        m.tets(t, 4 + e) = it->second;
+      }
+    }
+  }
+  m.nodes.resize(static_cast<int>(nodes.size()), 3);
+  for (size_t i = 0; i < nodes.size(); ++i) m.nodes.row(static_cast<int>(i)) = nodes[i].transpose();
+
+  // Faces seen once are exterior; faces between different bodies are interfaces.
+  struct Seen {
+    int tet, local, count, other;
+  };
+  std::map<std::array<int, 3>, Seen> seen;
+  for (int t = 0; t < nt; ++t) {
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key = {m.tets(t, kFaceCorners[f][0]), m.tets(t, kFaceCorners[f][1]),
+                                m.tets(t, kFaceCorners[f][2])};
+      std::sort(key.begin(), key.end());
+      auto [it, fresh] = seen.emplace(key, Seen{t, f, 1, -1});
+      if (!fresh) {
+        ++it->second.count;
+        it->second.other = t;
+      }
+    }
+  }
+  std::vector<std::array<int, 3>> picked;  // (tet, local face, other tet)
+  for (const auto& [key, s] : seen) {
+    if (s.count == 1) picked.push_back({s.tet, s.local, -1});
+    else if (m.tet_region[s.tet] != m.tet_region[s.other]) {
+      // Interfaces are owned by the lower body index.
+      const bool swap = core::index_of(m.tet_region[s.other]) < core::index_of(m.tet_region[s.tet]);
+      int owner = swap ? s.other : s.tet, other = swap ? s.tet : s.other;
+      int local = s.local;
+      if (swap) {
+        for (int f = 0; f < 4; ++f) {
+          std::array<int, 3> k2 = {m.tets(owner, kFaceCorners[f][0]), m.tets(owner, kFaceCorners[f][1]),
+                                   m.tets(owner, kFaceCorners[f][2])};
+          std::sort(k2.begin(), k2.end());
+          if (k2 == key) local = f;
+        }
+      }
+      picked.push_back({owner, local, other});
+    }
+  }
+  std::sort(picked.begin(), picked.end());
+  const int npf = m.order == 1 ? 3 : 6;
+  m.faces.resize(static_cast<int>(picked.size()), npf);
+  m.face_tet.resize(picked.size());
+  m.face_other_tet.resize(picked.size());
+  for (size_t i = 0; i < picked.size(); ++i) {
+    const auto [t, f, other] = picked[i];
+    const int* c = kFaceCorners[f];
+    for (int k = 0; k < 3; ++k) m.faces(static_cast<int>(i), k) = m.tets(t, c[k]);
+    if (m.order == 2) {
+      m.faces(static_cast<int>(i), 3) = m.tets(t, edge_slot(c[0], c[1]));
+      m.faces(static_cast<int>(i), 4) = m.tets(t, edge_slot(c[1], c[2]));
+      m.faces(static_cast<int>(i), 5) = m.tets(t, edge_slot(c[2], c[0]));
+    }
+    m.face_tet[i] = t;
+    m.face_other_tet[i] = other;
+  }
+
+  // Boundary groups: ordinary groups in order first, then the "rest" groups in order.
+  for (const auto& grp : spec.groups) m.group_names.push_back(grp.name);
+  m.face_group.assign(picked.size(), core::BoundaryId{-1});
+  Eigen::AlignedBox3d box;
+  for (const auto& p : nodes) box.extend(p);
+  const double tol = 1e-7 * box.diagonal().norm();
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t gi = 0; gi < spec.groups.size(); ++gi) {
+      if (spec.groups[gi].rest != (pass == 1)) continue;
+      for (int f = 0; f < static_cast<int>(picked.size()); ++f) {
+        if (core::index_of(m.face_group[f]) >= 0) continue;
+        const FaceGeometry g = face_geometry(m, f);
+        for (const auto& s : spec.groups[gi].select) {
+          if (selector_matches(s, m, f, g, tol, spec.mesh.circle_segments)) {
+            m.face_group[f] = core::BoundaryId{static_cast<int>(gi)};
+            break;
+          }
+        }
+      }
+    }
+  }
+
+  // Named points.
+  for (size_t i = 0; i < spec.points.size(); ++i) {
+    const auto& p = spec.points[i];
+    int node = point_vertex[i];
+    if (node < 0) {
+      double best = 1e300;
+      for (int v = 0; v < nc; ++v) {
+        const double d = (nodes[v] - p.position).norm();
+        if (d < best) best = d, node = v;
+      }
+    }
+    m.points.push_back(NamedNode{p.id, p.position, node});
+    if (p.on_group >= 0) {
+      bool on = false;
+      for (int f = 0; f < m.faces.rows() && !on; ++f)
+        if (core::index_of(m.face_group[f]) == p.on_group)
+          for (int k = 0; k < 3; ++k) on = on || m.faces(f, k) == node;
+      if (!on)
+        throw core::GeometryError(spec.source.string() + ": points.list '" + p.id +
+                                  "' is not on boundary group '" + spec.groups[p.on_group].name +
+                                  "' that it names. Hint: check its coordinates.");
+    }
+  }
+  return m;
+}
+
+TetMesh mesh_case(const core::CaseSpec& spec) {
+  const ExtrudedPlc plc = extruded_plc(spec);
+  TetgenOptions options{spec.mesh.radius_edge_ratio, spec.mesh.min_dihedral_deg};
+  const LinearTets lin = tetgen::tetrahedralize(plc.plc, options);
+  std::vector<int> vertex = plc.point_vertex;
+  // Points inserted inside were appended after the PLC's vertices; find them exactly.
+  for (size_t i = 0; i < vertex.size(); ++i) {
+    if (vertex[i] >= 0) continue;
+    for (size_t v = 0; v < lin.nodes.size(); ++v)
+      if (lin.nodes[v] == spec.points[i].position) vertex[i] = static_cast<int>(v);
+    if (vertex[i] < 0)
+      throw core::MeshError(spec.source.string() + ": TetGen did not keep point '" +
+                            spec.points[i].id + "' as a vertex");
+  }
+  return assemble_mesh(lin, spec, vertex);
+}
+
+std::vector<double> tet_volumes(const TetMesh& m) {
+  std::vector<double> v(m.tets.rows());
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    const Vector3d a = m.nodes.row(m.tets(t, 0)).transpose();
+    v[t] = (m.nodes.row(m.tets(t, 1)).transpose() - a)
+               .cross(m.nodes.row(m.tets(t, 2)).transpose() - a)
+               .dot(m.nodes.row(m.tets(t, 3)).transpose() - a) / 6.0;
+  }
+  return v;
+}
+
+std::vector<double> face_areas(const TetMesh& m) {
+  std::vector<double> a(m.faces.rows());
+  for (int f = 0; f < m.faces.rows(); ++f) {
+    const Vector3d p = m.nodes.row(m.faces(f, 0)).transpose();
+    a[f] = 0.5 * (m.nodes.row(m.faces(f, 1)).transpose() - p)
+                     .cross(m.nodes.row(m.faces(f, 2)).transpose() - p)
+                     .norm();
+  }
+  return a;
+}
+
+double min_dihedral_deg(const TetMesh& m) {
+  double worst = 180;
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    Vector3d x[4];
+    for (int k = 0; k < 4; ++k) x[k] = m.nodes.row(m.tets(t, k)).transpose();
+    Vector3d n[4];
+    for (int f = 0; f < 4; ++f) {
+      const int* c = kFaceCorners[f];
+      n[f] = (x[c[1]] - x[c[0]]).cross(x[c[2]] - x[c[0]]).normalized();
+    }
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const double cosine = std::clamp(-n[i].dot(n[j]), -1.0, 1.0);
+        worst = std::min(worst, std::acos(cosine) * 180.0 / kPi);
+      }
+  }
+  return worst;
+}
+
+MeshReport mesh_report(const TetMesh& m, const core::CaseSpec& spec) {
+  MeshReport r;
+  r.nodes = static_cast<int>(m.nodes.rows());
+  r.tets = static_cast<int>(m.tets.rows());
+  r.order = m.order;
+  r.min_dihedral_deg = min_dihedral_deg(m);
+  const auto vol = tet_volumes(m);
+  for (size_t b = 0; b < spec.bodies.size(); ++b) {
+    BodyReport br{spec.bodies[b].name, 0, exact_body_volume(spec.bodies[b])};
+    for (int t = 0; t < m.tets.rows(); ++t)
+      if (core::index_of(m.tet_region[t]) == static_cast<int>(b)) br.volume += vol[t];
+    r.bodies.push_back(br);
+  }
+  const auto area = face_areas(m);
+  r.group_areas.assign(m.group_names.size(), 0.0);
+  for (int f = 0; f < m.faces.rows(); ++f)
+    if (core::index_of(m.face_group[f]) >= 0) r.group_areas[core::index_of(m.face_group[f])] += area[f];
+  for (const auto& p : m.points)
+    r.point_distance.push_back((m.nodes.row(p.node).transpose() - p.position).norm());
+  return r;
+}
+
+}  // namespace tt::mesh

@@ -1,0 +1,49 @@
+// From a typed case to the conforming tetrahedral mesh of all its bodies, with boundary groups
+// classified by the case's rules and named points pinned to vertices.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "mesh/plc.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::mesh {
+
+struct BodyReport {
+  std::string name;
+  double volume = 0;         /// meshed volume [m^3]
+  double exact_volume = -1;  /// analytic volume of the primitive, -1 when not available [m^3]
+};
+
+struct MeshReport {
+  int nodes = 0;
+  int tets = 0;
+  int order = 1;
+  double min_dihedral_deg = 0;
+  std::vector<BodyReport> bodies;
+  std::vector<double> group_areas;  /// per boundary group [m^2]
+  std::vector<double> point_distance;  /// per named point: distance to its node [m]
+};
+
+/// Meshes the case: PLC, TetGen, mid-edge nodes, faces, groups, named points.
+TetMesh mesh_case(const core::CaseSpec& spec);
+
+/// Turns TetGen's linear tets into the project's mesh (order from the spec).
+TetMesh assemble_mesh(const LinearTets& tets, const core::CaseSpec& spec,
+                      const std::vector<int>& point_vertex);
+
+/// Figures a report needs, computed from the mesh alone.
+MeshReport mesh_report(const TetMesh& mesh, const core::CaseSpec& spec);
+
+/// Smallest dihedral angle over all tets [deg].
+double min_dihedral_deg(const TetMesh& mesh);
+
+/// Volume of every tet [m^3] (straight-sided).
+std::vector<double> tet_volumes(const TetMesh& mesh);
+
+/// Area of every face [m^2].
+std::vector<double> face_areas(const TetMesh& mesh);
+
+}  // namespace tt::mesh
