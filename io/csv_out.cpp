@@ -1,0 +1,178 @@
+#include "io/csv_out.hpp"
+
+#include <array>
+#include <charconv>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string_view>
+
+#include "core/errors.hpp"
+#include "io/atomic_dir.hpp"
+
+namespace tt::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string_view trimmed(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(" \t\r");
+  return text.substr(first, last - first + 1);
+}
+
+std::vector<std::string_view> split_cells(std::string_view line) {
+  std::vector<std::string_view> cells;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    cells.push_back(trimmed(line.substr(start, comma - start)));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return cells;
+}
+
+/// The number in `cell`, or false when the whole cell is not one number.
+bool parsed_number(std::string_view cell, double& value) {
+  if (cell.starts_with('+')) cell.remove_prefix(1);
+  if (cell.empty()) return false;
+  const auto result = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+  return result.ec == std::errc() && result.ptr == cell.data() + cell.size();
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const auto& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+}  // namespace
+
+int CsvTable::column_index(const std::string& name) const {
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    if (header[c] == name) return static_cast<int>(c);
+  }
+  throw core::DataError(
+      core::located(source, 0, "no column '" + name + "'; columns are: " + joined(header)));
+}
+
+Eigen::VectorXd CsvTable::column(const std::string& name) const {
+  return rows.col(column_index(name));
+}
+
+void write_csv(const fs::path& path, const std::vector<std::string>& header,
+               const Eigen::MatrixXd& rows, int precision) {
+  if (precision < 1 || precision > 17) {
+    throw core::DataError(path.string() + ": CSV precision = " + std::to_string(precision) +
+                          ": expected 1..17 significant digits");
+  }
+  if (static_cast<Eigen::Index>(header.size()) != rows.cols()) {
+    throw core::DataError(path.string() + ": CSV header has " + std::to_string(header.size()) +
+                          " names for " + std::to_string(rows.cols()) +
+                          " columns: expected one name per column");
+  }
+  for (const std::string& name : header) {
+    if (name.empty() || name.find_first_of(",\"\r\n") != std::string::npos ||
+        trimmed(name) != name) {
+      throw core::DataError(path.string() + ": CSV column name '" + name +
+                            "': expected a non-empty name without commas, quotes, line breaks "
+                            "or surrounding spaces; hint: use e.g. T02_degC");
+    }
+  }
+  std::string text;
+  text.reserve(static_cast<std::size_t>(rows.size()) * (precision + 8) + 64);
+  for (std::size_t c = 0; c < header.size(); ++c) text += (c ? "," : "") + header[c];
+  text += '\n';
+  std::array<char, 64> buffer{};
+  for (Eigen::Index r = 0; r < rows.rows(); ++r) {
+    for (Eigen::Index c = 0; c < rows.cols(); ++c) {
+      if (c) text += ',';
+      const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), rows(r, c),
+                                        std::chars_format::general, precision);
+      text.append(buffer.data(), result.ptr);
+    }
+    text += '\n';
+  }
+  write_file_atomically(path, text);
+}
+
+CsvTable read_numeric_csv(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw core::IoError(path.string() +
+                        ": cannot open the CSV file for reading; hint: check the "
+                        "path and its permissions");
+  }
+  std::ostringstream content;
+  content << in.rdbuf();
+  std::string text = content.str();
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte order mark
+
+  CsvTable table;
+  table.source = path.string();
+  std::vector<double> values;  // row-major
+  std::size_t row_count = 0;
+  std::istringstream lines(text);
+  std::string line;
+  int line_number = 0;
+  while (std::getline(lines, line)) {
+    ++line_number;
+    const std::string_view content_view = trimmed(line);
+    if (content_view.empty() || content_view.starts_with('#')) continue;
+    const auto cells = split_cells(content_view);
+    if (table.header.empty()) {
+      std::set<std::string> seen;
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        std::string_view name = cells[c];
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"') {
+          name = trimmed(name.substr(1, name.size() - 2));
+        }
+        if (name.empty()) {
+          throw core::DataError(core::located(
+              table.source, line_number,
+              "header column " + std::to_string(c + 1) + " has no name: expected a column name"));
+        }
+        if (!seen.insert(std::string(name)).second) {
+          throw core::DataError(core::located(table.source, line_number,
+                                              "header column " + std::to_string(c + 1) + " '" +
+                                                  std::string(name) +
+                                                  "' repeats an earlier column name"));
+        }
+        table.header.emplace_back(name);
+      }
+      continue;
+    }
+    if (cells.size() != table.header.size()) {
+      throw core::DataError(
+          core::located(table.source, line_number,
+                        "row has " + std::to_string(cells.size()) + " cells: expected " +
+                            std::to_string(table.header.size()) + " (one per header column)"));
+    }
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      double value = 0.0;
+      if (!parsed_number(cells[c], value)) {
+        throw core::DataError(core::located(
+            table.source, line_number,
+            "column " + std::to_string(c + 1) + " (" + table.header[c] + ") = '" +
+                std::string(cells[c]) + "': expected a number; hint: write missing values as nan"));
+      }
+      values.push_back(value);
+    }
+    ++row_count;
+  }
+  if (table.header.empty()) {
+    throw core::DataError(core::located(table.source, 0,
+                                        "no header line: expected column names such as "
+                                        "time_s,T02_degC"));
+  }
+  const auto column_count = static_cast<Eigen::Index>(table.header.size());
+  table.rows =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          values.data(), static_cast<Eigen::Index>(row_count), column_count);
+  return table;
+}
+
+}  // namespace tt::io
