@@ -1,0 +1,232 @@
+#include "fitting/models.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace tt::fitting {
+
+namespace {
+
+FeatureMap feature_map(const ModelSpec& spec, const Group& group, const std::vector<int>& sensors) {
+  FeatureMap map;
+  map.sensors = sensors;
+  for (int s : sensors) {
+    if (s < 0 || s >= static_cast<int>(group.sensor_names.size()))
+      throw core::DataError("sensor column " + std::to_string(s) + "; expected an index in [0, " +
+                            std::to_string(group.sensor_names.size()) + ")");
+    map.sensor_names.push_back(group.sensor_names[static_cast<std::size_t>(s)]);
+  }
+  if (spec.kind == ModelKind::distributed_lag) {
+    if (spec.time_constants.empty())
+      throw core::DataError(
+          "distributed_lag model with no time constants; expected at least "
+          "one, e.g. {1800} s");
+    map.time_constants = spec.time_constants;
+  }
+  return map;
+}
+
+using Body = std::variant<LinearFit, PprModel>;
+
+Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
+  switch (spec.kind) {
+    case ModelKind::least_squares:
+      return linear_fit(x, y, 0.0);
+    case ModelKind::ridge:
+    case ModelKind::distributed_lag:
+      return linear_fit(x, y, spec.ridge_lambda);
+    case ModelKind::projection_pursuit:
+      return ppr_fit(x, y, spec.ppr);
+  }
+  throw core::DataError("unknown model kind");
+}
+
+Eigen::VectorXd body_prediction(const Body& body, const Eigen::MatrixXd& x) {
+  if (const auto* linear = std::get_if<LinearFit>(&body)) return linear_prediction(*linear, x);
+  return ppr_prediction(std::get<PprModel>(body), x);
+}
+
+Eigen::MatrixXd selected_rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
+  return out;
+}
+
+}  // namespace
+
+std::string kind_name(ModelKind kind) {
+  switch (kind) {
+    case ModelKind::least_squares:
+      return "least_squares";
+    case ModelKind::ridge:
+      return "ridge";
+    case ModelKind::projection_pursuit:
+      return "projection_pursuit";
+    case ModelKind::distributed_lag:
+      return "distributed_lag";
+  }
+  return "unknown";
+}
+
+std::string model_label(const ModelSpec& spec) {
+  std::ostringstream out;
+  out << kind_name(spec.kind);
+  switch (spec.kind) {
+    case ModelKind::least_squares:
+      break;
+    case ModelKind::ridge:
+      out << "(lambda=" << spec.ridge_lambda << ")";
+      break;
+    case ModelKind::projection_pursuit:
+      out << "(degree=" << spec.ppr.degree << ",max_terms=" << spec.ppr.max_terms << ")";
+      break;
+    case ModelKind::distributed_lag:
+      out << "(tau_s=";
+      for (std::size_t t = 0; t < spec.time_constants.size(); ++t)
+        out << (t ? "/" : "") << spec.time_constants[t];
+      out << ",lambda=" << spec.ridge_lambda << ")";
+      break;
+  }
+  return out.str();
+}
+
+FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
+                         const std::vector<int>& sensors, int target) {
+  require_consistent_groups(groups);
+  if (sensors.empty())
+    throw core::DataError("model '" + model_label(spec) +
+                          "' with no sensors; expected at least one temperature column");
+  const Group& first = groups.front();
+  if (target < 0 || target >= static_cast<int>(first.target_names.size()))
+    throw core::DataError("target " + std::to_string(target) + "; expected an index in [0, " +
+                          std::to_string(first.target_names.size()) + ")");
+  FittedModel model;
+  model.spec = spec;
+  model.features = feature_map(spec, first, sensors);
+  model.target = target;
+  model.target_name = first.target_names[static_cast<std::size_t>(target)];
+  for (const Group& g : groups) model.fitted_on.push_back(g.name);
+
+  const StackedRows rows = stacked_rows(model.features, groups, target);
+  const Eigen::Index n = rows.error.size();
+  const Eigen::Index minimum = rows.features.cols() + 3;
+  std::vector<Eigen::Index> kept(static_cast<std::size_t>(n));
+  std::iota(kept.begin(), kept.end(), Eigen::Index{0});
+  model.rejection.samples = static_cast<int>(n);
+  // The 3σ loop ends when a fit leaves no residual beyond 3σ; 100 passes is far more than the few
+  // a campaign with gross errors needs and only guards against a pathological cycle.
+  for (int pass = 1; pass <= 100; ++pass) {
+    const Eigen::MatrixXd x = selected_rows(rows.features, kept);
+    Eigen::VectorXd y(static_cast<Eigen::Index>(kept.size()));
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      y(static_cast<Eigen::Index>(i)) = rows.error(kept[i]);
+    model.body = body_fit(spec, x, y);
+    model.rejection.passes = pass;
+    if (!spec.reject_gross_errors) break;
+    const Eigen::VectorXd residual = y - body_prediction(model.body, x);
+    const double limit = 3.0 * residual_std(residual);
+    std::vector<Eigen::Index> next;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      if (std::abs(residual(static_cast<Eigen::Index>(i))) <= limit) next.push_back(kept[i]);
+    if (next.size() == kept.size()) break;
+    if (static_cast<Eigen::Index>(next.size()) < minimum)
+      throw core::DataError("3σ rejection left " + std::to_string(next.size()) + " of " +
+                            std::to_string(n) + " samples for model '" + model_label(spec) +
+                            "'; expected at least " + std::to_string(minimum) +
+                            "; hint: check the data for a broken sensor");
+    kept = std::move(next);
+  }
+  model.rejection.rejected = static_cast<int>(n - static_cast<Eigen::Index>(kept.size()));
+  std::vector<bool> is_kept(static_cast<std::size_t>(n), false);
+  for (Eigen::Index row : kept) is_kept[static_cast<std::size_t>(row)] = true;
+  for (Eigen::Index row = 0; row < n; ++row)
+    if (!is_kept[static_cast<std::size_t>(row)])
+      model.rejection.rejected_rows.push_back(static_cast<int>(row));
+  return model;
+}
+
+Eigen::VectorXd predicted_error(const FittedModel& model, const Group& group) {
+  for (std::size_t k = 0; k < model.features.sensors.size(); ++k) {
+    const auto column = static_cast<std::size_t>(model.features.sensors[k]);
+    const std::string found =
+        column < group.sensor_names.size() ? "'" + group.sensor_names[column] + "'" : "missing";
+    if (found != "'" + model.features.sensor_names[k] + "'")
+      throw core::DataError("group '" + group.name + "' temperature column " +
+                            std::to_string(column) + " is " + found + "; the model expects '" +
+                            model.features.sensor_names[k] +
+                            "'; hint: predict on groups of the campaign the model was fitted on");
+  }
+  return body_prediction(model.body, feature_matrix(model.features, group));
+}
+
+Accuracy model_accuracy(const FittedModel& model, const std::vector<Group>& groups) {
+  std::vector<double> s;
+  for (const Group& g : groups) {
+    if (model.target >= g.error.cols())
+      throw core::DataError("group '" + g.name + "' has " + std::to_string(g.error.cols()) +
+                            " targets; the model predicts target " + std::to_string(model.target));
+    s.push_back(residual_std(g.error.col(model.target) - predicted_error(model, g)));
+  }
+  return accuracy(s);
+}
+
+std::vector<int> sensors_by_correlation(const std::vector<Group>& groups, int target, int count) {
+  require_consistent_groups(groups);
+  const int sensors = static_cast<int>(groups.front().sensor_names.size());
+  if (count < 1 || count > sensors)
+    throw core::DataError("sensor count " + std::to_string(count) + "; expected 1.." +
+                          std::to_string(sensors) + " (the standard recommends 2 to 4)");
+  FeatureMap all;
+  all.sensors.resize(static_cast<std::size_t>(sensors));
+  std::iota(all.sensors.begin(), all.sensors.end(), 0);
+  all.sensor_names = groups.front().sensor_names;
+  const StackedRows rows = stacked_rows(all, groups, target);
+  const Eigen::VectorXd e = rows.error.array() - rows.error.mean();
+  std::vector<double> score(static_cast<std::size_t>(sensors));
+  for (int k = 0; k < sensors; ++k) {
+    const Eigen::VectorXd t = rows.features.col(k).array() - rows.features.col(k).mean();
+    const double denominator = t.norm() * e.norm();
+    score[static_cast<std::size_t>(k)] = denominator > 0.0 ? std::abs(t.dot(e)) / denominator : 0.0;
+  }
+  std::vector<int> order(static_cast<std::size_t>(sensors));
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return score[static_cast<std::size_t>(a)] > score[static_cast<std::size_t>(b)];
+  });
+  order.resize(static_cast<std::size_t>(count));
+  return order;
+}
+
+std::vector<ModelSpec> default_model_candidates() {
+  std::vector<ModelSpec> specs;
+  specs.push_back(ModelSpec{});
+  for (double lambda : {1e-4, 1e-3, 1e-2, 1e-1}) {
+    ModelSpec s;
+    s.kind = ModelKind::ridge;
+    s.ridge_lambda = lambda;
+    specs.push_back(s);
+  }
+  for (auto [degree, terms] : {std::pair{2, 2}, std::pair{3, 2}, std::pair{3, 4}}) {
+    ModelSpec s;
+    s.kind = ModelKind::projection_pursuit;
+    s.ppr.degree = degree;
+    s.ppr.max_terms = terms;
+    specs.push_back(s);
+  }
+  for (const std::vector<double>& taus : std::vector<std::vector<double>>{
+           {600.0}, {1800.0}, {5400.0}, {900.0, 3600.0}, {600.0, 2400.0, 9600.0}}) {
+    ModelSpec s;
+    s.kind = ModelKind::distributed_lag;
+    s.time_constants = taus;
+    s.ridge_lambda = 1e-6;
+    specs.push_back(s);
+  }
+  return specs;
+}
+
+}  // namespace tt::fitting

@@ -1,0 +1,92 @@
+// Thermal-error models behind one interface: fit on groups, get a model value; predict on a group.
+// Every model reads the increments ΔT_k = T_k − T_k0 of its sensors, each group relative to its
+// own first reading (the standard's formula 2).
+#pragma once
+
+#include <Eigen/Dense>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "fitting/features.hpp"
+#include "fitting/group.hpp"
+#include "fitting/linear.hpp"
+#include "fitting/metrics.hpp"
+#include "fitting/ppr.hpp"
+
+namespace tt::fitting {
+
+enum class ModelKind {
+  /// the standard's E = β0 + Σ β_k ΔT_k (DB3401/T 326-2024 7.3)
+  least_squares,
+  /// the same model with standardised ridge shrinkage ridge_lambda
+  ridge,
+  /// projection pursuit regression with polynomial ridge functions (seed 002)
+  projection_pursuit,
+  /// linear in ΔT_k and in ΔT_k low-pass filtered with each of time_constants (distributed lags)
+  distributed_lag,
+};
+
+/// A model type with its settings: one candidate of the selection.
+struct ModelSpec {
+  ModelKind kind = ModelKind::least_squares;
+  /// dimensionless ridge strength (ridge, distributed_lag); see linear_fit
+  double ridge_lambda = 0.0;
+  /// low-pass time constants of distributed_lag [s]
+  std::vector<double> time_constants;
+  /// settings of projection_pursuit
+  PprOptions ppr;
+  /// the standard's 3σ criterion on the fitting samples (6.2.2): refit and drop samples whose
+  /// residual exceeds 3 residual standard deviations until none does
+  bool reject_gross_errors = true;
+};
+
+/// "least_squares", "ridge", "projection_pursuit" or "distributed_lag".
+std::string kind_name(ModelKind kind);
+
+/// A short label naming the kind and its settings, e.g. "ridge(lambda=0.001)".
+std::string model_label(const ModelSpec& spec);
+
+/// How many fitting samples the 3σ criterion dropped.
+struct GrossErrorRejection {
+  int samples = 0;
+  int rejected = 0;
+  /// rows dropped, counted over the fitting groups' samples stacked in group order
+  std::vector<int> rejected_rows;
+  /// fits done, the last one with no residual beyond 3σ
+  int passes = 0;
+};
+
+/// A fitted model: predicts one target from the sensors its feature map names.
+struct FittedModel {
+  ModelSpec spec;
+  FeatureMap features;
+  int target = 0;
+  std::string target_name;
+  /// LinearFit for least_squares, ridge and distributed_lag; PprModel for projection_pursuit
+  std::variant<LinearFit, PprModel> body;
+  GrossErrorRejection rejection;
+  /// names of the groups the coefficients were fitted on
+  std::vector<std::string> fitted_on;
+};
+
+/// Fits `spec` to error column `target` of the groups, reading the temperature columns `sensors`.
+/// Throws DataError on inconsistent groups or too few samples.
+FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
+                         const std::vector<int>& sensors, int target);
+
+/// #samples predicted error of the model's target on a group [m].
+Eigen::VectorXd predicted_error(const FittedModel& model, const Group& group);
+
+/// S per group (formula 5), S_M and S_σ of the model on the groups [m].
+Accuracy model_accuracy(const FittedModel& model, const std::vector<Group>& groups);
+
+/// The `count` sensors whose increments correlate best (largest |r|, pooled over the groups) with
+/// error column `target` (DB3401/T 326-2024 7.1), best first.
+std::vector<int> sensors_by_correlation(const std::vector<Group>& groups, int target, int count);
+
+/// The candidates the selection tries when none are given: least squares, ridge at four
+/// strengths, three PPR settings and five distributed-lag time-constant sets.
+std::vector<ModelSpec> default_model_candidates();
+
+}  // namespace tt::fitting
