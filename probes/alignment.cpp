@@ -173,11 +173,10 @@ Eigen::MatrixXd periodic_extension(const Eigen::MatrixXd& samples, double sample
 std::vector<double> alignment_scores(const Eigen::MatrixXd& reference,
                                      const Eigen::MatrixXd& extended, const AlignmentPlan& plan,
                                      AlignmentMethod method) {
-  const Eigen::MatrixXd& samples = extended;
   const Eigen::Index m = plan.window_samples;
-  if (reference.rows() != m || samples.rows() < m + plan.offsets)
+  if (reference.rows() != m || extended.rows() < m + plan.offsets)
     throw core::DataError("alignment_scores: reference of " + std::to_string(reference.rows()) +
-                          " rows and reading of " + std::to_string(samples.rows()) +
+                          " rows and reading of " + std::to_string(extended.rows()) +
                           " rows do not fit a window of " + std::to_string(m) + " and " +
                           std::to_string(plan.offsets) + " offsets");
   std::vector<double> scores(static_cast<std::size_t>(plan.offsets), 0.0);
@@ -185,7 +184,7 @@ std::vector<double> alignment_scores(const Eigen::MatrixXd& reference,
     double distance = 0.0, correlation = 0.0;
     for (int p : plan.probes) {
       const auto ref = reference.col(p);
-      const auto cand = samples.col(p).segment(k, m);
+      const auto cand = extended.col(p).segment(k, m);
       correlation += pearson(ref, cand);
       if (method == AlignmentMethod::information_distance)
         distance += information_distance(ref, cand, plan.bins);
