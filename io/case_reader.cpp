@@ -1,0 +1,1242 @@
+// Reads a case file into core::CaseSpec. Every key is checked against the keys its table may
+// hold, every value against its type and range, every name against what it refers to, and every
+// failure names the file, the line, the key path and the value received.
+#include "io/case_reader.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace tt::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+using core::CaseError;
+using core::CaseSpec;
+using Names = std::vector<std::string>;
+
+// ---------------------------------------------------------------------------------------------
+// Text helpers shared by the reader (messages) and the writer (resolved TOML).
+
+/// Shortest decimal that parses back to exactly `v`, in TOML float syntax.
+std::string number_text(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  std::string s(buf, end);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// A TOML basic string.
+std::string toml_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04X", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+/// A TOML key: bare when it can be, quoted otherwise.
+std::string key_text(std::string_view k) {
+  const bool bare = !k.empty() && std::all_of(k.begin(), k.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+  return bare ? std::string(k) : toml_string(k);
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+/// Optimal-string-alignment distance (edits, adjacent swaps count one), case-insensitive.
+std::size_t edit_distance(std::string_view a_in, std::string_view b_in) {
+  const std::string a = lower(a_in), b = lower(b_in);
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  }
+  return d[a.size()][b.size()];
+}
+
+/// "did you mean 'x'?" for a near miss (a few edits, or the same key with/without its unit
+/// suffix), otherwise the list of what is allowed.
+std::string suggestion(std::string_view wrong, const Names& known) {
+  if (known.empty()) return "nothing is declared to refer to";
+  const std::string w = lower(wrong);
+  std::string best;
+  std::size_t best_d = std::string::npos;
+  for (const auto& k : known) {
+    std::size_t d = edit_distance(wrong, k);
+    const std::string lk = lower(k);
+    if (!w.empty() && (lk.rfind(w + "_", 0) == 0 || w.rfind(lk + "_", 0) == 0)) d = 1;
+    if (d < best_d) best_d = d, best = k;
+  }
+  const std::size_t limit = std::max<std::size_t>(2, std::min<std::size_t>(4, wrong.size() / 3));
+  if (best_d <= limit) return "did you mean '" + best + "'?";
+  std::string list;
+  for (const auto& k : known) list += (list.empty() ? "'" : ", '") + k + "'";
+  return "expected one of " + list;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading context and typed access to TOML nodes.
+
+struct Ctx {
+  std::string file;           /// the case file as given, for messages
+  fs::path dir;               /// folder that relative file names in the case resolve against
+  double length_divisor = 1;  /// case length unit -> m: value / divisor (1 for m, 1000 for mm)
+};
+
+int line_of(const toml::node& n) {
+  return static_cast<int>(n.source().begin.line);
+}
+
+[[noreturn]] void fail(const Ctx& c, int line, const std::string& message) {
+  throw CaseError(core::located(c.file, line, message));
+}
+
+/// The value as it would be written in TOML, on one line (inline tables for tables).
+std::string node_text(const toml::node& n) {
+  if (const auto* x = n.as_string()) return toml_string(x->get());
+  if (const auto* x = n.as_integer()) return std::to_string(x->get());
+  if (const auto* x = n.as_floating_point()) return number_text(x->get());
+  if (const auto* x = n.as_boolean()) return x->get() ? "true" : "false";
+  if (const auto* a = n.as_array()) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < a->size() && s.size() < 100; ++i)
+      s += (i ? ", " : "") + node_text((*a)[i]);
+    return s + "]";
+  }
+  if (const auto* t = n.as_table()) {
+    std::string s = "{";
+    for (auto&& [k, v] : *t) {
+      if (s.size() >= 100) break;
+      s += (s.size() > 1 ? ", " : " ") + key_text(k.str()) + " = " + node_text(v);
+    }
+    return s + (s.size() > 1 ? " }" : "}");
+  }
+  std::ostringstream os;  // dates and times: whatever toml++ writes
+  os << toml::node_view<const toml::node>(&n);
+  return os.str();
+}
+
+std::string value_text(const toml::node& n) {
+  std::string s = node_text(n);
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+/// "path = value: expected[; hint]" at the node's line.
+[[noreturn]] void fail_value(const Ctx& c, const toml::node& n, const std::string& path,
+                             const std::string& expected, const std::string& hint = {}) {
+  fail(c, line_of(n),
+       path + " = " + value_text(n) + ": " + expected + (hint.empty() ? "" : "; " + hint));
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a float";
+    case toml::node_type::boolean:
+      return "a boolean";
+    default:
+      return "a date/time";
+  }
+}
+
+[[noreturn]] void fail_type(const Ctx& c, const toml::node& n, const std::string& path,
+                            const std::string& expected, const std::string& hint = {}) {
+  fail_value(c, n, path, "expected " + expected + ", got " + type_name(n), hint);
+}
+
+/// A table being read, with its key path ("materials.steel", "bodies[1].add[0].cylinder").
+struct Tab {
+  const Ctx* ctx;
+  const toml::table* t;
+  std::string path;
+
+  std::string at(std::string_view key) const {
+    return path.empty() ? std::string(key) : path + "." + std::string(key);
+  }
+  const toml::node* get(std::string_view key) const { return t->get(key); }
+  int line() const { return line_of(*t); }
+
+  /// Every key present must be one of `known`.
+  void allow(const Names& known) const {
+    for (auto&& [k, v] : *t) {
+      if (std::find(known.begin(), known.end(), k.str()) != known.end()) continue;
+      fail(*ctx, static_cast<int>(k.source().begin.line),
+           at(k.str()) + " = " + value_text(v) + ": unknown key; " + suggestion(k.str(), known));
+    }
+  }
+
+  const toml::node& need(std::string_view key, const std::string& expected) const {
+    const toml::node* n = get(key);
+    if (!n) {
+      fail(*ctx, line(),
+           at(key) + ": missing; expected " + expected + " in " +
+               (path.empty() ? "the file" : path));
+    }
+    return *n;
+  }
+};
+
+Tab as_tab(const Ctx& c, const toml::node& n, const std::string& path,
+           const std::string& expected = "a table") {
+  if (!n.is_table()) fail_type(c, n, path, expected);
+  return Tab{&c, n.as_table(), path};
+}
+
+double as_number(const Ctx& c, const toml::node& n, const std::string& path) {
+  double v = 0;
+  if (const auto* f = n.as_floating_point()) {
+    v = f->get();
+  } else if (const auto* i = n.as_integer()) {
+    v = static_cast<double>(i->get());
+  } else {
+    fail_type(c, n, path, "a number");
+  }
+  if (!std::isfinite(v)) fail_value(c, n, path, "must be a finite number");
+  return v;
+}
+
+enum class Sign { any, positive, non_negative };
+
+double checked(const Ctx& c, const toml::node& n, const std::string& path, Sign sign,
+               const std::string& hint) {
+  const double v = as_number(c, n, path);
+  if (sign == Sign::positive && !(v > 0)) fail_value(c, n, path, "must be > 0", hint);
+  if (sign == Sign::non_negative && v < 0) fail_value(c, n, path, "must be >= 0", hint);
+  return v;
+}
+
+double number(const Tab& t, std::string_view key, Sign sign = Sign::any,
+              const std::string& hint = {}) {
+  return checked(*t.ctx, t.need(key, "a number"), t.at(key), sign, hint);
+}
+
+double number_or(const Tab& t, std::string_view key, double fallback, Sign sign = Sign::any,
+                 const std::string& hint = {}) {
+  const toml::node* n = t.get(key);
+  return n ? checked(*t.ctx, *n, t.at(key), sign, hint) : fallback;
+}
+
+/// A length in the case's unit, returned in m.
+double length(const Tab& t, std::string_view key, Sign sign = Sign::positive,
+              const std::string& hint = "a length in [geometry] length_unit") {
+  return number(t, key, sign, hint) / t.ctx->length_divisor;
+}
+
+std::int64_t integer(const Ctx& c, const toml::node& n, const std::string& path) {
+  if (const auto* i = n.as_integer()) return i->get();
+  fail_type(c, n, path, "an integer", "write it without a decimal point");
+}
+
+std::string as_string(const Ctx& c, const toml::node& n, const std::string& path) {
+  if (const auto* s = n.as_string()) return s->get();
+  fail_type(c, n, path, "a string", "put it in double quotes");
+}
+
+/// A non-empty string.
+std::string name(const Tab& t, std::string_view key) {
+  const auto& n = t.need(key, "a string");
+  std::string s = as_string(*t.ctx, n, t.at(key));
+  if (s.empty()) fail_value(*t.ctx, n, t.at(key), "must not be empty");
+  return s;
+}
+
+bool flag_or(const Tab& t, std::string_view key, bool fallback) {
+  const toml::node* n = t.get(key);
+  if (!n) return fallback;
+  if (const auto* b = n->as_boolean()) return b->get();
+  fail_type(*t.ctx, *n, t.at(key), "true or false");
+}
+
+const toml::array& as_array(const Ctx& c, const toml::node& n, const std::string& path,
+                            const std::string& expected = "an array") {
+  if (!n.is_array()) fail_type(c, n, path, expected);
+  return *n.as_array();
+}
+
+template <class E>
+using Choices = std::vector<std::pair<std::string, E>>;
+
+template <class E>
+E choice(const Ctx& c, const toml::node& n, const std::string& path, const Choices<E>& choices) {
+  const std::string s = as_string(c, n, path);
+  Names names;
+  for (const auto& [k, e] : choices) {
+    if (k == s) return e;
+    names.push_back(k);
+  }
+  fail_value(c, n, path, "unknown value", suggestion(s, names));
+}
+
+template <class E>
+E choice_or(const Tab& t, std::string_view key, E fallback, const Choices<E>& choices) {
+  const toml::node* n = t.get(key);
+  return n ? choice(*t.ctx, *n, t.at(key), choices) : fallback;
+}
+
+/// Index of `n`'s string among `names`; `what` names the kind ("body", "boundary group").
+int reference(const Ctx& c, const toml::node& n, const std::string& path, const Names& names,
+              const std::string& what) {
+  const std::string s = as_string(c, n, path);
+  const auto it = std::find(names.begin(), names.end(), s);
+  if (it != names.end()) return static_cast<int>(it - names.begin());
+  fail_value(c, n, path, "no " + what + " of that name", suggestion(s, names));
+}
+
+int reference(const Tab& t, std::string_view key, const Names& names, const std::string& what) {
+  return reference(*t.ctx, t.need(key, "the name of a " + what), t.at(key), names, what);
+}
+
+std::vector<int> references(const Ctx& c, const toml::node& n, const std::string& path,
+                            const Names& names, const std::string& what) {
+  const auto& a = as_array(c, n, path, "an array of " + what + " names");
+  std::vector<int> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string p = path + "[" + std::to_string(i) + "]";
+    const int r = reference(c, a[i], p, names, what);
+    if (std::find(out.begin(), out.end(), r) != out.end())
+      fail_value(c, a[i], p, "listed twice", "name each " + what + " once");
+    out.push_back(r);
+  }
+  return out;
+}
+
+/// Fixed-size list of finite numbers.
+Eigen::VectorXd numbers(const Ctx& c, const toml::node& n, const std::string& path, int count,
+                        const std::string& shape) {
+  const auto& a = as_array(c, n, path, "an array " + shape);
+  if (static_cast<int>(a.size()) != count)
+    fail_value(c, n, path, "expected " + std::to_string(count) + " numbers " + shape);
+  Eigen::VectorXd v(count);
+  for (int i = 0; i < count; ++i) v[i] = as_number(c, a[i], path + "[" + std::to_string(i) + "]");
+  return v;
+}
+
+Eigen::Vector3d point3(const Tab& t, std::string_view key) {
+  return numbers(*t.ctx, t.need(key, "[x, y, z]"), t.at(key), 3, "[x, y, z]") /
+         t.ctx->length_divisor;
+}
+
+Eigen::Vector2d axis2(const Tab& t, std::string_view key) {
+  return numbers(*t.ctx, t.need(key, "[x, y] of the z-parallel axis"), t.at(key), 2, "[x, y]") /
+         t.ctx->length_divisor;
+}
+
+/// Array of tables (`[[key]]` or an array of inline tables), each passed to `read` with its path.
+template <class F>
+void each_table(const Tab& t, std::string_view key, F&& read) {
+  const toml::node* n = t.get(key);
+  if (!n) return;
+  const std::string path = t.at(key);
+  const auto& a = as_array(*t.ctx, *n, path, "an array of tables ([[" + path + "]])");
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string p = path + "[" + std::to_string(i) + "]";
+    read(as_tab(*t.ctx, a[i], p), i);
+  }
+}
+
+/// The case file's length unit as a divisor to m.
+double unit_divisor(const Ctx& c, const toml::node& n, const std::string& path) {
+  return choice<double>(c, n, path, {{"m", 1.0}, {"mm", 1000.0}});
+}
+
+void check_box(const Ctx& c, const Tab& t, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(lo[i] < hi[i])) {
+      fail_value(c, t.need("max", ""), t.at("max"),
+                 "must exceed min = " + value_text(t.need("min", "")) + " in every coordinate (" +
+                     std::string(1, "xyz"[i]) + " is not)",
+                 "min is the lower corner, max the upper one");
+    }
+  }
+}
+
+/// z = [z0, z1] with z0 < z1, in m.
+std::pair<double, double> z_range(const Tab& t) {
+  const auto& n = t.need("z", "[z0, z1]");
+  const Eigen::VectorXd z = numbers(*t.ctx, n, t.at("z"), 2, "[z0, z1]");
+  if (!(z[0] < z[1])) fail_value(*t.ctx, n, t.at("z"), "must have z0 < z1", "z = [start, end]");
+  return {z[0] / t.ctx->length_divisor, z[1] / t.ctx->length_divisor};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sections.
+
+void read_header(const Tab& root, CaseSpec& spec) {
+  const Tab c = as_tab(*root.ctx, root.need("case", "a [case] table with name"), "case");
+  c.allow({"name", "machine", "seed"});
+  spec.name = name(c, "name");
+  if (const auto* m = c.get("machine")) spec.machine = as_string(*c.ctx, *m, c.at("machine"));
+  if (const auto* s = c.get("seed")) {
+    const auto v = integer(*c.ctx, *s, c.at("seed"));
+    if (v < 0) fail_value(*c.ctx, *s, c.at("seed"), "must be >= 0");
+    spec.seed = static_cast<std::uint64_t>(v);
+  }
+}
+
+Names material_keys() {
+  return {"density_kg_m3",     "specific_heat_J_kgK", "conductivity_W_mK",
+          "youngs_modulus_Pa", "poisson_ratio",       "expansion_per_K"};
+}
+
+void read_materials(const Tab& root, CaseSpec& spec) {
+  const Tab all =
+      as_tab(*root.ctx, root.need("materials", "[materials.<name>] tables"), "materials");
+  // toml++ keeps keys sorted; the case's order is the order of declaration.
+  std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+  for (auto&& [k, v] : *all.t) entries.emplace_back(&k, &v);
+  std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+    const auto &sa = a.first->source().begin, &sb = b.first->source().begin;
+    return std::tie(sa.line, sa.column) < std::tie(sb.line, sb.column);
+  });
+  if (entries.empty()) fail(*root.ctx, all.line(), "materials: none declared");
+  for (const auto& [k, v] : entries) {
+    const Tab m = as_tab(*root.ctx, *v, all.at(k->str()), "a [materials.<name>] table");
+    m.allow(material_keys());
+    core::Material mat;
+    mat.name = k->str();
+    mat.density = number(m, "density_kg_m3", Sign::positive, "a density in kg/m^3, steel is 7850");
+    mat.specific_heat =
+        number(m, "specific_heat_J_kgK", Sign::positive, "in J/(kg K), steel is about 460");
+    mat.conductivity =
+        number(m, "conductivity_W_mK", Sign::positive, "in W/(m K), steel is about 45");
+    mat.youngs_modulus =
+        number(m, "youngs_modulus_Pa", Sign::positive, "in Pa, steel is about 2.1e11");
+    const auto& nu = m.need("poisson_ratio", "a number in (-1, 0.5)");
+    mat.poisson_ratio = as_number(*m.ctx, nu, m.at("poisson_ratio"));
+    if (!(mat.poisson_ratio > -1 && mat.poisson_ratio < 0.5))
+      fail_value(*m.ctx, nu, m.at("poisson_ratio"), "must lie in (-1, 0.5)",
+                 "0.5 is incompressible and singular; metals are about 0.3");
+    mat.expansion = number(m, "expansion_per_K", Sign::any, "in 1/K, steel is about 1.2e-5");
+    spec.materials.push_back(mat);
+  }
+}
+
+core::Primitive read_primitive(const Tab& p, const std::string& where) {
+  const Ctx& c = *p.ctx;
+  const Names kinds = {"box", "cylinder", "annulus", "surface"};
+  p.allow(kinds);
+  if (p.t->size() != 1) {
+    fail(c, p.line(),
+         where + " = " + value_text(*p.t) +
+             ": expected exactly one of 'box', 'cylinder', 'annulus', 'surface'");
+  }
+  // toml++ iterators hand out a proxy that lives inside the iterator: keep the iterator alive.
+  const auto only = p.t->begin();
+  const std::string key(only->first.str());
+  const toml::node& node = only->second;
+  core::Primitive prim;
+  prim.where = where;
+  const Tab s = as_tab(c, node, p.at(key), "an inline table");
+  if (key == "box") {
+    s.allow({"min", "max"});
+    prim.kind = core::Primitive::Kind::box;
+    prim.min = point3(s, "min");
+    prim.max = point3(s, "max");
+    check_box(c, s, prim.min, prim.max);
+  } else if (key == "cylinder") {
+    s.allow({"axis", "radius", "z"});
+    prim.kind = core::Primitive::Kind::cylinder;
+    prim.axis = axis2(s, "axis");
+    prim.radius = length(s, "radius");
+    std::tie(prim.z_min, prim.z_max) = z_range(s);
+  } else if (key == "annulus") {
+    s.allow({"axis", "inner_radius", "outer_radius", "z"});
+    prim.kind = core::Primitive::Kind::annulus;
+    prim.axis = axis2(s, "axis");
+    prim.inner_radius = length(s, "inner_radius", Sign::positive, "use a cylinder for a solid");
+    prim.radius = length(s, "outer_radius");
+    if (!(prim.inner_radius < prim.radius))
+      fail_value(c, s.need("outer_radius", ""), s.at("outer_radius"),
+                 "must exceed inner_radius = " + value_text(s.need("inner_radius", "")));
+    std::tie(prim.z_min, prim.z_max) = z_range(s);
+  } else {
+    s.allow({"file", "unit"});
+    prim.kind = core::Primitive::Kind::surface_file;
+    const auto& fn = s.need("file", "a path relative to the case file");
+    const std::string rel = as_string(c, fn, s.at("file"));
+    prim.file = fs::absolute(c.dir / rel).lexically_normal();
+    std::error_code ec;
+    if (rel.empty() || !fs::is_regular_file(prim.file, ec))
+      fail_value(c, fn, s.at("file"), "no such file (looked for " + prim.file.string() + ")",
+                 "paths are relative to the case file's folder");
+    const std::string ext = lower(prim.file.extension().string());
+    if (ext != ".stl" && ext != ".off" && ext != ".ply")
+      fail_value(c, fn, s.at("file"), "expected a closed surface in STL, OFF or PLY format");
+    const double divisor =
+        s.get("unit") ? unit_divisor(c, *s.get("unit"), s.at("unit")) : c.length_divisor;
+    prim.file_scale = 1.0 / divisor;
+  }
+  return prim;
+}
+
+std::vector<core::Primitive> read_primitives(const Tab& b, std::string_view key, bool required) {
+  std::vector<core::Primitive> out;
+  const toml::node* n = b.get(key);
+  if (!n && !required) return out;
+  const std::string path = b.at(key);
+  const auto& a = as_array(*b.ctx, b.need(key, "an array of primitives"), path,
+                           "an array of { box | cylinder | annulus | surface = {...} }");
+  if (required && a.empty())
+    fail_value(*b.ctx, *n, path, "must list at least one primitive", "e.g. [ { box = {...} } ]");
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string p = path + "[" + std::to_string(i) + "]";
+    out.push_back(read_primitive(as_tab(*b.ctx, a[i], p, "an inline table"), p));
+  }
+  return out;
+}
+
+Names names_of(const auto& items) {
+  Names out;
+  for (const auto& x : items) out.push_back(x.name);
+  return out;
+}
+
+/// Fails when `value` is already among the names read so far.
+void unique(const Tab& t, std::string_view key, const std::string& value, const Names& before,
+            const std::string& what) {
+  if (std::find(before.begin(), before.end(), value) != before.end())
+    fail_value(*t.ctx, t.need(key, ""), t.at(key), "a second " + what + " of that name",
+               "names must be unique");
+}
+
+void read_bodies(const Tab& root, CaseSpec& spec) {
+  root.need("bodies", "[[bodies]] tables");
+  const Names materials = names_of(spec.materials);
+  each_table(root, "bodies", [&](const Tab& b, std::size_t) {
+    b.allow({"name", "material", "max_edge", "add", "subtract"});
+    core::Body body;
+    body.name = name(b, "name");
+    unique(b, "name", body.name, names_of(spec.bodies), "body");
+    body.material = reference(b, "material", materials, "material");
+    body.max_edge = length(b, "max_edge", Sign::positive, "the target tet edge length");
+    body.add = read_primitives(b, "add", true);
+    body.subtract = read_primitives(b, "subtract", false);
+    spec.bodies.push_back(body);
+  });
+  if (spec.bodies.empty()) fail(*root.ctx, line_of(*root.get("bodies")), "bodies: none declared");
+}
+
+void read_mesh(const Tab& root, CaseSpec& spec) {
+  const toml::node* n = root.get("mesh");
+  if (!n) return;
+  const Tab m = as_tab(*root.ctx, *n, "mesh");
+  m.allow({"order", "circle_segments", "radius_edge_ratio", "min_dihedral_deg"});
+  if (const auto* o = m.get("order")) {
+    const auto v = integer(*m.ctx, *o, m.at("order"));
+    if (v != 1 && v != 2)
+      fail_value(*m.ctx, *o, m.at("order"), "must be 1 or 2",
+                 "1: 4-node tetrahedra, 2: 10-node (needed for thermal bending)");
+    spec.mesh.order = static_cast<int>(v);
+  }
+  if (const auto* s = m.get("circle_segments")) {
+    const auto v = integer(*m.ctx, *s, m.at("circle_segments"));
+    if (v < 8 || v > 100000)
+      fail_value(*m.ctx, *s, m.at("circle_segments"), "must be at least 8",
+                 "facets around each cylinder; 48 keeps the radius within 0.2 %");
+    spec.mesh.circle_segments = static_cast<int>(v);
+  }
+  if (const auto* r = m.get("radius_edge_ratio")) {
+    spec.mesh.radius_edge_ratio = as_number(*m.ctx, *r, m.at("radius_edge_ratio"));
+    if (!(spec.mesh.radius_edge_ratio > 1.0))
+      fail_value(*m.ctx, *r, m.at("radius_edge_ratio"), "must be > 1",
+                 "TetGen may not terminate below about 1.1; 1.5 is a good default");
+  }
+  if (const auto* d = m.get("min_dihedral_deg")) {
+    spec.mesh.min_dihedral_deg = as_number(*m.ctx, *d, m.at("min_dihedral_deg"));
+    if (!(spec.mesh.min_dihedral_deg >= 0 && spec.mesh.min_dihedral_deg < 70))
+      fail_value(*m.ctx, *d, m.at("min_dihedral_deg"), "must lie in [0, 70)",
+                 "a regular tetrahedron has 70.5 deg; TetGen manages about 12-18");
+  }
+}
+
+core::FaceSelector read_selector(const Tab& s, const Names& bodies) {
+  const Ctx& c = *s.ctx;
+  s.allow({"bodies", "side", "other_bodies", "plane", "on_cylinder", "within"});
+  core::FaceSelector sel;
+  using Side = core::FaceSelector::Side;
+  if (const auto* b = s.get("bodies"))
+    sel.bodies = references(c, *b, s.at("bodies"), bodies, "body");
+  sel.side = choice_or<Side>(
+      s, "side", Side::exterior,
+      {{"exterior", Side::exterior}, {"interface", Side::interface}, {"any", Side::any}});
+  if (const auto* o = s.get("other_bodies")) {
+    if (sel.side != Side::interface)
+      fail_value(c, *o, s.at("other_bodies"), "only meaningful with side = \"interface\"",
+                 "exterior faces have no body across them");
+    sel.other_bodies = references(c, *o, s.at("other_bodies"), bodies, "body");
+  }
+  if (const auto* p = s.get("plane")) {
+    const Tab pt = as_tab(c, *p, s.at("plane"), "{ normal = [x, y, z], offset = d }");
+    pt.allow({"normal", "offset"});
+    const auto& nn = pt.need("normal", "[x, y, z]");
+    const Eigen::Vector3d normal = numbers(c, nn, pt.at("normal"), 3, "[x, y, z]");
+    const double norm = normal.norm();
+    if (!(norm > 0)) fail_value(c, nn, pt.at("normal"), "must not be zero", "e.g. [0, 1, 0]");
+    const double offset = number(pt, "offset") / c.length_divisor;
+    sel.plane =
+        Eigen::Vector4d(normal.x() / norm, normal.y() / norm, normal.z() / norm, offset / norm);
+  }
+  if (const auto* oc = s.get("on_cylinder")) {
+    const Tab ct = as_tab(c, *oc, s.at("on_cylinder"), "{ axis = [x, y], radius = r }");
+    ct.allow({"axis", "radius"});
+    sel.on_cylinder = core::FaceSelector::Cylinder{axis2(ct, "axis"), length(ct, "radius")};
+  }
+  if (const auto* w = s.get("within")) {
+    const Tab wt = as_tab(c, *w, s.at("within"), "{ min = [x, y, z], max = [x, y, z] }");
+    wt.allow({"min", "max"});
+    sel.within_min = point3(wt, "min");
+    sel.within_max = point3(wt, "max");
+    check_box(c, wt, *sel.within_min, *sel.within_max);
+  }
+  return sel;
+}
+
+void read_boundary(const Tab& root, CaseSpec& spec) {
+  const Names bodies = names_of(spec.bodies);
+  each_table(root, "boundary", [&](const Tab& g, std::size_t) {
+    g.allow({"name", "rest", "select"});
+    core::BoundaryGroup group;
+    group.name = name(g, "name");
+    unique(g, "name", group.name, names_of(spec.groups), "boundary group");
+    group.rest = flag_or(g, "rest", false);
+    const auto& sn = g.need("select", "an array of selectors");
+    const auto& a = as_array(*g.ctx, sn, g.at("select"), "an array of { bodies = [...], ... }");
+    if (a.empty())
+      fail_value(*g.ctx, sn, g.at("select"), "must hold at least one selector",
+                 "{} selects every exterior face");
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string p = g.at("select") + "[" + std::to_string(i) + "]";
+      group.select.push_back(read_selector(as_tab(*g.ctx, a[i], p, "an inline table"), bodies));
+    }
+    spec.groups.push_back(group);
+  });
+}
+
+void read_points(const Tab& root, CaseSpec& spec) {
+  const toml::node* n = root.get("points");
+  if (!n) return;
+  const Tab pts = as_tab(*root.ctx, *n, "points");
+  pts.allow({"list"});
+  const Names groups = names_of(spec.groups);
+  Names ids;
+  each_table(pts, "list", [&](const Tab& p, std::size_t) {
+    p.allow({"id", "position", "on"});
+    core::NamedPoint pt;
+    pt.id = name(p, "id");
+    unique(p, "id", pt.id, ids, "point");
+    ids.push_back(pt.id);
+    pt.position = point3(p, "position");
+    if (p.get("on")) pt.on_group = reference(p, "on", groups, "boundary group");
+    spec.points.push_back(pt);
+  });
+}
+
+Names point_ids(const CaseSpec& spec) {
+  Names out;
+  for (const auto& p : spec.points) out.push_back(p.id);
+  return out;
+}
+
+/// Segments from a CSV "time_s,speed_rpm" with a header; errors point into the CSV.
+std::vector<core::DutyCycle::Segment> csv_segments(const Ctx& c, const toml::node& n,
+                                                   const std::string& path) {
+  const std::string rel = as_string(c, n, path);
+  const fs::path file = c.dir / rel;
+  std::ifstream in(file);
+  if (rel.empty() || !in)
+    fail_value(c, n, path, "cannot read " + file.string(),
+               "paths are relative to the case file's folder");
+  const std::string where = " (" + path + " of " + c.file + ")";
+  auto csv_fail = [&](int line, const std::string& msg) -> void {
+    throw CaseError(core::located(file.string(), line, msg + where));
+  };
+  auto trim = [](std::string s) {
+    const auto b = s.find_first_not_of(" \t\r");
+    const auto e = s.find_last_not_of(" \t\r");
+    return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+  };
+  std::vector<core::DutyCycle::Segment> out;
+  std::string text;
+  int line = 0;
+  bool header = false;
+  while (std::getline(in, text)) {
+    ++line;
+    text = trim(text);
+    if (text.empty() || text[0] == '#') continue;
+    const auto comma = text.find(',');
+    const std::string a = trim(text.substr(0, comma));
+    const std::string b = comma == std::string::npos ? std::string() : trim(text.substr(comma + 1));
+    if (!header) {
+      if (a != "time_s" || b != "speed_rpm")
+        csv_fail(line, "header = \"" + text + "\": expected \"time_s,speed_rpm\"");
+      header = true;
+      continue;
+    }
+    double v[2];
+    const std::string cells[2] = {a, b};
+    for (int i = 0; i < 2; ++i) {
+      const char* first = cells[i].data();
+      const char* last = first + cells[i].size();
+      const auto r = std::from_chars(first, last, v[i]);
+      if (cells[i].empty() || r.ec != std::errc() || r.ptr != last || !std::isfinite(v[i]))
+        csv_fail(line, std::string(i ? "speed_rpm" : "time_s") + " = \"" + cells[i] +
+                           "\": expected a finite number");
+    }
+    if (out.empty() && v[0] != 0)
+      csv_fail(line, "time_s = " + number_text(v[0]) + ": the first row must start at 0");
+    if (!out.empty() && !(v[0] > out.back().start))
+      csv_fail(line, "time_s = " + number_text(v[0]) + ": must exceed the previous row's " +
+                         number_text(out.back().start) + "; times must ascend");
+    if (v[1] < 0) csv_fail(line, "speed_rpm = " + number_text(v[1]) + ": must be >= 0");
+    out.push_back({v[0], v[1]});
+  }
+  if (out.empty()) csv_fail(line, "no data rows: expected \"time_s,speed_rpm\" then rows");
+  return out;
+}
+
+void read_duty_cycle(const Tab& root, CaseSpec& spec) {
+  const Tab d = as_tab(*root.ctx, root.need("duty_cycle", "a [duty_cycle] table"), "duty_cycle");
+  const Ctx& c = *d.ctx;
+  d.allow({"end_s", "segments", "csv"});
+  spec.duty_cycle.end = number(d, "end_s", Sign::positive, "the run's length in s");
+  const toml::node* seg = d.get("segments");
+  const toml::node* csv = d.get("csv");
+  if (seg && csv) fail_value(c, *csv, d.at("csv"), "give either segments or csv, not both");
+  if (!seg && !csv)
+    fail(c, d.line(),
+         "duty_cycle.segments: missing; expected segments = [{ start_s, speed_rpm }, "
+         "...] or csv = \"file.csv\"");
+  if (csv) {
+    spec.duty_cycle.segments = csv_segments(c, *csv, d.at("csv"));
+  } else {
+    each_table(d, "segments", [&](const Tab& s, std::size_t i) {
+      s.allow({"start_s", "speed_rpm"});
+      const auto& sn = s.need("start_s", "a time in s");
+      const double start = as_number(c, sn, s.at("start_s"));
+      if (i == 0 && start != 0)
+        fail_value(c, sn, s.at("start_s"), "the first segment must start at 0");
+      if (i > 0 && !(start > spec.duty_cycle.segments.back().start))
+        fail_value(
+            c, sn, s.at("start_s"),
+            "must exceed the previous start " + number_text(spec.duty_cycle.segments.back().start),
+            "segments must be in ascending time order");
+      const double rpm =
+          number(s, "speed_rpm", Sign::non_negative, "the speed's magnitude; 0 is standstill");
+      spec.duty_cycle.segments.push_back({start, rpm});
+    });
+    if (spec.duty_cycle.segments.empty())
+      fail_value(c, *seg, d.at("segments"), "must hold at least one segment");
+  }
+  if (!(spec.duty_cycle.end > spec.duty_cycle.segments.back().start))
+    fail_value(c, d.need("end_s", ""), d.at("end_s"),
+               "must exceed the last segment's start " +
+                   number_text(spec.duty_cycle.segments.back().start));
+}
+
+core::TimeTable sink_table(const Ctx& c, const toml::node& n, const std::string& path) {
+  const auto& a = as_array(c, n, path, "[[t_s, degC], ...]");
+  if (a.empty()) fail_value(c, n, path, "must hold at least one [t_s, degC] row");
+  core::TimeTable table;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string p = path + "[" + std::to_string(i) + "]";
+    const Eigen::VectorXd row = numbers(c, a[i], p, 2, "[t_s, degC]");
+    if (!table.time.empty() && !(row[0] > table.time.back()))
+      fail_value(c, a[i], p,
+                 "time must exceed the previous row's " + number_text(table.time.back()),
+                 "rows in ascending time");
+    table.time.push_back(row[0]);
+    table.value.push_back(row[1]);
+  }
+  return table;
+}
+
+void read_thermal(const Tab& root, CaseSpec& spec) {
+  const toml::node* n = root.get("thermal");
+  if (!n) return;
+  const Tab t = as_tab(*root.ctx, *n, "thermal");
+  const Ctx& c = *t.ctx;
+  t.allow({"initial_temperature_degC", "scheme", "step_s", "output_interval_s", "lumped_mass",
+           "convection", "heat_sources", "surface_flux"});
+  auto& th = spec.thermal;
+  th.initial_temperature_c = number_or(t, "initial_temperature_degC", th.initial_temperature_c);
+  th.scheme = choice_or<core::TimeScheme>(t, "scheme", th.scheme,
+                                          {{"backward_euler", core::TimeScheme::backward_euler},
+                                           {"crank_nicolson", core::TimeScheme::crank_nicolson},
+                                           {"bdf2", core::TimeScheme::bdf2}});
+  th.step = number_or(t, "step_s", th.step, Sign::positive, "the time step in s");
+  th.output_interval = number_or(t, "output_interval_s", th.output_interval, Sign::positive,
+                                 "time between written samples in s");
+  th.lumped_mass = flag_or(t, "lumped_mass", th.lumped_mass);
+
+  const Names groups = names_of(spec.groups);
+  const Names bodies = names_of(spec.bodies);
+  std::vector<int> convected;
+  each_table(t, "convection", [&](const Tab& cv, std::size_t) {
+    cv.allow({"group", "h_W_m2K", "h_speed_gain_W_m2K", "speed_ref_rpm", "speed_exponent",
+              "sink_degC", "sink_table"});
+    core::Convection conv;
+    conv.group = reference(cv, "group", groups, "boundary group");
+    if (std::find(convected.begin(), convected.end(), conv.group) != convected.end())
+      fail_value(c, cv.need("group", ""), cv.at("group"), "already has a convection entry",
+                 "merge the two into one");
+    convected.push_back(conv.group);
+    conv.h = number(cv, "h_W_m2K", Sign::non_negative, "heat transfer coefficient in W/(m^2 K)");
+    conv.h_speed_gain = number_or(cv, "h_speed_gain_W_m2K", 0.0, Sign::non_negative);
+    if (cv.get("h_speed_gain_W_m2K") && !cv.get("speed_ref_rpm"))
+      fail(c, cv.line(),
+           cv.at("speed_ref_rpm") +
+               ": missing; expected the speed at which the gain applies, "
+               "required with h_speed_gain_W_m2K");
+    conv.speed_ref_rpm = number_or(cv, "speed_ref_rpm", conv.speed_ref_rpm, Sign::positive);
+    conv.speed_exponent = number_or(cv, "speed_exponent", conv.speed_exponent, Sign::non_negative);
+    const toml::node* sd = cv.get("sink_degC");
+    const toml::node* st = cv.get("sink_table");
+    if (sd && st)
+      fail_value(c, *st, cv.at("sink_table"), "give either sink_degC or sink_table, not both");
+    if (sd) {
+      conv.sink.time = {0.0};
+      conv.sink.value = {as_number(c, *sd, cv.at("sink_degC"))};
+    } else if (st) {
+      conv.sink = sink_table(c, *st, cv.at("sink_table"));
+    } else {
+      fail(c, cv.line(),
+           cv.at("sink_degC") +
+               ": missing; expected the sink temperature (sink_degC = 20.0 or "
+               "sink_table = [[t_s, degC], ...])");
+    }
+    th.convection.push_back(conv);
+  });
+
+  using Law = core::HeatSource::Law;
+  const Names law_keys_speed = {"power_ref_W", "ref_speed_rpm", "exponent"};
+  const Names law_keys_const = {"power_ref_W"};
+  const Names law_keys_palm = {"palmgren_f0", "palmgren_nu_cSt", "palmgren_dm", "palmgren_f1",
+                               "palmgren_p1_N"};
+  Names all_keys = {"name",        "body",          "law",     "temperature_coefficient_per_K",
+                    "power_ref_W", "ref_speed_rpm", "exponent"};
+  all_keys.insert(all_keys.end(), law_keys_palm.begin(), law_keys_palm.end());
+  each_table(t, "heat_sources", [&](const Tab& h, std::size_t) {
+    h.allow(all_keys);
+    core::HeatSource src;
+    src.name = name(h, "name");
+    unique(h, "name", src.name, names_of(th.sources), "heat source");
+    src.body = reference(h, "body", bodies, "body");
+    src.law = choice_or<Law>(h, "law", Law::speed_power,
+                             {{"speed_power", Law::speed_power},
+                              {"constant", Law::constant},
+                              {"palmgren", Law::palmgren}});
+    const Names& used = src.law == Law::speed_power ? law_keys_speed
+                        : src.law == Law::constant  ? law_keys_const
+                                                    : law_keys_palm;
+    const std::string law_name = h.get("law") ? as_string(c, *h.get("law"), "") : "speed_power";
+    for (auto&& [k, v] : *h.t) {
+      const bool law_key =
+          std::find(all_keys.begin() + 4, all_keys.end(), k.str()) != all_keys.end();
+      if (law_key && std::find(used.begin(), used.end(), k.str()) == used.end())
+        fail(c, line_of(v),
+             h.at(k.str()) + " = " + value_text(v) + ": not used by law = \"" + law_name +
+                 "\"; remove it or change the law");
+    }
+    if (src.law == Law::speed_power) {
+      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_speed_rpm in W");
+      src.ref_speed_rpm = number(h, "ref_speed_rpm", Sign::positive);
+      src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
+    } else if (src.law == Law::constant) {
+      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat in W");
+    } else {
+      src.palmgren_f0 = number(h, "palmgren_f0", Sign::positive, "bearing type factor f0");
+      src.palmgren_nu_cSt =
+          number(h, "palmgren_nu_cSt", Sign::positive, "lubricant kinematic viscosity in cSt");
+      src.palmgren_dm = length(h, "palmgren_dm", Sign::positive, "bearing pitch diameter");
+      src.palmgren_f1 = number(h, "palmgren_f1", Sign::non_negative, "load factor f1");
+      src.palmgren_p1 = number(h, "palmgren_p1_N", Sign::non_negative, "equivalent load in N");
+    }
+    src.temperature_coefficient = number_or(h, "temperature_coefficient_per_K", 0.0);
+    th.sources.push_back(src);
+  });
+
+  each_table(t, "surface_flux", [&](const Tab& f, std::size_t) {
+    f.allow({"group", "flux_W_m2", "follows_speed", "ref_speed_rpm"});
+    core::SurfaceFlux flux;
+    flux.group = reference(f, "group", groups, "boundary group");
+    flux.flux = number(f, "flux_W_m2", Sign::any, "heat flux into the body in W/m^2");
+    flux.follows_speed = flag_or(f, "follows_speed", false);
+    if (flux.follows_speed) {
+      flux.ref_speed_rpm =
+          number(f, "ref_speed_rpm", Sign::positive, "speed at which flux_W_m2 holds");
+    } else if (const auto* r = f.get("ref_speed_rpm")) {
+      fail_value(c, *r, f.at("ref_speed_rpm"), "only used with follows_speed = true");
+    }
+    th.fluxes.push_back(flux);
+  });
+}
+
+/// A step longer than the run leaves nothing to integrate (the default step included).
+void check_step(const Tab& root, const CaseSpec& spec) {
+  if (spec.thermal.step <= spec.duty_cycle.end) return;
+  const std::string expected =
+      "must not exceed the run, duty_cycle.end_s = " + number_text(spec.duty_cycle.end);
+  const toml::node* th = root.get("thermal");
+  const toml::node* s = th && th->is_table() ? th->as_table()->get("step_s") : nullptr;
+  if (s) fail_value(*root.ctx, *s, "thermal.step_s", expected, "shorten the step");
+  fail(*root.ctx, th ? line_of(*th) : 0,
+       "thermal.step_s = " + number_text(spec.thermal.step) + " (the default): " + expected +
+           "; set step_s in [thermal]");
+}
+
+void read_mechanical(const Tab& root, CaseSpec& spec) {
+  auto& me = spec.mechanical;
+  const toml::node* n = root.get("mechanical");
+  if (!n) {
+    if (me.enabled)
+      fail(*root.ctx, 0,
+           "mechanical: missing; expected a [mechanical] table with fixed = [group names], or "
+           "enabled = false");
+    return;
+  }
+  const Tab m = as_tab(*root.ctx, *n, "mechanical");
+  const Ctx& c = *m.ctx;
+  m.allow({"enabled", "reference_temperature_degC", "fixed", "point_supports", "tcp", "probes"});
+  me.enabled = flag_or(m, "enabled", me.enabled);
+  me.reference_temperature_c =
+      number_or(m, "reference_temperature_degC", me.reference_temperature_c);
+  if (const auto* f = m.get("fixed"))
+    me.fixed_groups = references(c, *f, m.at("fixed"), names_of(spec.groups), "boundary group");
+  const Names ids = point_ids(spec);
+  Names supported;
+  each_table(m, "point_supports", [&](const Tab& s, std::size_t) {
+    s.allow({"point", "fixed"});
+    core::PointSupport support;
+    support.point = spec.points[reference(s, "point", ids, "point")].id;
+    unique(s, "point", support.point, supported, "support on the point");
+    supported.push_back(support.point);
+    if (const auto* f = s.get("fixed")) {
+      support.fixed = {false, false, false};
+      const auto& a =
+          as_array(c, *f, s.at("fixed"), "an array of directions [\"x\", \"y\", \"z\"]");
+      if (a.empty()) fail_value(c, *f, s.at("fixed"), "must name at least one direction");
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string p = s.at("fixed") + "[" + std::to_string(i) + "]";
+        const int d = choice<int>(c, a[i], p, {{"x", 0}, {"y", 1}, {"z", 2}});
+        if (support.fixed[d]) fail_value(c, a[i], p, "listed twice");
+        support.fixed[d] = true;
+      }
+    }
+    me.point_supports.push_back(support);
+  });
+  if (me.enabled && me.fixed_groups.empty() && me.point_supports.empty()) {
+    if (const auto* f = m.get("fixed"))
+      fail_value(c, *f, m.at("fixed"), "must name at least one boundary group",
+                 "without a support the body can move freely (or give point_supports)");
+    fail(c, m.line(),
+         m.at("fixed") +
+             ": missing; expected the boundary groups fixed in all directions "
+             "(or point_supports, or enabled = false)");
+  }
+  if (const auto* t = m.get("tcp"))
+    me.tcp_point = spec.points[reference(c, *t, m.at("tcp"), ids, "point")].id;
+  if (const auto* p = m.get("probes")) {
+    const auto idx = references(c, *p, m.at("probes"), ids, "point");
+    if (!idx.empty() && idx.size() != 2)
+      fail_value(c, *p, m.at("probes"), "expected two point ids [z1, z2]");
+    for (int i : idx) me.probe_points.push_back(spec.points[i].id);
+  }
+}
+
+void read_outputs(const Tab& root, CaseSpec& spec) {
+  const toml::node* n = root.get("outputs");
+  if (!n) return;
+  const Tab o = as_tab(*root.ctx, *n, "outputs");
+  o.allow({"plot_points", "fields", "fields_interval_s"});
+  if (const auto* p = o.get("plot_points")) {
+    for (int i : references(*o.ctx, *p, o.at("plot_points"), point_ids(spec), "point"))
+      spec.outputs.plot_points.push_back(spec.points[i].id);
+  }
+  spec.outputs.fields = flag_or(o, "fields", spec.outputs.fields);
+  spec.outputs.fields_interval = number_or(o, "fields_interval_s", spec.outputs.fields_interval,
+                                           Sign::positive, "time between field snapshots in s");
+}
+
+CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file) {
+  const Tab r{&ctx, &root, ""};
+  r.allow({"case", "geometry", "materials", "bodies", "mesh", "boundary", "points", "duty_cycle",
+           "thermal", "mechanical", "outputs"});
+  CaseSpec spec;
+  spec.source = file;
+  read_header(r, spec);
+  const Tab g = as_tab(ctx, r.need("geometry", "a [geometry] table with length_unit"), "geometry");
+  g.allow({"length_unit"});
+  ctx.length_divisor =
+      unit_divisor(ctx, g.need("length_unit", "\"m\" or \"mm\""), g.at("length_unit"));
+  read_materials(r, spec);
+  read_bodies(r, spec);
+  read_mesh(r, spec);
+  read_boundary(r, spec);
+  read_points(r, spec);
+  read_duty_cycle(r, spec);
+  read_thermal(r, spec);
+  check_step(r, spec);
+  read_mechanical(r, spec);
+  read_outputs(r, spec);
+  return spec;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writer.
+
+std::string vec_text(const auto& v) {
+  std::string s = "[";
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += (i ? ", " : "") + number_text(v[i]);
+  return s + "]";
+}
+
+std::string names_text(const std::vector<int>& idx, const Names& names) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < idx.size(); ++i) s += (i ? ", " : "") + toml_string(names.at(idx[i]));
+  return s + "]";
+}
+
+std::string strings_text(const Names& names) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + toml_string(names[i]);
+  return s + "]";
+}
+
+std::string primitive_text(const core::Primitive& p) {
+  using K = core::Primitive::Kind;
+  const std::string z = "z = [" + number_text(p.z_min) + ", " + number_text(p.z_max) + "]";
+  switch (p.kind) {
+    case K::box:
+      return "{ box = { min = " + vec_text(p.min) + ", max = " + vec_text(p.max) + " } }";
+    case K::cylinder:
+      return "{ cylinder = { axis = " + vec_text(p.axis) + ", radius = " + number_text(p.radius) +
+             ", " + z + " } }";
+    case K::annulus:
+      return "{ annulus = { axis = " + vec_text(p.axis) +
+             ", inner_radius = " + number_text(p.inner_radius) +
+             ", outer_radius = " + number_text(p.radius) + ", " + z + " } }";
+    case K::surface_file:
+      break;
+  }
+  if (p.file_scale != 1.0 && p.file_scale != 1e-3)
+    throw CaseError(p.where + ".surface: file_scale = " + number_text(p.file_scale) +
+                    ": cannot be written as a length unit; expected 1 (m) or 0.001 (mm)");
+  return "{ surface = { file = " + toml_string(fs::absolute(p.file).lexically_normal().string()) +
+         ", unit = " + toml_string(p.file_scale == 1.0 ? "m" : "mm") + " } }";
+}
+
+std::string primitives_text(const std::vector<core::Primitive>& ps) {
+  if (ps.empty()) return "[]";
+  std::string s = "[\n";
+  for (const auto& p : ps) s += "  " + primitive_text(p) + ",\n";
+  return s + "]";
+}
+
+std::string selector_text(const core::FaceSelector& s, const Names& bodies) {
+  using Side = core::FaceSelector::Side;
+  std::string t = "{ bodies = " + names_text(s.bodies, bodies) + ", side = " +
+                  toml_string(s.side == Side::exterior    ? "exterior"
+                              : s.side == Side::interface ? "interface"
+                                                          : "any");
+  if (s.side == Side::interface) t += ", other_bodies = " + names_text(s.other_bodies, bodies);
+  if (s.plane) {
+    t += ", plane = { normal = " + vec_text(s.plane->head<3>()) +
+         ", offset = " + number_text((*s.plane)[3]) + " }";
+  }
+  if (s.on_cylinder) {
+    t += ", on_cylinder = { axis = " + vec_text(s.on_cylinder->axis) +
+         ", radius = " + number_text(s.on_cylinder->radius) + " }";
+  }
+  if (s.within_min && s.within_max) {
+    t += ", within = { min = " + vec_text(*s.within_min) + ", max = " + vec_text(*s.within_max) +
+         " }";
+  }
+  return t + " }";
+}
+
+}  // namespace
+
+CaseSpec case_from_toml(std::string_view text, const fs::path& file) {
+  Ctx ctx;
+  ctx.file = file.string();
+  ctx.dir = file.parent_path();
+  toml::table root;
+  try {
+    root = toml::parse(text, std::string_view(ctx.file));
+  } catch (const toml::parse_error& e) {
+    fail(ctx, static_cast<int>(e.source().begin.line),
+         "not valid TOML: " + std::string(e.description()));
+  }
+  return case_from_root(root, ctx, file);
+}
+
+CaseSpec read_case(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::IoError(file.string() + ": cannot open the case file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw core::IoError(file.string() + ": cannot read the case file");
+  return case_from_toml(text.str(), file);
+}
+
+std::string resolved_case_toml(const CaseSpec& spec) {
+  using Law = core::HeatSource::Law;
+  const Names bodies = names_of(spec.bodies);
+  const Names groups = names_of(spec.groups);
+  std::ostringstream o;
+  o << "# Resolved case: SI units, every default explicit. Read from " << spec.source.string()
+    << "\n\n[case]\nname = " << toml_string(spec.name)
+    << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
+    << "\n\n[geometry]\nlength_unit = \"m\"\n";
+  for (const auto& m : spec.materials) {
+    o << "\n[materials." << key_text(m.name) << "]\ndensity_kg_m3 = " << number_text(m.density)
+      << "\nspecific_heat_J_kgK = " << number_text(m.specific_heat)
+      << "\nconductivity_W_mK = " << number_text(m.conductivity)
+      << "\nyoungs_modulus_Pa = " << number_text(m.youngs_modulus)
+      << "\npoisson_ratio = " << number_text(m.poisson_ratio)
+      << "\nexpansion_per_K = " << number_text(m.expansion) << "\n";
+  }
+  for (const auto& b : spec.bodies) {
+    o << "\n[[bodies]]\nname = " << toml_string(b.name)
+      << "\nmaterial = " << toml_string(spec.materials.at(b.material).name)
+      << "\nmax_edge = " << number_text(b.max_edge) << "\nadd = " << primitives_text(b.add)
+      << "\nsubtract = " << primitives_text(b.subtract) << "\n";
+  }
+  o << "\n[mesh]\norder = " << spec.mesh.order
+    << "\ncircle_segments = " << spec.mesh.circle_segments
+    << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
+    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg) << "\n";
+  for (const auto& g : spec.groups) {
+    o << "\n[[boundary]]\nname = " << toml_string(g.name)
+      << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";
+    for (const auto& s : g.select) o << "  " << selector_text(s, bodies) << ",\n";
+    o << "]\n";
+  }
+  const auto& th = spec.thermal;
+  const char* scheme = th.scheme == core::TimeScheme::backward_euler   ? "backward_euler"
+                       : th.scheme == core::TimeScheme::crank_nicolson ? "crank_nicolson"
+                                                                       : "bdf2";
+  o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
+    << "\nscheme = " << toml_string(scheme) << "\nstep_s = " << number_text(th.step)
+    << "\noutput_interval_s = " << number_text(th.output_interval)
+    << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
+  for (const auto& c : th.convection) {
+    o << "\n[[thermal.convection]]\ngroup = " << toml_string(groups.at(c.group))
+      << "\nh_W_m2K = " << number_text(c.h)
+      << "\nh_speed_gain_W_m2K = " << number_text(c.h_speed_gain)
+      << "\nspeed_ref_rpm = " << number_text(c.speed_ref_rpm)
+      << "\nspeed_exponent = " << number_text(c.speed_exponent) << "\n";
+    if (c.sink.time.size() == 1 && c.sink.time[0] == 0) {
+      o << "sink_degC = " << number_text(c.sink.value.at(0)) << "\n";
+    } else {
+      o << "sink_table = [";
+      for (std::size_t i = 0; i < c.sink.time.size(); ++i)
+        o << (i ? ", [" : "[") << number_text(c.sink.time[i]) << ", "
+          << number_text(c.sink.value.at(i)) << "]";
+      o << "]\n";
+    }
+  }
+  for (const auto& s : th.sources) {
+    o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
+      << "\nbody = " << toml_string(bodies.at(s.body)) << "\nlaw = ";
+    if (s.law == Law::speed_power) {
+      o << "\"speed_power\"\npower_ref_W = " << number_text(s.power_ref)
+        << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
+        << "\nexponent = " << number_text(s.exponent) << "\n";
+    } else if (s.law == Law::constant) {
+      o << "\"constant\"\npower_ref_W = " << number_text(s.power_ref) << "\n";
+    } else {
+      o << "\"palmgren\"\npalmgren_f0 = " << number_text(s.palmgren_f0)
+        << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
+        << "\npalmgren_dm = " << number_text(s.palmgren_dm)
+        << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
+        << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
+    }
+    o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
+  }
+  for (const auto& f : th.fluxes) {
+    o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
+      << "\nflux_W_m2 = " << number_text(f.flux)
+      << "\nfollows_speed = " << (f.follows_speed ? "true" : "false") << "\n";
+    if (f.follows_speed) o << "ref_speed_rpm = " << number_text(f.ref_speed_rpm) << "\n";
+  }
+  o << "\n[duty_cycle]\nend_s = " << number_text(spec.duty_cycle.end) << "\nsegments = [\n";
+  for (const auto& s : spec.duty_cycle.segments)
+    o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
+      << " },\n";
+  const auto& me = spec.mechanical;
+  o << "]\n\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
+    << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
+    << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
+  for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
+    const auto& ps = me.point_supports[i];
+    Names dirs;
+    for (int d = 0; d < 3; ++d)
+      if (ps.fixed[d]) dirs.push_back(std::string(1, "xyz"[d]));
+    o << (i ? ", " : "") << "{ point = " << toml_string(ps.point)
+      << ", fixed = " << strings_text(dirs) << " }";
+  }
+  o << "]\n";
+  if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
+  o << "probes = " << strings_text(me.probe_points) << "\n";
+  o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
+    << "\nfields = " << (spec.outputs.fields ? "true" : "false")
+    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval)
+    << "\n\n[points]\nlist = [\n";
+  for (const auto& p : spec.points) {
+    o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
+    if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));
+    o << " },\n";
+  }
+  o << "]\n";
+  return o.str();
+}
+
+}  // namespace tt::io

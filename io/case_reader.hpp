@@ -1,0 +1,28 @@
+// Case files in, typed specs out: the only code that sees a case's TOML parse tree.
+// Format by example: cases/sb1.toml. Lengths are in [geometry] length_unit ("m" or "mm"); every
+// other quantity carries its unit in its key (density_kg_m3, step_s, h_W_m2K, ...).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "core/case_spec.hpp"
+
+namespace tt::io {
+
+/// The validated case in SI units with every default filled in. Files named by the case
+/// (surface meshes, a duty-cycle CSV) are resolved against the case file's folder.
+/// Throws core::IoError when the file cannot be read, and core::CaseError for anything wrong in
+/// it, as "file:line: key.path = value: what was expected; hint".
+core::CaseSpec read_case(const std::filesystem::path& file);
+
+/// read_case on text already in memory; `file` names it in messages and anchors relative paths.
+core::CaseSpec case_from_toml(std::string_view text, const std::filesystem::path& file);
+
+/// The resolved case as TOML: SI (length_unit = "m"), every default explicit, the duty cycle as
+/// segments, surface files as absolute paths, doubles written to round-trip exactly.
+/// read_case of this text gives back a spec equal to `spec` (except `source`).
+std::string resolved_case_toml(const core::CaseSpec& spec);
+
+}  // namespace tt::io
