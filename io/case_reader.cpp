@@ -1131,7 +1131,8 @@ std::string resolved_case_toml(const CaseSpec& spec) {
   const Names bodies = names_of(spec.bodies);
   const Names groups = names_of(spec.groups);
   std::ostringstream o;
-  o << "# Resolved case: SI units, every default explicit. Read from " << spec.source.string()
+  o << "# Resolved case: SI units, every default explicit. Read from "
+    << fs::absolute(spec.source).lexically_normal().string()
     << "\n\n[case]\nname = " << toml_string(spec.name)
     << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
     << "\n\n[geometry]\nlength_unit = \"m\"\n";

@@ -689,6 +689,10 @@ const BadInput bad_inputs[] = {
      "geometry.length_unit = \"cm\"", "unknown value"},
     {"negative_h", "h_W_m2K = 10.0", "h_W_m2K = -1.0", "h_W_m2K",
      "thermal.convection[0].h_W_m2K = -1.0", "must be >= 0"},
+    {"two_convections_on_one_group", "sink_degC = 20.0",
+     "sink_degC = 20.0\n[[thermal.convection]]\ngroup = \"rest\" # dup\nh_W_m2K = 1.0\n"
+     "sink_degC = 20.0",
+     "# dup", "thermal.convection[1].group = \"rest\"", "already has a convection entry"},
     {"sink_missing", "sink_degC = 20.0\n", "", "[[thermal.convection]]",
      "thermal.convection[0].sink_degC", "missing"},
     {"sink_table_descending", "sink_degC = 20.0", "sink_table = [[0.0, 20.0], [0.0, 21.0]]",
