@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -141,8 +142,15 @@ struct ThermalSpec {
   std::vector<SurfaceFlux> fluxes;
 };
 
+/// A named point held in some directions (e.g. 3-2-1 supports against rigid motion only).
+struct PointSupport {
+  std::string point;                      /// id of a named point
+  std::array<bool, 3> fixed = {true, true, true};  /// x, y, z
+};
+
 struct MechanicalSpec {
   bool enabled = true;
+  std::vector<PointSupport> point_supports;
   double reference_temperature_c = 20;  /// stress-free temperature [degC]
   std::vector<int> fixed_groups;         /// boundary groups fixed in all directions
   std::string tcp_point;                 /// id of the tool centre point
@@ -152,6 +160,7 @@ struct MechanicalSpec {
 struct OutputSpec {
   std::vector<std::string> plot_points;  /// ids plotted in the temperature figure
   bool fields = true;                    /// write fields.pvd
+  double fields_interval = 600;          /// time between field snapshots [s]
 };
 
 struct CaseSpec {

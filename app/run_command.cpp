@@ -1,0 +1,188 @@
+// thermotwin mesh / run: the virtual machine's drivers.
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+#include "app/commands.hpp"
+#include "io/atomic_dir.hpp"
+#include "io/case_reader.hpp"
+#include "io/csv_out.hpp"
+#include "io/reports.hpp"
+#include "io/vtk_out.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/loads.hpp"
+#include "solvers/virtual_machine.hpp"
+
+namespace tt::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void write_mesh_files(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const std::filesystem::path& dir) {
+  io::write_mesh_vtu(mesh, dir / "mesh.vtu");
+  io::write_boundary_vtp(mesh, dir / "boundary.vtp");
+  io::write_points_vtp(mesh, dir / "points.vtp");
+  io::write_json(dir / "mesh_report.json", io::mesh_report_json(mesh, mesh::mesh_report(mesh, spec)));
+  io::write_file_atomically(dir / "case.resolved.toml", io::resolved_case_toml(spec));
+}
+
+/// temperatures.csv: time_s, then <id>_degC per named point.
+void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory& th, const std::filesystem::path& path) {
+  std::vector<std::string> header{"time_s"};
+  for (const auto& p : mesh.points) header.push_back(p.id + "_degC");
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(th.times.size()), static_cast<Eigen::Index>(header.size()));
+  for (size_t t = 0; t < th.times.size(); ++t) {
+    rows(t, 0) = th.times[t];
+    for (size_t i = 0; i < mesh.points.size(); ++i)
+      rows(t, i + 1) = th.temperature(mesh.points[i].node, t) - solvers::kCelsiusOffset;
+  }
+  io::write_csv(path, header, rows);
+}
+
+void write_thermal_error(const solvers::ThermalHistory& th, const solvers::ThermalError& e,
+                         const std::filesystem::path& path) {
+  const std::vector<std::string> header{"time_s",   "dx_um",    "dy_um",    "dz_um",
+                                        "dx_z1_um", "dy_z1_um", "dx_z2_um", "dy_z2_um",
+                                        "tilt_about_x_urad", "tilt_about_y_urad"};
+  Eigen::MatrixXd rows(e.values.rows(), 10);
+  for (Eigen::Index t = 0; t < e.values.rows(); ++t) {
+    rows(t, 0) = th.times[t];
+    rows.row(t).tail(9) = e.values.row(t) * 1e6;  // m -> um, rad -> urad
+  }
+  io::write_csv(path, header, rows);
+}
+
+void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const solvers::VirtualRun& run,
+                  const std::filesystem::path& dir) {
+  io::FieldSeriesWriter writer(mesh, dir, "fields");
+  const auto& th = run.thermal;
+  const double t0_k = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  double next = 0;
+  for (size_t t = 0; t < th.times.size(); ++t) {
+    const bool last = t + 1 == th.times.size();
+    if (th.times[t] + 1e-9 < next && !last) continue;
+    next = th.times[t] + spec.outputs.fields_interval;
+    const Eigen::VectorXd temp = th.temperature.col(static_cast<Eigen::Index>(t));
+    std::vector<io::NamedField> point{{"temperature_degC", 1, temp.array() - solvers::kCelsiusOffset},
+                                      {"temperature_rise_K", 1, temp.array() - t0_k}};
+    if (run.elastic) {
+      const Eigen::VectorXd u = run.elastic->displacement.col(static_cast<Eigen::Index>(t));
+      point.push_back({"displacement_m", 3, u});
+      point.push_back({"von_mises_Pa", 1, solvers::von_mises_nodal(mesh, spec, u, temp)});
+    }
+    writer.add_step(th.times[t], point);
+  }
+  writer.finish();
+}
+
+void plot(const std::vector<std::string>& args) {
+  std::string cmd = "/usr/bin/python3 " TT_SOURCE_DIR "/app/plot.py";
+  for (const auto& a : args) cmd += " '" + a + "'";
+  cmd += " 2>/dev/null";
+  if (std::system(cmd.c_str()) != 0) std::cerr << "thermotwin: note: plot skipped (" << args[0] << ")\n";
+}
+
+}  // namespace
+
+void report_progress(const std::string& stage, double done, double total) {
+  static int last_decile = -1;
+  const int decile = static_cast<int>(std::floor(10 * done / total + 1e-9));
+  if (decile == last_decile) return;
+  last_decile = decile >= 10 ? -1 : decile;
+  std::cerr << "thermotwin: " << stage << " " << 10 * decile << " % (t = " << done << " s of " << total << " s)\n";
+}
+
+int mesh_command(const MeshArgs& args) {
+  // 1. Read and validate the case.
+  const core::CaseSpec spec = io::read_case(args.case_file);
+  // 2. Mesh all bodies into one conforming mesh.
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  // 3. Write the mesh, its boundary, the named points and the report, all or nothing.
+  io::OutputDir out(args.out);
+  write_mesh_files(mesh, spec, out.path());
+  out.commit();
+  std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets -> "
+            << args.out.string() << "\n";
+  return 0;
+}
+
+int run_command(const RunArgs& args) {
+  const auto t_start = Clock::now();
+  // 1. Read and validate the case.
+  const core::CaseSpec spec = io::read_case(args.case_file);
+  // 2. Mesh.
+  const auto t_mesh = Clock::now();
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  const double mesh_s = seconds_since(t_mesh);
+  if (!args.quiet)
+    std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets ("
+              << mesh_s << " s)\n";
+  // 3. Simulate: heat transfer, then thermo-elasticity.
+  const auto t_sim = Clock::now();
+  const solvers::VirtualRun run = solvers::simulate(mesh, spec, [&](double t, double end) {
+    if (!args.quiet) report_progress("thermal", t, end);
+  });
+  const double sim_s = seconds_since(t_sim);
+  // 4. Write everything into DIR.partial, then publish it as DIR.
+  io::OutputDir out(args.out);
+  const auto& dir = out.path();
+  const auto t_write = Clock::now();
+  write_mesh_files(mesh, spec, dir);
+  write_temperatures(mesh, run.thermal, dir / "temperatures.csv");
+  if (run.error) write_thermal_error(run.thermal, *run.error, dir / "thermal_error.csv");
+  if (spec.outputs.fields) write_fields(mesh, spec, run, dir);
+  const double write_s = seconds_since(t_write);
+
+  const auto& e = run.thermal.energy;
+  nlohmann::json summary;
+  summary["case"] = spec.name;
+  summary["nodes"] = mesh.nodes.rows();
+  summary["tets"] = mesh.tets.rows();
+  summary["order"] = mesh.order;
+  summary["thermal_dofs"] = mesh.nodes.rows();
+  summary["steps"] = run.thermal.timings.steps;
+  summary["factorizations"] = run.thermal.timings.factorizations;
+  summary["peak_temperature_degC"] = run.thermal.temperature.maxCoeff() - solvers::kCelsiusOffset;
+  summary["energy_balance"] = {{"heat_in_J", e.heat_in},
+                               {"heat_in_from_laws_J", e.heat_in_law},
+                               {"stored_J", e.stored},
+                               {"lost_J", e.lost},
+                               {"closure_rel", e.closure()}};
+  nlohmann::json timings{{"mesh_s", mesh_s},
+                         {"thermal_assemble_s", run.thermal.timings.assemble_s},
+                         {"thermal_factor_s", run.thermal.timings.factor_s},
+                         {"thermal_solve_s", run.thermal.timings.solve_s},
+                         {"simulate_s", sim_s},
+                         {"write_s", write_s}};
+  if (run.elastic) {
+    summary["elastic_dofs"] = run.elastic->timings.dofs;
+    timings["elastic_assemble_s"] = run.elastic->timings.assemble_s;
+    timings["elastic_factor_s"] = run.elastic->timings.factor_s;
+    timings["elastic_solve_s"] = run.elastic->timings.solve_s;
+  }
+  if (run.error) {
+    const auto last = run.error->values.bottomRows(1);
+    summary["thermal_error_at_end_um"] = {{"dx", last(0, 0) * 1e6}, {"dy", last(0, 1) * 1e6}, {"dz", last(0, 2) * 1e6}};
+  }
+  timings["total_s"] = seconds_since(t_start);
+  summary["timings"] = timings;
+  io::write_json(dir / "summary.json", summary);
+
+  // 5. Figures (patent figures 3 and 4), when matplotlib is there.
+  if (!spec.outputs.plot_points.empty()) {
+    std::string cols;
+    for (const auto& id : spec.outputs.plot_points) cols += (cols.empty() ? "" : ",") + id + "_degC";
+    plot({"temperatures", (dir / "temperatures.csv").string(), (dir / "temperature_rise.png").string(),
+          "--columns", cols, "--rise-from-first", "--title", spec.name + ": temperature rise"});
+  }
+  if (run.error)
+    plot({"thermal_error", (dir / "thermal_error.csv").string(), (dir / "thermal_error.png").string(),
+          "--columns", "dx_um,dy_um,dz_um", "--title", spec.name + ": thermal error at the TCP"});
+  out.commit();
+  std::cerr << "thermotwin: run: done in " << seconds_since(t_start) << " s -> " << args.out.string() << "\n";
+  return 0;
+}
+
+}  // namespace tt::app

@@ -1,0 +1,19 @@
+// JSON reports of the mesher and the solvers.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/case_spec.hpp"
+#include "mesh/mesher.hpp"
+
+namespace tt::io {
+
+/// mesh_report.json: nodes, tets, order, min_dihedral_deg, bodies{name: {volume_m3,
+/// exact_volume_m3}}, points [{id, position, node, distance_m}], groups {name: area_m2}.
+nlohmann::json mesh_report_json(const mesh::TetMesh& mesh, const mesh::MeshReport& report);
+
+/// Writes a JSON value (pretty, via a temporary file and a rename).
+void write_json(const std::filesystem::path& path, const nlohmann::json& value);
+
+}  // namespace tt::io

@@ -1,0 +1,35 @@
+// Sparse Cholesky factor of a symmetric positive definite matrix through CHOLMOD (supernodal,
+// with the system's BLAS). CHOLMOD's status and `minor` become SolverError with context.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+
+namespace tt::solvers::cholmod {
+
+class Factor {
+ public:
+  /// Factors A (column-major, compressed; only its upper triangle is read). `what` names the
+  /// matrix in error messages.
+  Factor(const Eigen::SparseMatrix<double>& a, std::string what);
+  ~Factor();
+  Factor(const Factor&) = delete;
+  Factor& operator=(const Factor&) = delete;
+
+  /// x with A x = b; b may have several columns.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  /// In-place single right-hand side, reusing workspace (the per-step path).
+  void solve_in_place(Eigen::VectorXd& x) const;
+
+  /// Stored entries of the factor L (for the memory-bandwidth bound).
+  double factor_entries() const;
+  int rows() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tt::solvers::cholmod

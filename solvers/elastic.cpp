@@ -1,0 +1,211 @@
+#include "solvers/elastic.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
+#include "solvers/cholmod/cholmod_factor.hpp"
+#include "solvers/kernels/elasticity.hpp"
+#include "solvers/kernels/element.hpp"
+#include "solvers/thermal.hpp"
+
+namespace tt::solvers {
+namespace {
+
+namespace k = kernels;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+using Clock = std::chrono::steady_clock;
+
+template <int N>
+Eigen::Matrix<double, 3, N> coords(const mesh::TetMesh& m, int t) {
+  Eigen::Matrix<double, 3, N> x;
+  for (int a = 0; a < N; ++a) x.col(a) = m.nodes.row(m.tets(t, a)).transpose();
+  return x;
+}
+
+k::ElasticMaterial elastic_material(const mesh::TetMesh& m, const core::CaseSpec& spec, int t) {
+  const auto& mat = spec.materials[spec.bodies[core::index_of(m.tet_region[t])].material];
+  return k::ElasticMaterial{mat.youngs_modulus, mat.poisson_ratio, mat.expansion};
+}
+
+/// Stiffness K (3n x 3n) and thermal coupling G (3n x n): f_thermal = G (T - T_ref).
+template <int N>
+std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(const mesh::TetMesh& m,
+                                                                             const core::CaseSpec& spec) {
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    if (!(k::min_jacobian_determinant(coords<N>(m, t)) > 0))
+      throw core::SolverError("element " + std::to_string(t) + " is inverted or degenerate");
+    k::elasticity_matrix(elastic_material(m, spec, t));  // validates E and nu outside the loop
+  }
+  const int n = static_cast<int>(m.nodes.rows());
+  auto parts = core::parallel_chunks<std::pair<Triplets, Triplets>>(
+      m.tets.rows(), 2048, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
+        std::pair<Triplets, Triplets> out;
+        out.first.reserve((e - b) * 9 * N * N);
+        out.second.reserve((e - b) * 3 * N * N);
+        for (auto t = b; t < e; ++t) {
+          const int ti = static_cast<int>(t);
+          const auto x = coords<N>(m, ti);
+          const auto mat = elastic_material(m, spec, ti);
+          const auto ke = k::stiffness_matrix(x, mat, ti);
+          for (int i = 0; i < 3 * N; ++i)
+            for (int j = 0; j < 3 * N; ++j)
+              out.first.emplace_back(3 * m.tets(ti, i / 3) + i % 3, 3 * m.tets(ti, j / 3) + j % 3, ke(i, j));
+          for (int j = 0; j < N; ++j) {
+            Eigen::Matrix<double, N, 1> unit = Eigen::Matrix<double, N, 1>::Zero();
+            unit(j) = 1.0;
+            const auto g = k::thermal_load(x, mat, unit, 0.0, ti);
+            for (int i = 0; i < 3 * N; ++i) out.second.emplace_back(3 * m.tets(ti, i / 3) + i % 3, m.tets(ti, j), g(i));
+          }
+        }
+        return out;
+      });
+  Triplets kt, gt;
+  for (auto& p : parts) {
+    kt.insert(kt.end(), p.first.begin(), p.first.end());
+    gt.insert(gt.end(), p.second.begin(), p.second.end());
+  }
+  Eigen::SparseMatrix<double> kk(3 * n, 3 * n), g(3 * n, n);
+  kk.setFromTriplets(kt.begin(), kt.end());
+  g.setFromTriplets(gt.begin(), gt.end());
+  kk.makeCompressed();
+  g.makeCompressed();
+  return {std::move(kk), std::move(g)};
+}
+
+template <int N>
+Eigen::VectorXd von_mises_impl(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& u,
+                               const Eigen::VectorXd& temp) {
+  const double tref = spec.mechanical.reference_temperature_c + kCelsiusOffset;
+  const int n = static_cast<int>(m.nodes.rows());
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n), count = Eigen::VectorXd::Zero(n);
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    Eigen::Matrix<double, 3 * N, 1> ue;
+    Eigen::Matrix<double, N, 1> te;
+    for (int a = 0; a < N; ++a) {
+      te(a) = temp(m.tets(t, a));
+      for (int d = 0; d < 3; ++d) ue(3 * a + d) = u(3 * m.tets(t, a) + d);
+    }
+    const auto s = k::nodal_stresses(coords<N>(m, t), elastic_material(m, spec, t), ue, te, tref, t);
+    for (int a = 0; a < N; ++a) {
+      sum(m.tets(t, a)) += k::von_mises(s.col(a));
+      count(m.tets(t, a)) += 1;
+    }
+  }
+  return sum.cwiseQuotient(count.cwiseMax(1.0));
+}
+
+}  // namespace
+
+std::vector<char> constrained_dofs(const mesh::TetMesh& m, const core::CaseSpec& spec) {
+  const int n = static_cast<int>(m.nodes.rows());
+  std::vector<char> fixed(3 * static_cast<size_t>(n), 0);
+  for (int f = 0; f < m.faces.rows(); ++f) {
+    const int g = core::index_of(m.face_group[f]);
+    for (int fg : spec.mechanical.fixed_groups)
+      if (g == fg)
+        for (int a = 0; a < m.faces.cols(); ++a)
+          for (int d = 0; d < 3; ++d) fixed[3 * m.faces(f, a) + d] = 1;
+  }
+  for (const auto& s : spec.mechanical.point_supports) {
+    const int node = mesh::named_node(m, s.point);
+    if (node < 0) throw core::SolverError("mechanical support at unknown point '" + s.point + "'");
+    for (int d = 0; d < 3; ++d)
+      if (s.fixed[d]) fixed[3 * node + d] = 1;
+  }
+  // The six rigid motions restricted to the held dofs must be independent.
+  Eigen::Vector3d centre = m.nodes.colwise().mean().transpose();
+  std::vector<Eigen::Matrix<double, 1, 6>> rows;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d r = m.nodes.row(i).transpose() - centre;
+    for (int d = 0; d < 3; ++d) {
+      if (!fixed[3 * i + d]) continue;
+      Eigen::Matrix<double, 1, 6> row = Eigen::Matrix<double, 1, 6>::Zero();
+      row(d) = 1;
+      const Eigen::Vector3d e = Eigen::Vector3d::Unit(d);
+      for (int a = 0; a < 3; ++a) row(3 + a) = Eigen::Vector3d::Unit(a).cross(r).dot(e);
+      rows.push_back(row);
+    }
+  }
+  Eigen::MatrixXd c(static_cast<Eigen::Index>(rows.size()), 6);
+  for (size_t i = 0; i < rows.size(); ++i) c.row(static_cast<Eigen::Index>(i)) = rows[i];
+  const int rank = rows.empty() ? 0 : static_cast<int>(Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(c).rank());
+  if (rank < 6)
+    throw core::SolverError("mechanical constraints leave " + std::to_string(6 - rank) +
+                            " rigid motion(s) free (" + std::to_string(rows.size()) +
+                            " dofs held): the displacement would be undetermined. Hint: list a "
+                            "boundary group in mechanical.fixed or add point supports.");
+  return fixed;
+}
+
+ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                               const Eigen::MatrixXd& temperature) {
+  ElasticHistory h;
+  const auto t0 = Clock::now();
+  const std::vector<char> fixed = constrained_dofs(m, spec);
+  auto [kk, g] = m.order == 1 ? assemble<4>(m, spec) : assemble<10>(m, spec);
+  const int ndof = static_cast<int>(kk.rows());
+  std::vector<int> free_index(ndof, -1);
+  int nf = 0;
+  for (int i = 0; i < ndof; ++i)
+    if (!fixed[i]) free_index[i] = nf++;
+  Triplets ft;
+  ft.reserve(kk.nonZeros());
+  for (int col = 0; col < kk.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(kk, col); it; ++it)
+      if (free_index[it.row()] >= 0 && free_index[col] >= 0)
+        ft.emplace_back(free_index[it.row()], free_index[col], it.value());
+  Eigen::SparseMatrix<double> kf(nf, nf);
+  kf.setFromTriplets(ft.begin(), ft.end());
+  kf.makeCompressed();
+  h.timings.assemble_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  h.timings.dofs = ndof;
+  h.timings.free_dofs = nf;
+
+  const auto t1 = Clock::now();
+  cholmod::Factor factor(kf, "elastic stiffness");
+  h.timings.factor_s = std::chrono::duration<double>(Clock::now() - t1).count();
+
+  const auto t2 = Clock::now();
+  const double tref = spec.mechanical.reference_temperature_c + kCelsiusOffset;
+  const Eigen::MatrixXd load = g * (temperature.array() - tref).matrix();
+  Eigen::MatrixXd rhs(nf, load.cols());
+  for (int i = 0; i < ndof; ++i)
+    if (free_index[i] >= 0) rhs.row(free_index[i]) = load.row(i);
+  const Eigen::MatrixXd uf = factor.solve(rhs);
+  h.displacement = Eigen::MatrixXd::Zero(ndof, load.cols());
+  for (int i = 0; i < ndof; ++i)
+    if (free_index[i] >= 0) h.displacement.row(i) = uf.row(free_index[i]);
+  h.timings.solve_s = std::chrono::duration<double>(Clock::now() - t2).count();
+  return h;
+}
+
+Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& u,
+                                const Eigen::VectorXd& temp) {
+  return m.order == 1 ? von_mises_impl<4>(m, spec, u, temp) : von_mises_impl<10>(m, spec, u, temp);
+}
+
+Eigen::Vector3d displacement_at(const mesh::TetMesh& m, const Eigen::VectorXd& u, const Eigen::Vector3d& p) {
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    const auto x4 = coords<4>(m, t);
+    Eigen::Vector3d lo = x4.rowwise().minCoeff(), hi = x4.rowwise().maxCoeff();
+    if ((p.array() < lo.array() - 1e-12).any() || (p.array() > hi.array() + 1e-12).any()) continue;
+    const Eigen::Vector4d bary = k::tet_barycentric(x4, p, t);
+    if (bary.minCoeff() < -1e-10) continue;
+    Eigen::Vector3d result = Eigen::Vector3d::Zero();
+    if (m.order == 1) {
+      for (int a = 0; a < 4; ++a) result += bary(a) * u.segment<3>(3 * m.tets(t, a));
+    } else {
+      const auto w = k::tet10_weights_at(coords<10>(m, t), p, t);
+      for (int a = 0; a < 10; ++a) result += w(a) * u.segment<3>(3 * m.tets(t, a));
+    }
+    return result;
+  }
+  throw core::SolverError("point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                          std::to_string(p.z()) + ") m lies outside the mesh");
+}
+
+}  // namespace tt::solvers

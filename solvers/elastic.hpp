@@ -1,0 +1,40 @@
+// Linear thermo-elasticity on the thermal mesh: the stiffness is factored once and every output
+// time is solved as one multi-right-hand-side block.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::solvers {
+
+struct ElasticTimings {
+  double assemble_s = 0, factor_s = 0, solve_s = 0;
+  int dofs = 0, free_dofs = 0;
+};
+
+struct ElasticHistory {
+  Eigen::MatrixXd displacement;  /// 3 #nodes x #times, node-major (x, y, z) [m]
+  ElasticTimings timings;
+};
+
+/// Dofs held by the case: every dof of nodes on fixed groups, and the point supports' dofs.
+/// Throws SolverError when the constraints leave a rigid motion free.
+std::vector<char> constrained_dofs(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
+
+/// Displacements for each column of `temperature` (#nodes x #times [K]).
+ElasticHistory elastic_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                               const Eigen::MatrixXd& temperature);
+
+/// Von Mises stress per node [Pa] (element nodal stresses averaged at each node).
+Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                                const Eigen::VectorXd& displacement, const Eigen::VectorXd& temperature);
+
+/// Displacement [m] at a point inside the mesh (interpolated in the element that contains it).
+Eigen::Vector3d displacement_at(const mesh::TetMesh& mesh, const Eigen::VectorXd& displacement,
+                                const Eigen::Vector3d& point);
+
+}  // namespace tt::solvers

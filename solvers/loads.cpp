@@ -1,0 +1,104 @@
+#include "solvers/loads.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace tt::solvers {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double speed_at(const core::DutyCycle& cycle, double t) {
+  double n = cycle.segments.empty() ? 0.0 : cycle.segments.front().speed_rpm;
+  for (const auto& s : cycle.segments)
+    if (s.start <= t) n = s.speed_rpm;
+  return n;
+}
+
+double source_power(const core::HeatSource& s, double n) {
+  using Law = core::HeatSource::Law;
+  switch (s.law) {
+    case Law::constant: return s.power_ref;
+    case Law::speed_power:
+      if (n <= 0) return 0.0;
+      return s.power_ref * std::pow(n / s.ref_speed_rpm, s.exponent);
+    case Law::palmgren: {
+      if (n <= 0) return 0.0;
+      // Palmgren's bearing friction torque in N mm with dm in mm, nu in cSt, n in rpm.
+      const double dm_mm = s.palmgren_dm * 1e3;
+      const double nu_n = s.palmgren_nu_cSt * n;
+      const double m0 = nu_n >= 2000 ? 1e-7 * s.palmgren_f0 * std::pow(nu_n, 2.0 / 3.0) * std::pow(dm_mm, 3)
+                                     : 160e-7 * s.palmgren_f0 * std::pow(dm_mm, 3);
+      const double m1 = s.palmgren_f1 * s.palmgren_p1 * dm_mm;
+      return (m0 + m1) * 1e-3 * 2 * kPi * n / 60.0;
+    }
+  }
+  return 0.0;
+}
+
+double film_coefficient(const core::Convection& c, double n) {
+  if (c.h_speed_gain == 0 || n <= 0) return c.h;
+  return c.h + c.h_speed_gain * std::pow(n / c.speed_ref_rpm, c.speed_exponent);
+}
+
+double table_value(const core::TimeTable& table, double t) {
+  if (table.time.empty()) return 0.0;
+  if (t <= table.time.front()) return table.value.front();
+  if (t >= table.time.back()) return table.value.back();
+  const auto it = std::upper_bound(table.time.begin(), table.time.end(), t);
+  const size_t i = static_cast<size_t>(it - table.time.begin());
+  const double w = (t - table.time[i - 1]) / (table.time[i] - table.time[i - 1]);
+  return (1 - w) * table.value[i - 1] + w * table.value[i];
+}
+
+std::vector<double> switch_times(const core::CaseSpec& spec) {
+  const double end = spec.duty_cycle.end;
+  std::vector<double> s;
+  for (const auto& seg : spec.duty_cycle.segments)
+    if (seg.start > 0 && seg.start < end) s.push_back(seg.start);
+  for (const auto& c : spec.thermal.convection)
+    if (c.sink.time.size() > 1)
+      for (double t : c.sink.time)
+        if (t > 0 && t < end) s.push_back(t);
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end()), s.end());
+  return s;
+}
+
+std::vector<double> time_grid(const core::CaseSpec& spec, double max_step) {
+  const double end = spec.duty_cycle.end;
+  if (!(max_step > 0)) throw core::SolverError("time step " + std::to_string(max_step) + " s: must be > 0");
+  std::vector<double> marks = switch_times(spec);
+  marks.push_back(end);
+  std::vector<double> grid;
+  double a = 0;
+  for (double b : marks) {
+    const int k = std::max(1, static_cast<int>(std::ceil((b - a) / max_step - 1e-9)));
+    for (int i = 1; i < k; ++i) grid.push_back(a + (b - a) * i / k);
+    grid.push_back(b);
+    a = b;
+  }
+  return grid;
+}
+
+std::vector<double> output_times(const core::CaseSpec& spec) {
+  const double end = spec.duty_cycle.end, dt = spec.thermal.output_interval;
+  std::vector<double> t;
+  for (int k = 1; k * dt < end * (1 - 1e-12); ++k) t.push_back(k * dt);
+  t.push_back(end);
+  return t;
+}
+
+double heat_delivered(const core::CaseSpec& spec) {
+  const auto& segs = spec.duty_cycle.segments;
+  double total = 0;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    const double a = segs[i].start;
+    const double b = i + 1 < segs.size() ? segs[i + 1].start : spec.duty_cycle.end;
+    for (const auto& s : spec.thermal.sources) total += source_power(s, segs[i].speed_rpm) * (b - a);
+  }
+  return total;
+}
+
+}  // namespace tt::solvers

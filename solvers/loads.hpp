@@ -1,0 +1,38 @@
+// Loads over time from the duty cycle: spindle speed, heat per source, film coefficients and sink
+// temperatures, and the time grid whose steps land exactly on every duty-cycle switch.
+#pragma once
+
+#include <vector>
+
+#include "core/case_spec.hpp"
+
+namespace tt::solvers {
+
+/// Spindle speed [rpm] on the open interval that contains t (a switch at t belongs to the
+/// segment that starts there).
+double speed_at(const core::DutyCycle& cycle, double t);
+
+/// Heat of a source [W] at spindle speed n [rpm] (before any temperature dependence).
+double source_power(const core::HeatSource& source, double speed_rpm);
+
+/// Film coefficient [W/(m^2 K)] of a convection entry at spindle speed n [rpm].
+double film_coefficient(const core::Convection& convection, double speed_rpm);
+
+/// Linear interpolation in a table, constant beyond its ends.
+double table_value(const core::TimeTable& table, double t);
+
+/// The times at which the load can change: segment starts after 0, and the table points of
+/// every time-varying sink, inside (0, end).
+std::vector<double> switch_times(const core::CaseSpec& spec);
+
+/// Step end times t_1 < ... < t_N = end: every switch is a step end; between switches the steps
+/// are equal and no longer than `max_step`.
+std::vector<double> time_grid(const core::CaseSpec& spec, double max_step);
+
+/// Output times: multiples of the output interval up to the end, plus the end.
+std::vector<double> output_times(const core::CaseSpec& spec);
+
+/// Heat delivered by every source from 0 to the end, from the laws alone [J] (no mesh, no solver).
+double heat_delivered(const core::CaseSpec& spec);
+
+}  // namespace tt::solvers

@@ -1,0 +1,64 @@
+// Transient heat conduction: operators assembled once from the mesh and the case, then a time
+// history under the duty cycle with one CHOLMOD factor per distinct (step, speed) and a
+// back-substitution per step.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <functional>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::solvers {
+
+constexpr double kCelsiusOffset = 273.15;
+
+/// Everything the time loop needs, independent of time and speed.
+struct ThermalOperators {
+  Eigen::SparseMatrix<double> conduction;            /// K [W/K]
+  Eigen::SparseMatrix<double> capacity;              /// M [J/K] (consistent or lumped)
+  std::vector<Eigen::SparseMatrix<double>> film;     /// per convection entry: int N N^T dA [m^2]
+  std::vector<Eigen::VectorXd> film_area;            /// per convection entry: int N dA [m^2]
+  std::vector<Eigen::VectorXd> source_shape;         /// per source: int N dV / V_body [-], sums to 1
+  std::vector<Eigen::VectorXd> flux_area;            /// per surface flux: int N dA [m^2]
+};
+
+/// Assembles the operators (element loops in parallel, deterministic order). Throws SolverError
+/// for inverted elements and sources on empty bodies.
+ThermalOperators thermal_operators(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
+
+/// Heat in, stored and lost, each computed on its own path [J].
+struct EnergyBalance {
+  double heat_in = 0;      /// from the sources' laws over the steps
+  double heat_in_law = 0;  /// from the laws over the duty cycle alone
+  double stored = 0;       /// quadrature of rho c (T - T0) over the mesh at the end
+  double lost = 0;         /// quadrature of h (T - T_sink) over the surfaces, over time
+  double closure() const { return (heat_in - stored - lost) / heat_in; }
+};
+
+struct ThermalTimings {
+  double assemble_s = 0, factor_s = 0, solve_s = 0;
+  int steps = 0, factorizations = 0;
+  double factor_entries = 0;  /// entries of the largest Cholesky factor
+};
+
+struct ThermalHistory {
+  std::vector<double> times;    /// output times, t = 0 first [s]
+  Eigen::MatrixXd temperature;  /// #nodes x #times [K]
+  EnergyBalance energy;
+  ThermalTimings timings;
+};
+
+/// Progress: (simulated time [s], end time [s]).
+using Progress = std::function<void(double, double)>;
+
+/// Integrates the transient from the uniform initial temperature to the duty cycle's end.
+ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                               const ThermalOperators& ops, const Progress& progress = {});
+
+/// Element coordinates gathered from the mesh: 3 x nodes-per-element [m].
+Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet);
+
+}  // namespace tt::solvers
