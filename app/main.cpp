@@ -3,10 +3,13 @@
 //   thermotwin run CASE --out DIR    simulate it: fields.pvd, temperatures.csv, thermal_error.csv, summary.json
 // Errors print one line on stderr and exit non-zero; no partial output directory is left.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdlib>
 #include <iostream>
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "solvers/cholmod/cholmod_factor.hpp"
 
 int main(int argc, char** argv) {
   using namespace tt::app;
@@ -25,6 +28,9 @@ int main(int argc, char** argv) {
   run->add_flag("--quiet", run_args.quiet, "no progress on stderr");
 
   CLI11_PARSE(cli, argc, argv);
+  // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
+  const char* blas = std::getenv("TT_BLAS_THREADS");
+  tt::solvers::cholmod::set_blas_threads(blas ? std::max(1, std::atoi(blas)) : 1);
   try {
     if (*mesh) return mesh_command(mesh_args);
     if (*run) return run_command(run_args);

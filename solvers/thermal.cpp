@@ -170,21 +170,13 @@ double stored_heat_total(const mesh::TetMesh& m, const core::CaseSpec& spec, con
   return total;
 }
 
-/// Heat rate leaving through every convection entry by face quadrature [W].
-template <int N>
-double convected_rate(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& t_k,
-                      const std::vector<double>& h, const std::vector<double>& sink_k) {
-  constexpr int F = N == 4 ? 3 : 6;
+/// Heat rate leaving through every convection entry [W]: h (int T dA - T_sink int dA), with
+/// int T dA from the face-quadrature weights (exact for the element's T).
+double convected_rate(const ThermalOperators& ops, const Eigen::VectorXd& t_k, const std::vector<double>& h,
+                      const std::vector<double>& sink_k) {
   double rate = 0;
-  for (size_t c = 0; c < spec.thermal.convection.size(); ++c) {
-    const int g = spec.thermal.convection[c].group;
-    for (int f = 0; f < m.faces.rows(); ++f) {
-      if (core::index_of(m.face_group[f]) != g) continue;
-      Eigen::Matrix<double, F, 1> tf;
-      for (int a = 0; a < F; ++a) tf(a) = t_k(m.faces(f, a));
-      rate += k::convected_heat_rate(face_coords<F>(m, f), h[c], tf, sink_k[c], f);
-    }
-  }
+  for (size_t c = 0; c < h.size(); ++c)
+    rate += h[c] * (ops.film_area[c].dot(t_k) - sink_k[c] * ops.film_area[c].sum());
   return rate;
 }
 
@@ -289,7 +281,7 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
       const LoadState s_old = load_state(spec, ops, mid, t_prev, temp, t0_k);
       f_prev = load_vector(spec, ops, s_old);
       rhs = ops.capacity * temp - (0.5 * dt) * (kk * temp) + (0.5 * dt) * (f_prev + f_new);
-      lost_rate_prev = convected_rate<N>(m, spec, temp, s_old.h, s_old.sink_k);
+      lost_rate_prev = convected_rate(ops, temp, s_old.h, s_old.sink_k);
     } else {
       rhs = ops.capacity * temp + dt * f_new;
     }
@@ -299,7 +291,7 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
 
     double power = 0;
     for (double p : s_new.power) power += p;
-    const double lost_new = convected_rate<N>(m, spec, next, s_new.h, s_new.sink_k);
+    const double lost_new = convected_rate(ops, next, s_new.h, s_new.sink_k);
     hist.energy.heat_in += dt * power;
     hist.energy.lost += cn ? 0.5 * dt * (lost_rate_prev + lost_new) : dt * lost_new;
     // Surface fluxes enter as heat too.

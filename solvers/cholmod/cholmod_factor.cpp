@@ -6,7 +6,13 @@
 
 #include "core/errors.hpp"
 
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
 namespace tt::solvers::cholmod {
+
+void set_blas_threads(int threads) {
+  if (openblas_set_num_threads) openblas_set_num_threads(threads);
+}
 
 struct Factor::Impl {
   cholmod_common common;

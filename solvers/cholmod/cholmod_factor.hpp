@@ -9,6 +9,11 @@
 
 namespace tt::solvers::cholmod {
 
+/// Pins the BLAS behind CHOLMOD to `threads` threads (OpenBLAS; no effect on other BLAS).
+/// One thread is the default of the CLI: bitwise-repeatable results and, for the per-step
+/// back-substitutions of this size, faster than two.
+void set_blas_threads(int threads);
+
 class Factor {
  public:
   /// Factors A (column-major, compressed; only its upper triangle is read). `what` names the
