@@ -1,0 +1,208 @@
+#include "placement/search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "core/errors.hpp"
+#include "core/parallel.hpp"
+#include "core/rng.hpp"
+#include "placement/random.hpp"
+
+namespace tt::placement {
+
+namespace {
+
+void require_search(int pool_size, int m) {
+  if (m < 1 || m > pool_size)
+    throw core::DataError("placement: search for " + std::to_string(m) + " sensors among " +
+                          std::to_string(pool_size) +
+                          " candidates: expected 1 <= m <= #candidates");
+}
+
+/// Strictly better, with ties resolved towards the lexicographically smaller combination.
+bool better(double fa, const std::vector<int>& a, double fb, const std::vector<int>& b) {
+  if (fa != fb) return fa > fb;
+  return a < b;
+}
+
+std::vector<int> random_combination(std::mt19937_64& gen, int pool_size, int m) {
+  std::vector<int> c;
+  c.reserve(static_cast<std::size_t>(m));
+  while (static_cast<int>(c.size()) < m) {
+    const int g = static_cast<int>(uniform_index(gen, pool_size));
+    if (std::find(c.begin(), c.end(), g) == c.end()) c.push_back(g);
+  }
+  std::sort(c.begin(), c.end());
+  return c;
+}
+
+}  // namespace
+
+std::int64_t combination_count(int n, int m) {
+  if (m < 0 || m > n) return 0;
+  m = std::min(m, n - m);
+  // C(n, i) = C(n, i-1) · (n - i + 1) / i stays an integer at every step.
+  unsigned __int128 c = 1;
+  for (int i = 1; i <= m; ++i) {
+    c = c * static_cast<unsigned>(n - i + 1) / static_cast<unsigned>(i);
+    if (c > static_cast<unsigned __int128>(std::numeric_limits<std::int64_t>::max()))
+      return std::numeric_limits<std::int64_t>::max();
+  }
+  return static_cast<std::int64_t>(c);
+}
+
+SearchResult exhaustive_search(int pool_size, int m, const SetFitness& fitness) {
+  require_search(pool_size, m);
+  const std::int64_t count = combination_count(pool_size, m);
+  if (count > 50'000'000)
+    throw core::DataError("placement: exhaustive search over " + std::to_string(count) +
+                          " combinations: too many; hint: use the genetic search");
+  std::vector<int> all;
+  all.reserve(static_cast<std::size_t>(count * m));
+  std::vector<int> c(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) c[static_cast<std::size_t>(i)] = i;
+  while (true) {
+    all.insert(all.end(), c.begin(), c.end());
+    int i = m - 1;
+    while (i >= 0 && c[static_cast<std::size_t>(i)] == pool_size - m + i) --i;
+    if (i < 0) break;
+    ++c[static_cast<std::size_t>(i)];
+    for (int j = i + 1; j < m; ++j)
+      c[static_cast<std::size_t>(j)] = c[static_cast<std::size_t>(j - 1)] + 1;
+  }
+  std::vector<double> f(static_cast<std::size_t>(count));
+  core::parallel_for(count, [&](std::ptrdiff_t k) {
+    f[static_cast<std::size_t>(k)] =
+        fitness(std::span<const int>(all.data() + k * m, static_cast<std::size_t>(m)));
+  });
+  // Combinations are in lexicographic order, so the first maximum is the tie winner.
+  std::int64_t best = 0;
+  for (std::int64_t k = 1; k < count; ++k)
+    if (f[static_cast<std::size_t>(k)] > f[static_cast<std::size_t>(best)]) best = k;
+  SearchResult r;
+  r.best.assign(all.begin() + best * m, all.begin() + (best + 1) * m);
+  r.fitness = f[static_cast<std::size_t>(best)];
+  r.evaluations = count;
+  return r;
+}
+
+SearchResult genetic_search(int pool_size, int m, const SetFitness& fitness,
+                            const GaOptions& options) {
+  require_search(pool_size, m);
+  if (options.population < 2 || options.elites < 0 || options.elites >= options.population ||
+      options.tournament < 1)
+    throw core::DataError("placement.ga: population " + std::to_string(options.population) +
+                          ", elites " + std::to_string(options.elites) + ", tournament " +
+                          std::to_string(options.tournament) +
+                          ": expected population >= 2, 0 <= elites < population, tournament >= 1");
+  std::mt19937_64 gen = core::generator(options.seed, static_cast<std::uint64_t>(m));
+  std::map<std::vector<int>, double> seen;  // every distinct combination evaluated, once
+
+  // Evaluates the not yet seen members of `batch` in parallel, in first-appearance order.
+  auto evaluate = [&](const std::vector<std::vector<int>>& batch) {
+    std::vector<const std::vector<int>*> fresh;
+    std::map<std::vector<int>, bool> queued;
+    for (const auto& c : batch)
+      if (!seen.count(c) && queued.emplace(c, true).second) fresh.push_back(&c);
+    std::vector<double> f(fresh.size());
+    core::parallel_for(static_cast<std::ptrdiff_t>(fresh.size()), [&](std::ptrdiff_t k) {
+      f[static_cast<std::size_t>(k)] = fitness(*fresh[static_cast<std::size_t>(k)]);
+    });
+    for (std::size_t k = 0; k < fresh.size(); ++k) seen.emplace(*fresh[k], f[k]);
+  };
+
+  // The initial population holds distinct combinations while the pool allows.
+  const std::int64_t distinct = combination_count(pool_size, m);
+  std::vector<std::vector<int>> pop;
+  for (int tries = 0; static_cast<int>(pop.size()) < options.population; ++tries) {
+    auto c = random_combination(gen, pool_size, m);
+    if (tries < 20 * options.population && static_cast<std::int64_t>(pop.size()) < distinct &&
+        std::find(pop.begin(), pop.end(), c) != pop.end())
+      continue;
+    pop.push_back(std::move(c));
+  }
+  evaluate(pop);
+
+  auto fit = [&](const std::vector<int>& c) { return seen.at(c); };
+  auto by_rank = [&](const std::vector<int>& a, const std::vector<int>& b) {
+    return better(fit(a), a, fit(b), b);
+  };
+  std::sort(pop.begin(), pop.end(), by_rank);
+  std::vector<int> best = pop.front();
+  double best_f = fit(best);
+  int stall = 0;
+  int generation = 0;
+
+  auto tournament = [&]() -> const std::vector<int>& {
+    std::size_t w = static_cast<std::size_t>(uniform_index(gen, options.population));
+    for (int t = 1; t < options.tournament; ++t) {
+      const auto o = static_cast<std::size_t>(uniform_index(gen, options.population));
+      if (by_rank(pop[o], pop[w])) w = o;
+    }
+    return pop[w];
+  };
+
+  while (generation < options.max_generations && stall < options.stall_generations) {
+    ++generation;
+    std::vector<std::vector<int>> next(pop.begin(), pop.begin() + options.elites);
+    while (static_cast<int>(next.size()) < options.population) {
+      const auto& a = tournament();
+      const auto& b = tournament();
+      std::vector<int> child = a;
+      if (uniform_unit(gen) < options.crossover_rate) {
+        // Shared genes are kept; the rest is drawn from the union of both parents.
+        std::vector<int> shared, rest;
+        std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(shared));
+        std::set_symmetric_difference(a.begin(), a.end(), b.begin(), b.end(),
+                                      std::back_inserter(rest));
+        child = shared;
+        while (static_cast<int>(child.size()) < m) {
+          const auto k =
+              static_cast<std::size_t>(uniform_index(gen, static_cast<std::int64_t>(rest.size())));
+          child.push_back(rest[k]);
+          rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(k));
+        }
+      }
+      // Mutation, forced when the child is a copy of a combination already in the next
+      // generation, so the search keeps moving instead of re-evaluating clones.
+      const bool clone = std::find(next.begin(), next.end(), [&] {
+                           auto s = child;
+                           std::sort(s.begin(), s.end());
+                           return s;
+                         }()) != next.end();
+      if ((clone || uniform_unit(gen) < options.mutation_rate) && m < pool_size) {
+        const auto k = static_cast<std::size_t>(uniform_index(gen, m));
+        int g = static_cast<int>(uniform_index(gen, pool_size));
+        while (std::find(child.begin(), child.end(), g) != child.end())
+          g = static_cast<int>(uniform_index(gen, pool_size));
+        child[k] = g;
+      }
+      std::sort(child.begin(), child.end());
+      next.push_back(std::move(child));
+    }
+    evaluate(next);
+    pop = std::move(next);
+    std::sort(pop.begin(), pop.end(), by_rank);
+    if (better(fit(pop.front()), pop.front(), best_f, best)) {
+      if (fit(pop.front()) > best_f)
+        stall = 0;
+      else
+        ++stall;
+      best = pop.front();
+      best_f = fit(best);
+    } else {
+      ++stall;
+    }
+  }
+  SearchResult r;
+  r.best = best;
+  r.fitness = best_f;
+  r.evaluations = static_cast<std::int64_t>(seen.size());
+  r.generations = generation;
+  return r;
+}
+
+}  // namespace tt::placement
