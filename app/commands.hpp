@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,13 @@ struct RunArgs {
   bool quiet = false;
 };
 
+struct ProbesArgs {
+  std::filesystem::path in, from_run, out, truth;
+  std::optional<double> speed_rpm, sample_rate_hz, probe_distance_mm;
+};
+
 int mesh_command(const MeshArgs& args);
+int probes_command(const ProbesArgs& args);
 int run_command(const RunArgs& args);
 
 /// Progress on stderr, at most every 10 % of the simulated time.

@@ -27,6 +27,20 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_args.out, "output directory")->required();
   run->add_flag("--quiet", run_args.quiet, "no progress on stderr");
 
+  ProbesArgs probes_args;
+  auto* probes = cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
+  auto* probes_in = probes->add_option("--in", probes_args.in, "raw probe readings (CSV, see docs/probes.md)")
+                        ->check(CLI::ExistingFile);
+  auto* probes_run = probes->add_option("--from-run", probes_args.from_run,
+                                        "make a virtual probe signal from a finished run's probe points")
+                         ->check(CLI::ExistingDirectory);
+  probes_in->excludes(probes_run);
+  probes->add_option("--out", probes_args.out, "output directory")->required();
+  probes->add_option("--truth", probes_args.truth, "true drift CSV to score the methods against");
+  probes->add_option("--speed-rpm", probes_args.speed_rpm, "measuring speed when the file does not say");
+  probes->add_option("--sample-rate-hz", probes_args.sample_rate_hz, "sample rate when the file does not say");
+  probes->add_option("--probe-distance-mm", probes_args.probe_distance_mm, "D when the file does not say");
+
   CLI11_PARSE(cli, argc, argv);
   // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
   const char* blas = std::getenv("TT_BLAS_THREADS");
@@ -34,6 +48,11 @@ int main(int argc, char** argv) {
   try {
     if (*mesh) return mesh_command(mesh_args);
     if (*run) return run_command(run_args);
+    if (*probes) {
+      if (probes_args.in.empty() && probes_args.from_run.empty())
+        throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");
+      return probes_command(probes_args);
+    }
   } catch (const tt::core::Error& e) {
     std::cerr << "thermotwin: error: " << e.what() << "\n";
     return 1;
