@@ -64,7 +64,8 @@ int probes_command(const ProbesArgs& args) {
   }();
   if (!scratch.empty()) {
     for (const char* name : {"virtual_raw.csv", "virtual_truth.csv"})
-      std::filesystem::rename(scratch / name, args.out / name);
+      std::filesystem::copy_file(scratch / name, args.out / name,
+                                 std::filesystem::copy_options::overwrite_existing);
     std::filesystem::remove_all(scratch);
   }
   std::cerr << "thermotwin: probes: " << summary.readings << " readings -> " << args.out.string() << "\n";
