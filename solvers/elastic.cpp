@@ -141,44 +141,79 @@ std::vector<char> constrained_dofs(const mesh::TetMesh& m, const core::CaseSpec&
   return fixed;
 }
 
-ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spec,
-                               const Eigen::MatrixXd& temperature) {
-  ElasticHistory h;
+struct ElasticModel::Impl {
+  Eigen::SparseMatrix<double> coupling;  // G, 3n x n [N/K]
+  std::vector<int> free_index;           // per dof: index among free dofs, -1 when held
+  int free_dofs = 0;
+  std::unique_ptr<cholmod::Factor> factor;
+};
+
+ElasticModel::ElasticModel(const mesh::TetMesh& m, const core::CaseSpec& spec) : impl_(std::make_unique<Impl>()) {
   const auto t0 = Clock::now();
   const std::vector<char> fixed = constrained_dofs(m, spec);
   auto [kk, g] = m.order == 1 ? assemble<4>(m, spec) : assemble<10>(m, spec);
   const int ndof = static_cast<int>(kk.rows());
-  std::vector<int> free_index(ndof, -1);
+  impl_->free_index.assign(ndof, -1);
   int nf = 0;
   for (int i = 0; i < ndof; ++i)
-    if (!fixed[i]) free_index[i] = nf++;
+    if (!fixed[i]) impl_->free_index[i] = nf++;
   Triplets ft;
   ft.reserve(kk.nonZeros());
   for (int col = 0; col < kk.outerSize(); ++col)
     for (Eigen::SparseMatrix<double>::InnerIterator it(kk, col); it; ++it)
-      if (free_index[it.row()] >= 0 && free_index[col] >= 0)
-        ft.emplace_back(free_index[it.row()], free_index[col], it.value());
+      if (impl_->free_index[it.row()] >= 0 && impl_->free_index[col] >= 0)
+        ft.emplace_back(impl_->free_index[it.row()], impl_->free_index[col], it.value());
   Eigen::SparseMatrix<double> kf(nf, nf);
   kf.setFromTriplets(ft.begin(), ft.end());
   kf.makeCompressed();
-  h.timings.assemble_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  h.timings.dofs = ndof;
-  h.timings.free_dofs = nf;
-
+  impl_->coupling = std::move(g);
+  impl_->free_dofs = nf;
+  timings_.assemble_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  timings_.dofs = ndof;
+  timings_.free_dofs = nf;
   const auto t1 = Clock::now();
-  cholmod::Factor factor(kf, "elastic stiffness");
-  h.timings.factor_s = std::chrono::duration<double>(Clock::now() - t1).count();
+  impl_->factor = std::make_unique<cholmod::Factor>(kf, "elastic stiffness");
+  timings_.factor_s = std::chrono::duration<double>(Clock::now() - t1).count();
+  reference_k_ = spec.mechanical.reference_temperature_c + kCelsiusOffset;
+}
 
+ElasticModel::~ElasticModel() = default;
+ElasticModel::ElasticModel(ElasticModel&&) noexcept = default;
+
+Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) const {
+  const Eigen::MatrixXd load = impl_->coupling * (temperature.array() - reference_k_).matrix();
+  const int ndof = static_cast<int>(load.rows());
+  Eigen::MatrixXd rhs(impl_->free_dofs, load.cols());
+  for (int i = 0; i < ndof; ++i)
+    if (impl_->free_index[i] >= 0) rhs.row(impl_->free_index[i]) = load.row(i);
+  const Eigen::MatrixXd uf = impl_->factor->solve(rhs);
+  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(ndof, load.cols());
+  for (int i = 0; i < ndof; ++i)
+    if (impl_->free_index[i] >= 0) u.row(i) = uf.row(impl_->free_index[i]);
+  return u;
+}
+
+Eigen::VectorXd ElasticModel::influence(int node, int direction) const {
+  const int dof = 3 * node + direction;
+  const int n = static_cast<int>(impl_->coupling.cols());
+  if (impl_->free_index[dof] < 0) return Eigen::VectorXd::Zero(n);
+  // K is symmetric: u_dof = e^T K^-1 G dT = (G^T K^-1 e)^T dT.
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(impl_->free_dofs, 1);
+  e(impl_->free_index[dof], 0) = 1.0;
+  const Eigen::MatrixXd wf = impl_->factor->solve(e);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(impl_->coupling.rows());
+  for (int i = 0; i < static_cast<int>(w.size()); ++i)
+    if (impl_->free_index[i] >= 0) w(i) = wf(impl_->free_index[i], 0);
+  return impl_->coupling.transpose() * w;
+}
+
+ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                               const Eigen::MatrixXd& temperature) {
+  const ElasticModel model(m, spec);
+  ElasticHistory h;
   const auto t2 = Clock::now();
-  const double tref = spec.mechanical.reference_temperature_c + kCelsiusOffset;
-  const Eigen::MatrixXd load = g * (temperature.array() - tref).matrix();
-  Eigen::MatrixXd rhs(nf, load.cols());
-  for (int i = 0; i < ndof; ++i)
-    if (free_index[i] >= 0) rhs.row(free_index[i]) = load.row(i);
-  const Eigen::MatrixXd uf = factor.solve(rhs);
-  h.displacement = Eigen::MatrixXd::Zero(ndof, load.cols());
-  for (int i = 0; i < ndof; ++i)
-    if (free_index[i] >= 0) h.displacement.row(i) = uf.row(free_index[i]);
+  h.displacement = model.displacements(temperature);
+  h.timings = model.timings();
   h.timings.solve_s = std::chrono::duration<double>(Clock::now() - t2).count();
   return h;
 }

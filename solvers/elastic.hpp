@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
 
 #include "core/case_spec.hpp"
@@ -24,6 +25,29 @@ struct ElasticHistory {
 /// Dofs held by the case: every dof of nodes on fixed groups, and the point supports' dofs.
 /// Throws SolverError when the constraints leave a rigid motion free.
 std::vector<char> constrained_dofs(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
+
+/// The factored stiffness of a case and its thermal coupling: built once, then displacements for
+/// any temperature fields, or influence vectors that make one displacement component a dot
+/// product with the temperature field (the adjoint route for a few points).
+class ElasticModel {
+ public:
+  ElasticModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
+  ~ElasticModel();
+  ElasticModel(ElasticModel&&) noexcept;
+
+  /// 3 #nodes x #times displacements [m] for temperature fields #nodes x #times [K].
+  Eigen::MatrixXd displacements(const Eigen::MatrixXd& temperature) const;
+  /// a with u(node, direction) = a . (T - T_ref) for every temperature field T [m/K].
+  Eigen::VectorXd influence(int node, int direction) const;
+  double reference_temperature_k() const { return reference_k_; }
+  const ElasticTimings& timings() const { return timings_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  double reference_k_ = 0;
+  ElasticTimings timings_;
+};
 
 /// Displacements for each column of `temperature` (#nodes x #times [K]).
 ElasticHistory elastic_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,

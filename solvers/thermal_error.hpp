@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
@@ -21,5 +22,12 @@ struct ThermalError {
 /// (right-handed rotation of the axis direction), tilt about y is (dx_z2 - dx_z1)/D.
 ThermalError thermal_error(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                            const Eigen::MatrixXd& displacement);
+
+/// The mesh nodes of the TCP and the two probe points (throws when the case does not name them).
+std::array<int, 3> error_nodes(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
+
+/// The same from the displacements of only those three nodes: 9 x #times rows
+/// (tcp x, y, z, z1 x, y, z, z2 x, y, z) [m].
+ThermalError thermal_error_of(const Eigen::MatrixXd& node_displacements, double probe_distance);
 
 }  // namespace tt::solvers

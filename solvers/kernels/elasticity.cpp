@@ -34,23 +34,31 @@ Lame lame_of(const ElasticMaterial& material) {
   return l;
 }
 
-/// Adds weight * (lambda g_a g_b^T + mu g_b g_a^T + mu (g_a . g_b) I) to each 3 x 3 block (a, b):
-/// B^T D B for an isotropic D without forming B.
+/// Adds weight * g g^T to t, where g is the 3n vector of the gradients stacked node-major
+/// (g_{3a+i} = dN_a/dx_i): the quadrature sum from which isotropic_stiffness builds K.
 template <int Nodes>
-void add_isotropic_stiffness(Eigen::Matrix<double, 3 * Nodes, 3 * Nodes>& k,
-                             const Eigen::Matrix<double, Nodes, 3>& g, const Lame& l,
-                             double weight) {
-  for (int a = 0; a < Nodes; ++a) {
-    const Eigen::RowVector3d ga = g.row(a);
-    for (int b = a; b < Nodes; ++b) {
-      const Eigen::RowVector3d gb = g.row(b);
-      Eigen::Matrix3d block = l.lambda * ga.transpose() * gb + l.mu * gb.transpose() * ga;
-      block.diagonal().array() += l.mu * ga.dot(gb);
-      block *= weight;
-      k.template block<3, 3>(3 * a, 3 * b) += block;
-      if (b != a) k.template block<3, 3>(3 * b, 3 * a) += block.transpose();
+void add_gradient_outer_product(Eigen::Matrix<double, 3 * Nodes, 3 * Nodes>& t,
+                                const Eigen::Matrix<double, Nodes, 3>& dn_dx, double weight) {
+  const Eigen::Matrix<double, 3, Nodes> g = dn_dx.transpose();
+  const Eigen::Map<const Eigen::Matrix<double, 3 * Nodes, 1>> stacked(g.data());
+  t.noalias() += weight * stacked * stacked.transpose();
+}
+
+/// B^T D B for an isotropic D without forming B: with T = integral g g^T,
+/// K(3a+i, 3b+k) = lambda T(3a+i, 3b+k) + mu T(3a+k, 3b+i) + mu delta_ik sum_j T(3a+j, 3b+j).
+template <int Nodes>
+Eigen::Matrix<double, 3 * Nodes, 3 * Nodes> isotropic_stiffness(
+    const Eigen::Matrix<double, 3 * Nodes, 3 * Nodes>& t, const Lame& l) {
+  Eigen::Matrix<double, 3 * Nodes, 3 * Nodes> k;
+  for (int b = 0; b < Nodes; ++b) {
+    for (int a = 0; a < Nodes; ++a) {
+      const Eigen::Matrix3d tab = t.template block<3, 3>(3 * a, 3 * b);
+      Eigen::Matrix3d block = l.lambda * tab + l.mu * tab.transpose();
+      block.diagonal().array() += l.mu * tab.trace();
+      k.template block<3, 3>(3 * a, 3 * b) = block;
     }
   }
+  return k;
 }
 
 template <int Nodes>
@@ -110,9 +118,9 @@ Eigen::Matrix<double, 12, 12> stiffness_matrix(const Tet4Coords& x, const Elasti
                                                int element) {
   const Lame l = lame_of(material);
   const ShapeGradients<4> g = tet4_gradients(x, element);
-  Eigen::Matrix<double, 12, 12> k = Eigen::Matrix<double, 12, 12>::Zero();
-  add_isotropic_stiffness<4>(k, g.dn_dx, l, g.det_j / 6.0);
-  return k;
+  Eigen::Matrix<double, 12, 12> t = Eigen::Matrix<double, 12, 12>::Zero();
+  add_gradient_outer_product<4>(t, g.dn_dx, g.det_j / 6.0);
+  return isotropic_stiffness<4>(t, l);
 }
 
 Eigen::Matrix<double, 30, 30> stiffness_matrix(const Tet10Coords& x,
@@ -121,12 +129,12 @@ Eigen::Matrix<double, 30, 30> stiffness_matrix(const Tet10Coords& x,
   // Degree 3, not the degree 2 a straight tet10 needs, so that K and the thermal load use the
   // same points: then free thermal expansion stays exactly stress-free on curved elements too.
   const TetRule<8>& rule = tet_rule_degree3();
-  Eigen::Matrix<double, 30, 30> k = Eigen::Matrix<double, 30, 30>::Zero();
+  Eigen::Matrix<double, 30, 30> t = Eigen::Matrix<double, 30, 30>::Zero();
   for (int q = 0; q < 8; ++q) {
     const ShapeGradients<10> g = tet10_gradients(x, rule.points.col(q), element);
-    add_isotropic_stiffness<10>(k, g.dn_dx, l, rule.weights(q) * g.det_j);
+    add_gradient_outer_product<10>(t, g.dn_dx, rule.weights(q) * g.det_j);
   }
-  return k;
+  return isotropic_stiffness<10>(t, l);
 }
 
 Tet4Vector thermal_load(const Tet4Coords& x, const ElasticMaterial& material,
@@ -154,6 +162,33 @@ Tet10Vector thermal_load(const Tet10Coords& x, const ElasticMaterial& material,
     f += (rule.weights(q) * g.det_j * l.beta * strain) * g.dn_dx.transpose();
   }
   return Eigen::Map<const Tet10Vector>(f.data());
+}
+
+Eigen::Matrix<double, 12, 4> thermal_coupling_matrix(const Tet4Coords& x,
+                                                     const ElasticMaterial& material, int element) {
+  const Lame l = lame_of(material);
+  const ShapeGradients<4> g = tet4_gradients(x, element);
+  const Eigen::Matrix<double, 3, 4> gt = g.dn_dx.transpose();
+  const Eigen::Map<const Tet4Vector> stacked(gt.data());
+  // integral N_j dV = V / 4 for every node
+  const double scale = l.beta * material.thermal_expansion * g.det_j / 24.0;
+  return (scale * stacked).replicate<1, 4>();
+}
+
+Eigen::Matrix<double, 30, 10> thermal_coupling_matrix(const Tet10Coords& x,
+                                                      const ElasticMaterial& material,
+                                                      int element) {
+  const Lame l = lame_of(material);
+  const TetRule<8>& rule = tet_rule_degree3();
+  Eigen::Matrix<double, 30, 10> c = Eigen::Matrix<double, 30, 10>::Zero();
+  for (int q = 0; q < 8; ++q) {
+    const Eigen::Vector3d xi = rule.points.col(q);
+    const ShapeGradients<10> g = tet10_gradients(x, xi, element);
+    const Eigen::Matrix<double, 3, 10> gt = g.dn_dx.transpose();
+    const Eigen::Map<const Tet10Vector> stacked(gt.data());
+    c.noalias() += (rule.weights(q) * g.det_j) * stacked * tet10_shape(xi).transpose();
+  }
+  return (l.beta * material.thermal_expansion) * c;
 }
 
 Vector6d stress_at(const Tet4Coords& x, const ElasticMaterial& material, const Tet4Vector& u,

@@ -48,6 +48,14 @@ Tet10Vector thermal_load(const Tet10Coords& x, const ElasticMaterial& material,
                          const Eigen::Matrix<double, 10, 1>& temperatures,
                          double reference_temperature, int element);
 
+/// Thermal coupling G, 3n x n [N/K]: thermal_load = G (T - T_ref), column j = integral
+/// beta alpha N_j grad N dV (beta = E / (1 - 2 nu)), by the same rules as thermal_load. For an
+/// assembler that stores the global G once instead of calling thermal_load per time step.
+Eigen::Matrix<double, 12, 4> thermal_coupling_matrix(const Tet4Coords& x,
+                                                     const ElasticMaterial& material, int element);
+Eigen::Matrix<double, 30, 10> thermal_coupling_matrix(const Tet10Coords& x,
+                                                      const ElasticMaterial& material, int element);
+
 /// Stress sigma = D (B u - alpha (T - T_ref) m) [Pa] at natural point xi.
 Vector6d stress_at(const Tet4Coords& x, const ElasticMaterial& material, const Tet4Vector& u,
                    const Eigen::Vector4d& temperatures, double reference_temperature,

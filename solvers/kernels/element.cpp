@@ -50,11 +50,19 @@ Eigen::Matrix<double, 4, 3> barycentric_derivatives() {
   return d;
 }
 
+/// det J, or min(det J, 0) where checked_determinant would reject it as flat to rounding.
+double acceptance_determinant(const Eigen::Matrix3d& j) {
+  const double det_j = j.determinant();
+  const double bound =
+      internal::degenerate_ratio * j.col(0).norm() * j.col(1).norm() * j.col(2).norm();
+  return det_j > bound ? det_j : std::min(det_j, 0.0);
+}
+
 template <int Points>
 double min_det_over(const Tet10Coords& x, const Eigen::Matrix<double, 3, Points>& points) {
   double smallest = std::numeric_limits<double>::infinity();
   for (int q = 0; q < Points; ++q) {
-    smallest = std::min(smallest, jacobian(x, points.col(q)).determinant());
+    smallest = std::min(smallest, acceptance_determinant(jacobian(x, points.col(q))));
   }
   return smallest;
 }
@@ -146,7 +154,7 @@ Eigen::Matrix3d jacobian(const Tet10Coords& x, const Eigen::Vector3d& xi) {
 }
 
 double min_jacobian_determinant(const Tet4Coords& x) {
-  return jacobian(x).determinant();
+  return acceptance_determinant(jacobian(x));
 }
 
 double min_jacobian_determinant(const Tet10Coords& x) {

@@ -79,9 +79,9 @@ Eigen::Matrix3d jacobian(const Tet4Coords& x);
 /// J_ab = dx_a/dxi_b of the quadratic tet at xi.
 Eigen::Matrix3d jacobian(const Tet10Coords& x, const Eigen::Vector3d& xi);
 
-/// Smallest det J [m^3] over the nodes and the quadrature points the kernels use; an element is
-/// usable iff this is > 0 (and not flat to rounding, see above). Never throws: meant for a
-/// serial validity pass before assembly.
+/// Smallest det J [m^3] over the nodes and the quadrature points the kernels use, with a point
+/// where the element is flat to rounding (see above) counted as <= 0: the kernels accept the
+/// element iff this is > 0. Never throws: meant for a serial validity pass before assembly.
 double min_jacobian_determinant(const Tet4Coords& x);
 double min_jacobian_determinant(const Tet10Coords& x);
 

@@ -31,7 +31,7 @@ double checked_tet10_det(const Tet10Coords& x, const Eigen::Vector3d& xi, int el
 
 Eigen::Matrix4d conductivity_matrix(const Tet4Coords& x, double conductivity, int element) {
   const ShapeGradients<4> g = tet4_gradients(x, element);
-  return (conductivity * g.det_j / 6.0) * g.dn_dx * g.dn_dx.transpose();
+  return (conductivity * g.det_j / 6.0) * g.dn_dx.lazyProduct(g.dn_dx.transpose());
 }
 
 Eigen::Matrix<double, 10, 10> conductivity_matrix(const Tet10Coords& x, double conductivity,
@@ -40,7 +40,8 @@ Eigen::Matrix<double, 10, 10> conductivity_matrix(const Tet10Coords& x, double c
   Eigen::Matrix<double, 10, 10> k = Eigen::Matrix<double, 10, 10>::Zero();
   for (int q = 0; q < 4; ++q) {
     const ShapeGradients<10> g = tet10_gradients(x, rule.points.col(q), element);
-    k.noalias() += (rule.weights(q) * g.det_j) * g.dn_dx * g.dn_dx.transpose();
+    // lazyProduct: coefficient-based, not Eigen's blocked (and OpenMP-aware) GEMM
+    k.noalias() += (rule.weights(q) * g.det_j) * g.dn_dx.lazyProduct(g.dn_dx.transpose());
   }
   return conductivity * k;
 }
