@@ -5,7 +5,8 @@
 // Prints the wall time of each method for m = 1..6 per target, the GA's distinct evaluations
 // and the Gaussian MI each method reaches. The budget (issue 5): histogram ranking, Gaussian
 // greedy, QR-POD and the Gaussian-fitness GA together under 10 s on 2 cores; KSG and JMI run on
-// the pool's 300 candidates best correlated with the target (PlacementOptions::ksg_max_candidates).
+// a 300-candidate subsample (PlacementOptions::ksg_max_candidates: the 150 best correlated with
+// the target plus 150 spread over the rest).
 #include <omp.h>
 
 #include <chrono>
@@ -125,14 +126,15 @@ int main(int argc, char** argv) {
     report(r);
     std::printf("histogram ranking (m = 1, both targets, with diagnosis): %.3f s\n", ranking);
     std::printf("gaussian greedy + gaussian GA + QR-POD + baselines: %.3f s (budget 10 s)\n", fast);
+    std::printf("budgeted together (ranking + the line above): %.3f s\n", ranking + fast);
     std::printf("histogram ranking + GA m = 2..6 + diagnoses: %.3f s\n", histogram);
 
     // 3. KSG and JMI on the documented subsample.
     const double ksg = run(input, o, {Method::kKsgGreedy, Method::kJmiKsg}, r);
     report(r);
-    std::printf("KSG greedy + JMI on %zu of %d candidates: %.3f s\n", r.ksg_pool.size(), candidates,
-                ksg);
-    return fast < 10.0 ? 0 : 1;
+    std::printf("KSG greedy + JMI on %zu of %d candidates: %.3f s\n",
+                r.targets.front().ksg_pool.size(), candidates, ksg);
+    return ranking + fast < 10.0 ? 0 : 1;
   } catch (const tt::core::Error& e) {
     std::fprintf(stderr, "bench_placement_scale: %s\n", e.what());
     return 1;

@@ -81,7 +81,8 @@ json placement_json(const placement::PlacementResult& result) {
                {"crossover_rate", o.ga.crossover_rate},
                {"mutation_rate", o.ga.mutation_rate},
                {"tournament", o.ga.tournament},
-               {"elites", o.ga.elites}};
+               {"elites", o.ga.elites},
+               {"min_parallel_batch", o.ga.min_parallel_batch}};
   doc["candidates"] = result.ids.size();
   json twins = json::array();
   for (const auto& [kept, dropped] : result.twins)
@@ -89,14 +90,13 @@ json placement_json(const placement::PlacementResult& result) {
                      core::index_of(result.ids[static_cast<std::size_t>(dropped)])});
   doc["mirror_twins_kept_dropped"] = twins;
   doc["search_pool_size"] = result.pool.size();
-  doc["ksg_pool_size"] = result.ksg_pool.size();
   doc["pod_seconds"] = result.pod_seconds;
   json targets = json::object();
   for (const auto& t : result.targets) {
     json methods = json::object();
     for (const auto& s : t.selections)
       methods[std::string(placement::method_name(s.method))].push_back(selection_json(s));
-    targets[t.target] = methods;
+    targets[t.target] = {{"ksg_pool_size", t.ksg_pool.size()}, {"methods", methods}};
   }
   doc["targets"] = targets;
   return doc;

@@ -11,7 +11,9 @@
 
 namespace tt::io {
 
-/// The document written to placement.json.
+/// The document written to placement.json: options as used, the mirror twins (kept id, dropped
+/// id), and targets.<name>.methods.<method> = [one object per m: m, ids, search, score,
+/// score_kind, gaussian_bits, seconds, evaluations, and for histogram_mi a saturation object].
 nlohmann::json placement_json(const placement::PlacementResult& result);
 
 /// The text of mi_ranking.csv: header `id,x_m,y_m,z_m,mi_bits_<t>,rank_<t>,...` (one pair of

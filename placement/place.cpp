@@ -193,7 +193,10 @@ void ranked_selections(const TargetData& d, Method method, const Eigen::VectorXd
   }
 }
 
-/// The pool's best `limit` candidates by |r| with the target, ascending columns.
+/// KSG's subsample of a large pool, ascending columns: the limit/2 candidates with the largest
+/// |r| with the target (where the answer most likely is), plus limit − limit/2 spread evenly over
+/// the rest of the pool in column order (so that the top ones, often near-collinear, do not crowd
+/// out every other direction).
 std::vector<int> ksg_pool_of(const std::vector<int>& pool, const LinearProblem& linear, int limit) {
   if (static_cast<int>(pool.size()) <= limit) return pool;
   std::vector<int> order = pool;
@@ -202,9 +205,14 @@ std::vector<int> ksg_pool_of(const std::vector<int>& pool, const LinearProblem& 
     if (ra != rb) return ra > rb;
     return a < b;
   });
-  order.resize(static_cast<std::size_t>(limit));
-  std::sort(order.begin(), order.end());
-  return order;
+  const auto top = static_cast<std::size_t>(limit / 2);
+  std::vector<int> chosen(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(top));
+  std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(top), order.end());
+  std::sort(rest.begin(), rest.end());
+  const std::size_t spread = static_cast<std::size_t>(limit) - top;
+  for (std::size_t k = 0; k < spread; ++k) chosen.push_back(rest[k * rest.size() / spread]);
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
 }
 
 }  // namespace
@@ -295,17 +303,17 @@ PlacementResult place_all(const PlacementInput& input, const PlacementOptions& o
                       "gaussian_bits", out);
     if (wants(Method::kGaussianGa)) gaussian_ga_selections(d, out);
     if (wants(Method::kKsgGreedy) || wants(Method::kJmiKsg)) {
-      result.ksg_pool = ksg_pool_of(result.pool, linear, o.ksg_max_candidates);
+      tr.ksg_pool = ksg_pool_of(result.pool, linear, o.ksg_max_candidates);
       const auto ksg = ksg_problem(linear, o.ksg_k,
                                    core::derived_seed(o.seed, stream(d, Method::kKsgGreedy, 63)));
-      const int m_max = std::min(o.m_max, static_cast<int>(result.ksg_pool.size()));
+      const int m_max = std::min(o.m_max, static_cast<int>(tr.ksg_pool.size()));
       if (wants(Method::kKsgGreedy))
         path_selections(d, Method::kKsgGreedy,
-                        ksg_greedy(ksg, linear, result.ksg_pool, m_max, o.collinearity), "ksg_bits",
+                        ksg_greedy(ksg, linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
                         out);
       if (wants(Method::kJmiKsg))
         path_selections(d, Method::kJmiKsg,
-                        jmi_greedy(ksg, linear, result.ksg_pool, m_max, o.collinearity), "ksg_bits",
+                        jmi_greedy(ksg, linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
                         out);
     }
     if (wants(Method::kQrPod)) {

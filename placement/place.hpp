@@ -61,10 +61,12 @@ struct PlacementOptions {
   std::int64_t exhaustive_limit = 30000;  ///< search exhaustively when C(pool, m) <= this
   GaOptions ga;  ///< its seed is derived from `seed` per target, method and m
   SaturationOptions saturation;
-  int ksg_k = 4;                 ///< neighbours of the KSG estimator (3 to 5)
-  int ksg_max_candidates = 300;  ///< KSG and JMI see the pool's top ones by |r| beyond this
-  Collinearity collinearity;     ///< when a candidate does not count as a sensor of its own
-  bool mirror_twins = true;      ///< drop the higher member of each mirror pair from the searches
+  int ksg_k = 4;  ///< neighbours of the KSG estimator (3 to 5)
+  /// Beyond this pool size KSG and JMI see a subsample: the half with the largest |r| with the
+  /// target plus the other half spread evenly over the rest of the pool.
+  int ksg_max_candidates = 300;
+  Collinearity collinearity;  ///< when a candidate does not count as a sensor of its own
+  bool mirror_twins = true;   ///< drop the higher member of each mirror pair from the searches
   double mirror_plane_x_m = 0.0;
   double mirror_tolerance_m = 1e-6;
   double grey_rho = 0.5;
@@ -89,8 +91,9 @@ struct Selection {
 
 struct TargetResult {
   std::string target;
-  Eigen::VectorXd mi_bits;   ///< #candidates formula-1 I(Y; T_i) [bits]
-  std::vector<int> mi_rank;  ///< #candidates 1-based rank by mi_bits, ties to the lower column
+  Eigen::VectorXd mi_bits;    ///< #candidates formula-1 I(Y; T_i) [bits]
+  std::vector<int> mi_rank;   ///< #candidates 1-based rank by mi_bits, ties to the lower column
+  std::vector<int> ksg_pool;  ///< columns KSG and JMI chose from (depends on the target)
   std::vector<Selection> selections;
 };
 

@@ -108,9 +108,14 @@ SearchResult genetic_search(int pool_size, int m, const SetFitness& fitness,
     for (const auto& c : batch)
       if (!seen.count(c) && queued.emplace(c, true).second) fresh.push_back(&c);
     std::vector<double> f(fresh.size());
-    core::parallel_for(static_cast<std::ptrdiff_t>(fresh.size()), [&](std::ptrdiff_t k) {
+    const auto one = [&](std::ptrdiff_t k) {
       f[static_cast<std::size_t>(k)] = fitness(*fresh[static_cast<std::size_t>(k)]);
-    });
+    };
+    const auto count = static_cast<std::ptrdiff_t>(fresh.size());
+    if (count >= options.min_parallel_batch)
+      core::parallel_for(count, one);
+    else
+      for (std::ptrdiff_t k = 0; k < count; ++k) one(k);
     for (std::size_t k = 0; k < fresh.size(); ++k) seen.emplace(*fresh[k], f[k]);
   };
 

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <set>
 
 #include "core/errors.hpp"
@@ -62,7 +63,8 @@ TEST(Place, TwinsAreNeverBothChosenWithOrWithoutTheMirrorRule) {
 TEST(Place, ResultsDoNotDependOnTheThreadCount) {
   const auto input = synthetic::c54_input(0.05, 2);
   auto options = quick_options();
-  options.exhaustive_limit = 2000;  // force the genetic search from m = 3 on
+  options.exhaustive_limit = 2000;    // force the genetic search from m = 3 on
+  options.ga.min_parallel_batch = 1;  // and evaluate every generation in parallel
   omp_set_num_threads(1);
   const auto one = place_all(input, options);
   omp_set_num_threads(2);
@@ -119,6 +121,32 @@ TEST(Place, HistogramDiagnosisFlagsSetsTiedAtTheCeilingOnTheC54Problem) {
       tied += d.at_ceiling && d.share_near_ceiling > 0.0;
     }
   EXPECT_GE(tied, 1) << "dz reaches the ceiling with ties from m = 3 on";
+}
+
+TEST(Place, KsgSeesADocumentedSubsampleOfLargePools) {
+  const auto input = synthetic::c54_input(0.05, 6);
+  auto options = quick_options();
+  options.mirror_twins = false;
+  options.ksg_max_candidates = 20;
+  options.m_max = 3;
+  options.methods = {Method::kKsgGreedy, Method::kCorrelation};
+  const auto r = place_all(input, options);
+  // The best-correlated candidate (the correlation ranking's first pick) is in the subsample, and
+  // every KSG choice comes from it.
+  for (const auto& t : r.targets) {
+    ASSERT_EQ(t.ksg_pool.size(), 20u);
+    EXPECT_TRUE(std::is_sorted(t.ksg_pool.begin(), t.ksg_pool.end()));
+    for (const auto& s : t.selections) {
+      if (s.method == Method::kCorrelation && s.m == 1) {
+        EXPECT_TRUE(std::binary_search(t.ksg_pool.begin(), t.ksg_pool.end(), s.columns[0]));
+      }
+      if (s.method == Method::kKsgGreedy) {
+        for (int c : s.columns) {
+          EXPECT_TRUE(std::binary_search(t.ksg_pool.begin(), t.ksg_pool.end(), c));
+        }
+      }
+    }
+  }
 }
 
 TEST(Place, RejectsInconsistentInputWithTypedErrors) {

@@ -28,15 +28,16 @@ TEST(PlacementOut, WritesJsonAndCsvThatReadBack) {
   std::ifstream jf(dir / "placement.json");
   const auto doc = nlohmann::json::parse(jf);
   EXPECT_EQ(doc["samples"], 100);
+  EXPECT_EQ(doc["targets"]["dy"]["ksg_pool_size"], 0) << "KSG was not run";
   EXPECT_EQ(doc["mirror_twins_kept_dropped"].size(), 24u);
-  const auto& hist = doc["targets"]["dy"]["histogram_mi"];
+  const auto& hist = doc["targets"]["dy"]["methods"]["histogram_mi"];
   ASSERT_EQ(hist.size(), 3u);
   EXPECT_EQ(hist[0]["m"], 1);
   EXPECT_EQ(hist[2]["ids"].size(), 3u);
   EXPECT_TRUE(hist[2]["saturation"].contains("p_value"));
   EXPECT_TRUE(hist[2]["saturation"]["saturated"].is_boolean());
   EXPECT_TRUE(hist[2]["saturation"]["at_ceiling"].is_boolean());
-  EXPECT_EQ(doc["targets"]["dz"]["gaussian_greedy"][1]["ids"].size(), 2u);
+  EXPECT_EQ(doc["targets"]["dz"]["methods"]["gaussian_greedy"][1]["ids"].size(), 2u);
   EXPECT_EQ(hist[0]["ids"][0].get<int>(),
             tt::core::index_of(result.targets[0].selections[0].ids[0]));
 
