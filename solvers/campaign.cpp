@@ -1,0 +1,111 @@
+#include "solvers/campaign.hpp"
+
+#include <algorithm>
+
+#include "core/errors.hpp"
+#include "core/rng.hpp"
+#include "solvers/elastic.hpp"
+#include "solvers/thermal_error.hpp"
+
+namespace tt::solvers {
+namespace {
+
+using Segment = core::DutyCycle::Segment;
+
+core::CaseSpec with_cycle(const core::CaseSpec& base, std::vector<Segment> segments, double end) {
+  core::CaseSpec s = base;
+  s.duty_cycle.segments = std::move(segments);
+  s.duty_cycle.end = end;
+  return s;
+}
+
+/// Every sink that follows the base's initial (ambient) temperature now follows `table`.
+void set_ambient(core::CaseSpec& s, double initial_c, const core::TimeTable& table) {
+  const double ambient = s.thermal.initial_temperature_c;
+  for (auto& c : s.thermal.convection)
+    if (c.sink.value.size() == 1 && c.sink.value[0] == ambient) c.sink = table;
+  s.thermal.initial_temperature_c = initial_c;
+}
+
+std::vector<Segment> irregular_cycle(double end, std::uint64_t seed, const std::vector<double>& speeds) {
+  auto gen = core::generator(seed, 0);
+  std::uniform_real_distribution<double> on_minutes(10, 50), off_minutes(5, 25);
+  std::uniform_int_distribution<size_t> pick(0, speeds.size() - 1);
+  std::vector<Segment> segs;
+  double t = 0;
+  bool on = true;
+  while (t < end) {
+    // Whole minutes, so that switches fall on the 60 s output grid of a measurement.
+    const double minutes = std::round(on ? on_minutes(gen) : off_minutes(gen));
+    segs.push_back({t, on ? speeds[pick(gen)] : 0.0});
+    t += 60 * minutes;
+    on = !on;
+  }
+  return segs;
+}
+
+}  // namespace
+
+std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed) {
+  if (!(hours > 0)) throw core::CaseError("campaign length " + std::to_string(hours) + " h: must be > 0");
+  const double end = 3600 * hours;
+  const double q = end / 4;
+  const double t0 = base.thermal.initial_temperature_c;
+  std::vector<CampaignRun> runs;
+  runs.push_back({"p1_extended", "P-1 then running",
+                  with_cycle(base, {{0, 3000}, {600, 0}, {900, 3000}, {2100, 0}, {2400, 3000}}, end)});
+  runs.push_back({"staircase_up", "speed staircase", with_cycle(base, {{0, 1000}, {q, 2000}, {2 * q, 3000}, {3 * q, 4000}}, end)});
+  runs.push_back({"staircase_down", "speed staircase",
+                  with_cycle(base, {{0, 4500}, {q, 3000}, {2 * q, 1500}, {3 * q, 0}}, end)});
+  runs.push_back({"irregular_a", "irregular on/off",
+                  with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 1), {1500, 2500, 3500}), end)});
+  runs.push_back({"irregular_b", "irregular on/off",
+                  with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 2), {2000, 3000, 4500}), end)});
+  {
+    CampaignRun r{"warm_start", "warmer ambient", with_cycle(base, {{0, 2500}, {2 * q, 0}, {2.5 * q, 2500}}, end)};
+    set_ambient(r.spec, t0 + 4, core::TimeTable{{0.0}, {t0 + 4}});
+    runs.push_back(std::move(r));
+  }
+  {
+    CampaignRun r{"ambient_drift", "ambient drifting",
+                  with_cycle(base, {{0, 3000}, {1.5 * q, 0}, {2 * q, 3000}, {3.5 * q, 0}}, end)};
+    set_ambient(r.spec, t0, core::TimeTable{{0.0, end / 2, end}, {t0, t0 + 3, t0 + 1.5}});
+    runs.push_back(std::move(r));
+  }
+  runs.push_back({"run_then_cool", "run then cool down", with_cycle(base, {{0, 3500}, {2 * q, 0}}, end)});
+  runs.push_back({"mixed_speeds", "mixed speeds",
+                  with_cycle(base, {{0, 2000}, {3600, 0}, {5400, 4000}, {9000, 0}, {10800, 3000}}, end)});
+  return runs;
+}
+
+std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,
+                                              const std::vector<CampaignRun>& runs, const Progress& progress) {
+  const ThermalOperators ops = thermal_operators(mesh, base);
+  const ElasticModel elastic(mesh, base);
+  const auto nodes = error_nodes(mesh, base);
+  // 9 influence vectors: (tcp, z1, z2) x (x, y, z).
+  Eigen::MatrixXd influence(9, mesh.nodes.rows());
+  for (int p = 0; p < 3; ++p)
+    for (int d = 0; d < 3; ++d) influence.row(3 * p + d) = elastic.influence(nodes[p], d).transpose();
+  const double distance = (mesh.nodes.row(nodes[2]) - mesh.nodes.row(nodes[1])).norm();
+
+  std::vector<CampaignResult> results;
+  double done = 0, total = 0;
+  for (const auto& r : runs) total += r.spec.duty_cycle.end;
+  for (const auto& r : runs) {
+    const ThermalHistory th = thermal_history(mesh, r.spec, ops, [&](double t, double) {
+      if (progress) progress(done + t, total);
+    });
+    done += r.spec.duty_cycle.end;
+    CampaignResult c{r.name, r.shape, th.times, {}, {}};
+    c.point_temperature.resize(static_cast<Eigen::Index>(th.times.size()), static_cast<Eigen::Index>(mesh.points.size()));
+    for (size_t i = 0; i < mesh.points.size(); ++i)
+      c.point_temperature.col(static_cast<Eigen::Index>(i)) = th.temperature.row(mesh.points[i].node).transpose();
+    const Eigen::MatrixXd u = influence * (th.temperature.array() - elastic.reference_temperature_k()).matrix();
+    c.error = thermal_error_of(u, distance).values;
+    results.push_back(std::move(c));
+  }
+  return results;
+}
+
+}  // namespace tt::solvers

@@ -1,0 +1,41 @@
+// A virtual test campaign: the same machine under other duty cycles and ambient conditions, run
+// on one mesh with the operators assembled once; each run sampled at the named points (the
+// sensors' readings) and at the tool (the thermal error), as a measurement would be.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
+#include "solvers/thermal.hpp"
+
+namespace tt::solvers {
+
+struct CampaignRun {
+  std::string name;
+  std::string shape;  /// what kind of duty cycle it is, for reports
+  core::CaseSpec spec;
+};
+
+/// At least eight runs of `hours` each (the standard's minimum is 5 h), derived from `base`:
+/// P-1 extended, speed staircases up and down, irregular on/off cycles at several speeds (seeded
+/// from `seed`), a run starting at a warmer uniform ambient, one whose ambient drifts, a
+/// run-then-cool-down. The base case's own duty cycle is ignored.
+std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed);
+
+struct CampaignResult {
+  std::string name, shape;
+  std::vector<double> times;           /// [s], t = 0 first
+  Eigen::MatrixXd point_temperature;   /// #times x #named points [K]
+  Eigen::MatrixXd error;               /// #times x 9: thermal_error.csv's columns [m, rad]
+};
+
+/// Simulates every run on `mesh` (built from `base`; runs may differ from it only in duty cycle,
+/// initial temperature and sinks). The thermal error comes from adjoint influence vectors.
+std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,
+                                              const std::vector<CampaignRun>& runs,
+                                              const Progress& progress = {});
+
+}  // namespace tt::solvers
