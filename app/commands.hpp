@@ -22,9 +22,19 @@ struct ProbesArgs {
   std::optional<double> speed_rpm, sample_rate_hz, probe_distance_mm;
 };
 
+struct PlaceArgs {
+  std::filesystem::path case_file, from_run, out;
+  int samples = 100, bins = 20, m_max = 6;
+  bool quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int place_command(const PlaceArgs& args);
 int probes_command(const ProbesArgs& args);
 int run_command(const RunArgs& args);
+
+/// Runs app/plot.py with these arguments; a missing matplotlib only skips the figure.
+void plot(const std::vector<std::string>& args);
 
 /// Progress on stderr, at most every 10 % of the simulated time.
 void report_progress(const std::string& stage, double done, double total);

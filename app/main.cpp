@@ -41,6 +41,18 @@ int main(int argc, char** argv) {
   probes->add_option("--sample-rate-hz", probes_args.sample_rate_hz, "sample rate when the file does not say");
   probes->add_option("--probe-distance-mm", probes_args.probe_distance_mm, "D when the file does not say");
 
+  PlaceArgs place_args;
+  auto* place = cli.add_subcommand("place", "Sensor placement: the patent's MI + GA method and stronger criteria");
+  auto* place_case = place->add_option("case", place_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
+  auto* place_from = place->add_option("--from", place_args.from_run, "a finished run directory instead of a case")
+                         ->check(CLI::ExistingDirectory);
+  place_case->excludes(place_from);
+  place->add_option("--out", place_args.out, "output directory")->required();
+  place->add_option("--samples", place_args.samples, "S, samples the histories are resampled to (patent: 100)");
+  place->add_option("--bins", place_args.bins, "N = M, histogram bins (patent: 20 to 40)");
+  place->add_option("--m-max", place_args.m_max, "largest number of sensors");
+  place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
+
   CLI11_PARSE(cli, argc, argv);
   // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
   const char* blas = std::getenv("TT_BLAS_THREADS");
@@ -48,6 +60,11 @@ int main(int argc, char** argv) {
   try {
     if (*mesh) return mesh_command(mesh_args);
     if (*run) return run_command(run_args);
+    if (*place) {
+      if (place_args.case_file.empty() && place_args.from_run.empty())
+        throw tt::core::CaseError("place: give a case file or --from RUNDIR");
+      return place_command(place_args);
+    }
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

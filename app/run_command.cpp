@@ -77,14 +77,14 @@ void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const s
   writer.finish();
 }
 
+}  // namespace
+
 void plot(const std::vector<std::string>& args) {
   std::string cmd = "/usr/bin/python3 " TT_SOURCE_DIR "/app/plot.py";
   for (const auto& a : args) cmd += " '" + a + "'";
   cmd += " 2>/dev/null";
   if (std::system(cmd.c_str()) != 0) std::cerr << "thermotwin: note: plot skipped (" << args[0] << ")\n";
 }
-
-}  // namespace
 
 void report_progress(const std::string& stage, double done, double total) {
   static int last_decile = -1;

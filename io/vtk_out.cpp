@@ -379,6 +379,33 @@ void write_points_vtp(const mesh::TetMesh& mesh, const fs::path& path) {
   write_xml_atomically(writer, cloud, path);
 }
 
+void write_point_cloud_vtp(const fs::path& path, const std::vector<std::string>& ids,
+                           const Eigen::MatrixX3d& positions, const std::vector<NamedField>& fields) {
+  const auto count = positions.rows();
+  if (static_cast<Eigen::Index>(ids.size()) != count)
+    throw core::DataError(path.string() + ": " + str(ids.size()) + " ids for " + str(count) + " points");
+  mesh::NodeMatrix xyz = positions;
+  mesh::IndexMatrix vertices(count, 1);
+  for (Eigen::Index p = 0; p < count; ++p) vertices(p, 0) = static_cast<int>(p);
+  vtkNew<vtkPolyData> cloud;
+  cloud->SetPoints(point_coordinates(xyz));
+  cloud->SetVerts(cell_array(vertices, 1));
+  cloud->GetPointData()->AddArray(string_array("id", ids));
+  for (const NamedField& f : fields) {
+    if (f.values.size() != count * f.components)
+      throw core::DataError(path.string() + ": field '" + f.name + "' has " + str(f.values.size()) +
+                            " values, expected " + str(count * f.components));
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(f.name.c_str());
+    array->SetNumberOfComponents(f.components);
+    array->SetNumberOfTuples(count);
+    std::copy(f.values.data(), f.values.data() + f.values.size(), array->GetPointer(0));
+    cloud->GetPointData()->AddArray(array);
+  }
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  write_xml_atomically(writer, cloud, path);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Field series
 
