@@ -28,7 +28,14 @@ struct PlaceArgs {
   bool quiet = false;
 };
 
+struct FitArgs {
+  std::filesystem::path case_file, out;
+  double hours = 5, required_sm_um = 1.0;
+  bool quick = false, quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int fit_command(const FitArgs& args);
 int place_command(const PlaceArgs& args);
 int probes_command(const ProbesArgs& args);
 int run_command(const RunArgs& args);

@@ -53,6 +53,15 @@ int main(int argc, char** argv) {
   place->add_option("--m-max", place_args.m_max, "largest number of sensors");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
 
+  FitArgs fit_args;
+  auto* fit = cli.add_subcommand("fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
+  fit->add_option("case", fit_args.case_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
+  fit->add_option("--out", fit_args.out, "output directory")->required();
+  fit->add_option("--hours", fit_args.hours, "length of each campaign run (the standard's minimum: 5)");
+  fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it");
+  fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
+  fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
+
   CLI11_PARSE(cli, argc, argv);
   // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
   const char* blas = std::getenv("TT_BLAS_THREADS");
@@ -65,6 +74,7 @@ int main(int argc, char** argv) {
         throw tt::core::CaseError("place: give a case file or --from RUNDIR");
       return place_command(place_args);
     }
+    if (*fit) return fit_command(fit_args);
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

@@ -1,0 +1,207 @@
+// thermotwin fit: how well a thermal-error model fed by m sensors predicts the drift on duty
+// cycles it was not fitted on (DB3401/T 326-2024 metrics S, S_M, S_sigma).
+//   thermotwin fit CASE --out DIR [--hours 5] [--required-sm-um 1] [--quick]
+// Writes fit.json, modelling_record.{json,md}, compensation.csv, sensor_count_<target>.csv and
+// sensor_count_<target>.png, campaign.csv (what each group was).
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include "app/commands.hpp"
+#include "app/study.hpp"
+#include "core/errors.hpp"
+#include "fitting/group.hpp"
+#include "fitting/metrics.hpp"
+#include "fitting/models.hpp"
+#include "fitting/noise.hpp"
+#include "fitting/selection.hpp"
+#include "io/atomic_dir.hpp"
+#include "io/case_reader.hpp"
+#include "io/csv_out.hpp"
+#include "io/fitting_out.hpp"
+#include "io/reports.hpp"
+#include "mesh/mesher.hpp"
+#include "placement/place.hpp"
+#include "solvers/campaign.hpp"
+
+namespace tt::app {
+namespace {
+
+/// Which campaign runs fit, validate and test (by name; runs not listed are not used).
+const std::vector<std::string> kFitting{"p1_extended", "staircase_up", "irregular_a", "warm_start"};
+const std::vector<std::string> kValidation{"staircase_down", "ambient_drift"};
+const std::vector<std::string> kTest{"irregular_b", "run_then_cool", "mixed_speeds"};
+
+fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResult& r) {
+  const Histories h = histories_from_points(spec, r.times, r.point_temperature, r.error);
+  fitting::Group g;
+  g.name = r.name;
+  g.time = h.times;
+  g.temperature = h.temperature;
+  g.error.resize(h.times.size(), 2);
+  g.error.col(0) = h.dy;
+  g.error.col(1) = h.dz;
+  g.sensor_names = h.names;
+  g.target_names = {"dy", "dz"};
+  return g;
+}
+
+std::vector<int> indices_of(const std::vector<fitting::Group>& groups, const std::vector<std::string>& names) {
+  std::vector<int> out;
+  for (const auto& n : names)
+    for (size_t i = 0; i < groups.size(); ++i)
+      if (groups[i].name == n) out.push_back(static_cast<int>(i));
+  return out;
+}
+
+/// Placement on the fitting groups laid end to end (times shifted so they increase).
+placement::PlacementResult placement_on(const std::vector<fitting::Group>& groups, const std::vector<int>& fit,
+                                        const Eigen::MatrixX3d& positions, std::uint64_t seed) {
+  Eigen::Index rows = 0;
+  for (int i : fit) rows += groups[i].time.size();
+  placement::PlacementInput in;
+  const auto& g0 = groups[fit[0]];
+  for (size_t c = 0; c < g0.sensor_names.size(); ++c) in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
+  in.positions_m = positions;
+  in.times_s.resize(rows);
+  in.temperatures_K.resize(rows, g0.temperature.cols());
+  Eigen::VectorXd dy(rows), dz(rows);
+  Eigen::Index r = 0;
+  double offset = 0;
+  for (int i : fit) {
+    const auto& g = groups[i];
+    const Eigen::Index n = g.time.size();
+    in.times_s.segment(r, n) = g.time.array() + offset;
+    in.temperatures_K.middleRows(r, n) = g.temperature;
+    dy.segment(r, n) = g.error.col(0);
+    dz.segment(r, n) = g.error.col(1);
+    offset += g.time(n - 1) + 1.0;
+    r += n;
+  }
+  in.targets = {{"dy", dy}, {"dz", dz}};
+  placement::PlacementOptions options;
+  options.samples = 0;  // every reading of the campaign, not the patent's 100
+  options.seed = seed;
+  return placement::place_all(in, options);
+}
+
+/// Sensor sets per placement method and m for one target, as fitting takes them.
+std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p, int target, int max_m) {
+  std::vector<fitting::SensorSet> sets;
+  for (const auto& s : p.targets[target].selections) {
+    if (s.m > max_m) continue;
+    sets.push_back({std::string(placement::method_name(s.method)), s.columns});
+  }
+  return sets;
+}
+
+/// Mean over groups of the standard deviation of the uncompensated error [m].
+double uncompensated_std(const std::vector<fitting::Group>& groups, const std::vector<int>& which, int target) {
+  double sum = 0;
+  for (int i : which) {
+    const Eigen::VectorXd e = groups[i].error.col(target);
+    sum += fitting::residual_std((e.array() - e.mean()).matrix());
+  }
+  return sum / static_cast<double>(which.size());
+}
+
+}  // namespace
+
+int fit_command(const FitArgs& args) {
+  // 1. The case and its mesh.
+  const core::CaseSpec spec = io::read_case(args.case_file);
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  // 2. The virtual test campaign, with sensor noise on every reading.
+  const auto runs = solvers::campaign_runs(spec, args.hours, spec.seed);
+  const auto results = solvers::simulate_campaign(mesh, spec, runs, [&](double t, double end) {
+    if (!args.quiet) report_progress("campaign", t, end);
+  });
+  std::vector<fitting::Group> groups;
+  for (size_t i = 0; i < results.size(); ++i)
+    groups.push_back(fitting::noisy_group(group_of(spec, results[i]), fitting::SensorNoise{}, spec.seed, i));
+  fitting::Split split{indices_of(groups, kFitting), indices_of(groups, kValidation), indices_of(groups, kTest)};
+  fitting::require_valid_split(split, static_cast<int>(groups.size()));
+  // 3. Placement on the fitting groups only.
+  const Histories first = histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
+  const placement::PlacementResult placed = placement_on(groups, split.fitting, first.positions, spec.seed);
+  // 4. Per target: choose model, settings and placement method on validation; test; count sensors.
+  const std::vector<fitting::ModelSpec> specs =
+      args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}} : fitting::default_model_candidates();
+  std::vector<fitting::Evaluation> evals;
+  std::vector<fitting::SensorCountTable> tables;
+  nlohmann::json summary = nlohmann::json::object();
+  for (int target = 0; target < 2; ++target) {
+    std::vector<fitting::SensorSet> at_most_4 = sensor_sets(placed, target, 4);
+    const auto corr = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, 4);
+    at_most_4.insert(at_most_4.end(), corr.begin(), corr.end());
+    evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
+    std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
+    const auto corr6 = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, 6);
+    all.insert(all.end(), corr6.begin(), corr6.end());
+    tables.push_back(fitting::sensor_count_table(groups, split, target, all, specs, args.required_sm_um * 1e-6));
+    const auto& e = evals.back();
+    const double drift = uncompensated_std(groups, split.test, target);
+    const auto& chosen = e.sensor_sets[e.selection.candidates[e.selection.best].sensor_set];
+    std::vector<std::string> names;
+    for (int c : chosen.sensors) names.push_back(groups[0].sensor_names[c]);
+    summary[groups[0].target_names[target]] = {{"method", chosen.method},
+                                               {"sensors", names},
+                                               {"model", fitting::model_label(e.model.spec)},
+                                               {"test_sm_um", e.test.sm * 1e6},
+                                               {"test_s_sigma_um", e.test.s_sigma * 1e6},
+                                               {"uncompensated_std_um", drift * 1e6},
+                                               {"test_sm_over_uncompensated", e.test.sm / drift}};
+  }
+  // 5. Outputs, all or nothing.
+  io::OutputDir out(args.out);
+  const auto& dir = out.path();
+  io::write_fit_json(dir / "fit.json", evals, tables);
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "fit.json"));
+  doc["summary"] = summary;
+  doc["campaign"] = nlohmann::json::array();
+  for (const auto& r : runs)
+    doc["campaign"].push_back({{"name", r.name}, {"shape", r.shape}, {"hours", r.spec.duty_cycle.end / 3600.0},
+                               {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
+  io::write_json(dir / "fit.json", doc);
+  io::ModellingConditions conditions;
+  conditions.machine_model = spec.machine.empty() ? spec.name : spec.machine;
+  conditions.machine_number = "virtual";
+  conditions.modelling_date = "2026-11-21";
+  conditions.initial_ambient_temperature = spec.thermal.initial_temperature_c + 273.15;
+  double max_speed = 0;
+  for (const auto& r : runs)
+    for (const auto& s : r.spec.duty_cycle.segments) max_speed = std::max(max_speed, s.speed_rpm);
+  conditions.max_spindle_speed = max_speed * 2 * 3.14159265358979323846 / 60;
+  io::write_modelling_record(dir / "modelling_record.json", dir / "modelling_record.md", conditions, evals);
+  std::vector<fitting::FittedModel> models;
+  for (const auto& e : evals) models.push_back(e.model);
+  io::write_compensation_csv(dir / "compensation.csv", models, groups);
+  for (const auto& t : tables) {
+    std::set<std::string> methods;
+    for (const auto& row : t.rows) methods.insert(row.method);
+    std::vector<std::string> header{"m"};
+    for (const auto& m : methods) header.push_back(m + "_test_sm_um");
+    int max_m = 0;
+    for (const auto& row : t.rows) max_m = std::max(max_m, row.m);
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Constant(max_m, static_cast<Eigen::Index>(header.size()), std::nan(""));
+    for (int m = 1; m <= max_m; ++m) rows(m - 1, 0) = m;
+    for (const auto& row : t.rows) {
+      const auto col = 1 + std::distance(methods.begin(), methods.find(row.method));
+      rows(row.m - 1, col) = row.test_sm * 1e6;
+    }
+    const std::string stem = "sensor_count_" + t.target_name;
+    io::write_csv(dir / (stem + ".csv"), header, rows);
+    std::string cols;
+    for (size_t i = 1; i < header.size(); ++i) cols += (i > 1 ? "," : "") + header[i];
+    plot({"lines", (dir / (stem + ".csv")).string(), (dir / (stem + ".png")).string(), "--x", "m", "--columns",
+          cols, "--xlabel", "sensors m", "--ylabel", "test S_M [um]", "--title",
+          "test accuracy by number of sensors, target " + t.target_name});
+  }
+  out.commit();
+  std::cerr << "thermotwin: fit: " << summary.dump() << "\n";
+  return 0;
+}
+
+}  // namespace tt::app
