@@ -54,12 +54,10 @@ std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(con
           for (int i = 0; i < 3 * N; ++i)
             for (int j = 0; j < 3 * N; ++j)
               out.first.emplace_back(3 * m.tets(ti, i / 3) + i % 3, 3 * m.tets(ti, j / 3) + j % 3, ke(i, j));
-          for (int j = 0; j < N; ++j) {
-            Eigen::Matrix<double, N, 1> unit = Eigen::Matrix<double, N, 1>::Zero();
-            unit(j) = 1.0;
-            const auto g = k::thermal_load(x, mat, unit, 0.0, ti);
-            for (int i = 0; i < 3 * N; ++i) out.second.emplace_back(3 * m.tets(ti, i / 3) + i % 3, m.tets(ti, j), g(i));
-          }
+          const auto g = k::thermal_coupling_matrix(x, mat, ti);
+          for (int j = 0; j < N; ++j)
+            for (int i = 0; i < 3 * N; ++i)
+              out.second.emplace_back(3 * m.tets(ti, i / 3) + i % 3, m.tets(ti, j), g(i, j));
         }
         return out;
       });

@@ -315,9 +315,19 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
   hist.timings.solve_s = seconds_since(t_solve) - hist.timings.factor_s;
   hist.energy.stored = stored_heat_total<N>(m, spec, temp, t0_k);
   hist.energy.heat_in_law = heat_delivered(spec);
-  for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j)
-    if (!spec.thermal.fluxes[j].follows_speed)
-      hist.energy.heat_in_law += spec.thermal.fluxes[j].flux * ops.flux_area[j].sum() * end;
+  const auto& segs = spec.duty_cycle.segments;
+  for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {
+    const auto& fl = spec.thermal.fluxes[j];
+    double seconds = end;  // flux-weighted time: n / n_ref over the cycle for a speed-following flux
+    if (fl.follows_speed) {
+      seconds = 0;
+      for (size_t i = 0; i < segs.size(); ++i) {
+        const double b = i + 1 < segs.size() ? segs[i + 1].start : end;
+        seconds += segs[i].speed_rpm / fl.ref_speed_rpm * (b - segs[i].start);
+      }
+    }
+    hist.energy.heat_in_law += fl.flux * ops.flux_area[j].sum() * seconds;
+  }
   return hist;
 }
 

@@ -136,8 +136,6 @@ TEST(ThermalEnergy, SpeedFollowingFluxEntersTheBalance) {
 }
 
 TEST(ThermalEnergy, SpeedFollowingFluxCountsInTheLaw) {
-  GTEST_SKIP() << "solvers/thermal.cpp:318-320 adds only fluxes with follows_speed = false to "
-                  "heat_in_law, so a speed-following flux is missing from it (2500 J here)";
   EnergyCase c;
   c.fluxes = kSpeedFlux;
   const Solution run = run_case(case_of(c.toml()));

@@ -1,0 +1,58 @@
+// Measured runs in the exchange format of docs/measured-data.md (meta.json + data.csv): read with
+// every rejection the format lists, and written (the generator of test data uses the writer).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tt::io {
+
+struct MeasuredSensor {
+  std::string id;
+  std::optional<Eigen::Vector3d> position;  /// [m], absent when null
+};
+
+struct MeasuredProbe {
+  std::string id;
+  std::optional<Eigen::Vector3d> point;      /// [m]
+  std::optional<Eigen::Vector3d> direction;  /// unit vector
+};
+
+struct MeasuredRun {
+  std::filesystem::path folder;
+  std::string machine;  /// "SB-1" means docs/SB-1-spindle-box.md
+  std::string run;
+  std::vector<MeasuredSensor> sensors;
+  std::vector<MeasuredProbe> displacements;
+  std::vector<std::string> inputs;           /// e.g. "speed_rpm"
+  std::optional<std::string> ambient_sensor; /// id of one of `sensors`
+  std::optional<double> initial_temperature_c, nominal_ambient_c;  /// [degC]
+  Eigen::VectorXd time;           /// #samples [s], strictly increasing
+  Eigen::MatrixXd input_values;   /// #samples x #inputs (speeds in rpm)
+  Eigen::MatrixXd temperature;    /// #samples x #sensors [K]; NaN where the reading is missing
+  Eigen::MatrixXd displacement;   /// #samples x #probes [m]; NaN where the reading is missing
+  nlohmann::json meta;            /// the whole meta.json, keys not interpreted carried along
+};
+
+struct MeasuredReadLimits {
+  std::optional<Eigen::AlignedBox3d> machine_box;  /// positions must lie inside (known machine)
+  std::size_t max_bytes = std::size_t(2) << 30;    /// data.csv larger than this is rejected
+  std::size_t max_rows = 50'000'000;               /// more rows than this are rejected
+};
+
+/// Reads folder/meta.json and folder/data.csv. Throws DataError naming the file, the line and the
+/// column (or the JSON key) for: a missing, duplicated or unknown column, a time that does not
+/// increase, text or a non-finite number in a number cell, a position outside the machine's box,
+/// an unknown unit or format; IoError when a file cannot be read. Empty cells stay NaN.
+MeasuredRun read_measured_run(const std::filesystem::path& folder, const MeasuredReadLimits& limits = {});
+
+/// Writes a run in the same format (folder created; files via temporary names).
+void write_measured_run(const std::filesystem::path& folder, const MeasuredRun& run);
+
+}  // namespace tt::io
