@@ -7,9 +7,11 @@
 #include <Eigen/Geometry>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "mesh/cgal/surface_body.hpp"
 
 namespace tt::mesh {
 namespace {
@@ -330,6 +332,74 @@ std::vector<double> merged_breakpoints(std::vector<ZValue> values, double tol) {
   return out;
 }
 
+core::GeometryError outside_every_body(const core::CaseSpec& spec, const core::NamedPoint& pt) {
+  std::ostringstream msg;
+  msg << spec.source.string() << ": points.list '" << pt.id << "' at (" << pt.position.x() << ", "
+      << pt.position.y() << ", " << pt.position.z()
+      << ") m is outside every body. Hint: check its coordinates and the length unit.";
+  return core::GeometryError(msg.str());
+}
+
+/// Axis-aligned bounds of a z-extruded primitive, circles taken at their nominal radius.
+Eigen::AlignedBox3d primitive_bounds(const Primitive& p) {
+  if (p.kind == Primitive::Kind::box) return Eigen::AlignedBox3d(p.min, p.max);
+  const double r = p.radius;
+  return Eigen::AlignedBox3d(Vector3d(p.axis.x() - r, p.axis.y() - r, p.z_min),
+                             Vector3d(p.axis.x() + r, p.axis.y() + r, p.z_max));
+}
+
+/// The closed, outward-oriented surface of a box or of a faceted cylinder or annulus: the same
+/// facets the extrusion meshes, for testing surface-file bodies against it.
+cgal::TriangleSurface primitive_surface(const Primitive& p, int n) {
+  const auto [outer, inner] = primitive_rings(p, n);
+  const auto [z0, z1] = z_range(p);
+  cgal::TriangleSurface s;
+  auto ring_at = [&](const Ring& ring, double z) {
+    const int first = static_cast<int>(s.vertices.size());
+    for (const auto& q : ring) s.vertices.emplace_back(q.x(), q.y(), z);
+    return first;
+  };
+  auto walls = [&](int bottom, int top, int count, bool outward) {
+    for (int a = 0; a < count; ++a) {
+      const int b = (a + 1) % count;
+      if (outward) {
+        s.triangles.push_back({bottom + a, bottom + b, top + b});
+        s.triangles.push_back({bottom + a, top + b, top + a});
+      } else {
+        s.triangles.push_back({bottom + a, top + b, bottom + b});
+        s.triangles.push_back({bottom + a, top + a, top + b});
+      }
+    }
+  };
+  const int m = static_cast<int>(outer.size());
+  const int o0 = ring_at(outer, z0), o1 = ring_at(outer, z1);
+  walls(o0, o1, m, true);
+  if (inner.empty()) {
+    Vector2d c = Vector2d::Zero();
+    for (const auto& q : outer) c += q / m;
+    const int c0 = static_cast<int>(s.vertices.size());
+    s.vertices.emplace_back(c.x(), c.y(), z0);
+    s.vertices.emplace_back(c.x(), c.y(), z1);
+    for (int a = 0; a < m; ++a) {
+      const int b = (a + 1) % m;
+      s.triangles.push_back({c0, o0 + b, o0 + a});
+      s.triangles.push_back({c0 + 1, o1 + a, o1 + b});
+    }
+  } else {
+    // Inner and outer rings of an annulus share their angles, so each cap is a ring of quads.
+    const int i0 = ring_at(inner, z0), i1 = ring_at(inner, z1);
+    walls(i0, i1, m, false);
+    for (int a = 0; a < m; ++a) {
+      const int b = (a + 1) % m;
+      s.triangles.push_back({o1 + a, o1 + b, i1 + b});
+      s.triangles.push_back({o1 + a, i1 + b, i1 + a});
+      s.triangles.push_back({o0 + a, i0 + b, o0 + b});
+      s.triangles.push_back({o0 + a, i0 + a, i0 + b});
+    }
+  }
+  return s;
+}
+
 }  // namespace
 
 double faceted_radius(double r, int n) {
@@ -352,6 +422,10 @@ bool body_contains(const Body& body, const Vector3d& p, int circle_segments) {
 }
 
 double exact_body_volume(const Body& body) {
+  if (body.add.size() == 1 && body.subtract.empty() &&
+      body.add[0].kind == Primitive::Kind::surface_file)
+    return cgal::surface_solid(body.add[0].file, body.add[0].file_scale, "body '" + body.name + "'")
+        .volume;
   auto volume = [](const Primitive& p) {
     switch (p.kind) {
       case Primitive::Kind::box: return (p.max - p.min).prod();
@@ -361,30 +435,29 @@ double exact_body_volume(const Body& body) {
       default: return -1.0;
     }
   };
-  auto bounds = [](const Primitive& p) {
-    Eigen::AlignedBox3d b;
-    if (p.kind == Primitive::Kind::box) return Eigen::AlignedBox3d(p.min, p.max);
-    const double r = p.radius;
-    return Eigen::AlignedBox3d(Vector3d(p.axis.x() - r, p.axis.y() - r, p.z_min),
-                               Vector3d(p.axis.x() + r, p.axis.y() + r, p.z_max));
-  };
+
   if (body.add.size() != 1) return -1;
   double v = volume(body.add[0]);
   if (v < 0) return -1;
-  const auto outer = bounds(body.add[0]);
+  const auto outer = primitive_bounds(body.add[0]);
   for (size_t i = 0; i < body.subtract.size(); ++i) {
     const auto& s = body.subtract[i];
     if (body.add[0].kind != Primitive::Kind::box || s.kind == Primitive::Kind::surface_file)
       return -1;
-    if (!outer.contains(bounds(s))) return -1;
+    if (!outer.contains(primitive_bounds(s))) return -1;
     for (size_t j = 0; j < i; ++j)
-      if (!bounds(s).intersection(bounds(body.subtract[j])).isEmpty()) return -1;
+      if (!primitive_bounds(s).intersection(primitive_bounds(body.subtract[j])).isEmpty()) return -1;
     v -= volume(s);
   }
   return v;
 }
 
-ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
+namespace {
+
+/// The PLC of z-extruded bodies only. `is_free` says whether a point of empty space lies outside
+/// every surface-file body, so that no hole point falls inside one.
+ExtrudedPlc extruded_part(const core::CaseSpec& spec,
+                          const std::function<bool(const Vector3d&)>& is_free) {
   const int n = spec.mesh.circle_segments;
   // 1. Extent and tolerance.
   Eigen::AlignedBox3d extent;
@@ -512,13 +585,36 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
     }
   }
 
-  // 6. Regions and holes, one point per cell.
+  // 6. Regions and holes, one point per cell; hole points stay out of surface-file bodies.
+  auto free_in_slab = [&](const Vector2d& q, int j) -> std::optional<Vector3d> {
+    for (double s : {0.5, 0.25, 0.75, 0.1, 0.9, 0.02, 0.98}) {
+      const Vector3d p(q.x(), q.y(), z[j] + s * (z[j + 1] - z[j]));
+      if (is_free(p)) return p;
+    }
+    return std::nullopt;
+  };
+  auto hole_point = [&](int f, int j) {
+    if (const auto p = free_in_slab(rep[f], j)) return *p;
+    try {
+      const Vector2d q = point_beside(g, arr.faces[f].outer, +1, [&](const Vector2d& c) {
+        return face_contains(g, arr.faces[f], c) && free_in_slab(c, j).has_value();
+      });
+      return *free_in_slab(q, j);
+    } catch (const core::GeometryError&) {
+      std::ostringstream msg;
+      msg << spec.source.string() << ": a surface-file body fills the empty space near ("
+          << rep[f].x() << ", " << rep[f].y() << ", " << 0.5 * (z[j] + z[j + 1])
+          << ") m so closely that no point of that space is left to mark it empty. Hint: leave "
+             "a clear gap around surface-file bodies.";
+      throw core::GeometryError(msg.str());
+    }
+  };
   for (int f = 0; f < nf; ++f) {
     for (int j = 0; j < nslab; ++j) {
       const Vector3d p(rep[f].x(), rep[f].y(), 0.5 * (z[j] + z[j + 1]));
       const int b = label[f][j];
       if (b < 0) {
-        plc.holes.push_back(p);
+        plc.holes.push_back(hole_point(f, j));
       } else {
         const double h = spec.bodies[b].max_edge;
         plc.regions.push_back(PlcRegion{p, b, h * h * h / (6.0 * std::sqrt(2.0))});
@@ -542,14 +638,288 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
     }
     bool inside = false;
     for (const auto& b : spec.bodies) inside = inside || body_contains(b, pt.position, n);
-    if (!inside) {
-      std::ostringstream msg;
-      msg << spec.source.string() << ": points.list '" << pt.id << "' at (" << pt.position.x()
-          << ", " << pt.position.y() << ", " << pt.position.z()
-          << ") m is outside every body. Hint: check its coordinates and the length unit.";
-      throw core::GeometryError(msg.str());
-    }
+    if (!inside) throw outside_every_body(spec, pt);
     plc.interior_points.push_back(pt.position);
+  }
+  return result;
+}
+
+bool is_surface_body(const Body& body) {
+  for (const auto* list : {&body.add, &body.subtract})
+    for (const auto& p : *list)
+      if (p.kind == Primitive::Kind::surface_file) return true;
+  return false;
+}
+
+/// A surface-file body read and checked, with its bounds.
+struct SurfaceBody {
+  int body = -1;  /// index into CaseSpec::bodies
+  cgal::SurfaceSolid solid;
+  Eigen::AlignedBox3d bounds;
+};
+
+SurfaceBody surface_body(const core::CaseSpec& spec, int index) {
+  const Body& body = spec.bodies[index];
+  if (body.add.size() != 1 || !body.subtract.empty() ||
+      body.add[0].kind != Primitive::Kind::surface_file) {
+    std::ostringstream msg;
+    msg << spec.source.string() << ": body '" << body.name << "' uses a surface file but has "
+        << body.add.size() << " add and " << body.subtract.size()
+        << " subtract entries; a surface-file body is exactly one add entry, the surface, and "
+           "nothing else. Hint: give the boxes and cylinders a body of their own, or build the "
+           "whole solid in the CAD tool.";
+    throw core::GeometryError(msg.str());
+  }
+  const Primitive& p = body.add[0];
+  SurfaceBody s{index, cgal::surface_solid(p.file, p.file_scale, "body '" + body.name + "'"), {}};
+  for (const auto& v : s.solid.surface.vertices) s.bounds.extend(v);
+  return s;
+}
+
+/// Puts vertex v, lying on the segment a-b, into the ring of `facet` that has that edge (in either
+/// direction, perhaps already split by earlier points), ordered along it.
+void insert_on_edge(PlcFacet& facet, int a, int b, int v, const std::vector<Vector3d>& x) {
+  auto between = [&](int w) {
+    const Vector3d ab = x[b] - x[a];
+    return (x[w] - x[a]).cross(ab).norm() <= 1e-9 * ab.squaredNorm();
+  };
+  for (auto& ring : facet.polygons)
+    for (const auto& [from, to] : {std::pair{a, b}, std::pair{b, a}}) {
+      const auto it = std::find(ring.begin(), ring.end(), from);
+      if (ring.size() < 3 || it == ring.end()) continue;
+      std::vector<int> r = ring;
+      std::rotate(r.begin(), r.begin() + (it - ring.begin()), r.end());
+      size_t k = 1;
+      while (k < r.size() && r[k] != to && between(r[k])) ++k;
+      if (k == r.size() || r[k] != to) continue;
+      size_t j = 1;
+      while (j < k && (x[r[j]] - x[from]).norm() < (x[v] - x[from]).norm()) ++j;
+      r.insert(r.begin() + static_cast<std::ptrdiff_t>(j), v);
+      ring = r;
+      return;
+    }
+}
+
+/// Edge-connected coplanar triangles of a surface body, handed to TetGen as one facet: separate
+/// coplanar triangle facets let its refinement leave zero-volume tets along their shared edges.
+struct Patch {
+  std::vector<int> triangles;
+  std::vector<std::vector<int>> polygons;  /// its boundary ring, or its triangles when not one ring
+};
+
+std::vector<Patch> planar_patches(const cgal::TriangleSurface& s, double tol, std::vector<int>& patch_of) {
+  const auto& x = s.vertices;
+  const auto& tri = s.triangles;
+  const int nt = static_cast<int>(tri.size());
+  std::vector<Vector3d> normal(nt);
+  std::map<std::pair<int, int>, int> edge_triangle;  // directed edge -> triangle
+  for (int t = 0; t < nt; ++t) {
+    normal[t] = (x[tri[t][1]] - x[tri[t][0]]).cross(x[tri[t][2]] - x[tri[t][0]]).normalized();
+    for (int k = 0; k < 3; ++k) edge_triangle[{tri[t][k], tri[t][(k + 1) % 3]}] = t;
+  }
+  std::vector<int> root(nt);
+  std::iota(root.begin(), root.end(), 0);
+  std::function<int(int)> find = [&](int t) { return root[t] == t ? t : root[t] = find(root[t]); };
+  for (int t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int u = edge_triangle.at({tri[t][(k + 1) % 3], tri[t][k]});
+      bool flat = normal[t].dot(normal[u]) > 1 - 1e-12;
+      for (int c : tri[u]) flat = flat && std::abs(normal[t].dot(x[c] - x[tri[t][0]])) <= tol;
+      if (flat) root[find(t)] = find(u);
+    }
+  std::vector<Patch> patches;
+  std::map<int, int> patch_of_root;
+  patch_of.assign(nt, -1);
+  for (int t = 0; t < nt; ++t) {
+    const auto [it, fresh] = patch_of_root.emplace(find(t), static_cast<int>(patches.size()));
+    if (fresh) patches.emplace_back();
+    patches[it->second].triangles.push_back(t);
+    patch_of[t] = it->second;
+  }
+  for (auto& p : patches) {
+    std::map<int, int> next;  // boundary edges of the patch, vertex -> vertex
+    bool simple = true;
+    for (int t : p.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const int a = tri[t][k], b = tri[t][(k + 1) % 3];
+        if (patch_of[edge_triangle.at({b, a})] == patch_of[t]) continue;
+        simple = simple && next.emplace(a, b).second;
+      }
+    std::vector<int> ring;
+    if (simple && !next.empty()) {
+      int v = next.begin()->first;
+      do {
+        ring.push_back(v);
+        v = next[v];
+      } while (v != ring.front() && ring.size() <= next.size());
+      simple = v == ring.front() && ring.size() == next.size();
+    }
+    if (simple) {
+      p.polygons.push_back(ring);
+    } else {
+      for (int t : p.triangles) p.polygons.push_back({tri[t][0], tri[t][1], tri[t][2]});
+    }
+  }
+  return patches;
+}
+
+std::string overlap_message(const core::CaseSpec& spec, const SurfaceBody& s, int other) {
+  return spec.source.string() + ": body '" + spec.bodies[s.body].name + "' (" +
+         spec.bodies[s.body].add[0].file.string() + ") overlaps or touches body '" +
+         spec.bodies[other].name +
+         "'. A surface-file body must stand clear of every other body, or lie strictly inside a "
+         "subtracted primitive of it; bonded contact with it is not supported. Hint: leave a gap.";
+}
+
+/// Throws unless every surface-file body is clear of the other bodies (see overlap_message).
+void check_surface_bodies_clear(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces) {
+  const int n = spec.mesh.circle_segments;
+  for (size_t i = 0; i < surfaces.size(); ++i)
+    for (size_t j = i + 1; j < surfaces.size(); ++j)
+      if (surfaces[i].bounds.intersects(surfaces[j].bounds) &&
+          cgal::solids_meet(surfaces[i].solid.surface, surfaces[j].solid.surface))
+        throw core::GeometryError(overlap_message(spec, surfaces[i], surfaces[j].body));
+  for (const auto& s : surfaces) {
+    for (size_t b = 0; b < spec.bodies.size(); ++b) {
+      if (is_surface_body(spec.bodies[b])) continue;
+      for (const auto& a : spec.bodies[b].add) {
+        if (!primitive_bounds(a).intersects(s.bounds) ||
+            !cgal::solids_meet(s.solid.surface, primitive_surface(a, n)))
+          continue;
+        bool carved_out = false;
+        for (const auto& u : spec.bodies[b].subtract)
+          carved_out = carved_out || (primitive_bounds(u).contains(s.bounds) &&
+                                      cgal::solid_strictly_inside(s.solid.surface,
+                                                                  primitive_surface(u, n)));
+        if (!carved_out) throw core::GeometryError(overlap_message(spec, s, static_cast<int>(b)));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
+  // 1. Surface-file bodies are read and checked; the others go to the extrusion.
+  std::vector<SurfaceBody> surfaces;
+  for (size_t b = 0; b < spec.bodies.size(); ++b)
+    if (is_surface_body(spec.bodies[b])) surfaces.push_back(surface_body(spec, static_cast<int>(b)));
+  if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
+  check_surface_bodies_clear(spec, surfaces);
+
+  // 2. Named points on or in a surface body belong to it; the others to the extrusion.
+  Eigen::AlignedBox3d extent;
+  for (const auto& s : surfaces) extent.extend(s.bounds);
+  for (const auto& b : spec.bodies)
+    if (!is_surface_body(b))
+      for (const auto& p : b.add) extent.extend(primitive_bounds(p));
+  const double tol = 1e-9 * extent.diagonal().norm();
+  std::vector<Vector3d> positions;
+  for (const auto& p : spec.points) positions.push_back(p.position);
+  using Kind = cgal::PointLocation::Kind;
+  std::vector<int> point_surface(spec.points.size(), -1);
+  std::vector<cgal::PointLocation> location(spec.points.size());
+  for (size_t s = 0; s < surfaces.size(); ++s) {
+    const auto located = cgal::locate_points(surfaces[s].solid.surface, positions, tol);
+    for (size_t i = 0; i < located.size(); ++i)
+      if (point_surface[i] < 0 && located[i].kind != Kind::outside)
+        point_surface[i] = static_cast<int>(s), location[i] = located[i];
+  }
+  core::CaseSpec extruded = spec;
+  extruded.bodies.clear();
+  extruded.points.clear();
+  std::vector<int> extruded_body, extruded_point;  // reduced index -> index in spec
+  for (size_t b = 0; b < spec.bodies.size(); ++b)
+    if (!is_surface_body(spec.bodies[b])) {
+      extruded.bodies.push_back(spec.bodies[b]);
+      extruded_body.push_back(static_cast<int>(b));
+    }
+  for (size_t i = 0; i < spec.points.size(); ++i)
+    if (point_surface[i] < 0) {
+      extruded.points.push_back(spec.points[i]);
+      extruded_point.push_back(static_cast<int>(i));
+    }
+
+  // 3. The extruded bodies, with body and point indices mapped back to the whole case.
+  ExtrudedPlc result;
+  result.point_vertex.assign(spec.points.size(), -1);
+  if (!extruded.bodies.empty()) {
+    auto is_free = [&](const Vector3d& p) {
+      for (const auto& s : surfaces)
+        if (s.bounds.contains(p) &&
+            cgal::locate_points(s.solid.surface, {p}, 0.0)[0].kind != Kind::outside)
+          return false;
+      return true;
+    };
+    ExtrudedPlc part = extruded_part(extruded, is_free);
+    for (auto& r : part.plc.regions) r.region = extruded_body[r.region];
+    for (size_t i = 0; i < extruded_point.size(); ++i)
+      result.point_vertex[extruded_point[i]] = part.point_vertex[i];
+    result.plc = std::move(part.plc);
+  } else if (!extruded.points.empty()) {
+    throw outside_every_body(spec, extruded.points.front());
+  }
+
+  // 4. Each surface body: its triangles as facets, a region point, and its named points.
+  Plc& plc = result.plc;
+  for (size_t s = 0; s < surfaces.size(); ++s) {
+    const cgal::SurfaceSolid& solid = surfaces[s].solid;
+    const int first = static_cast<int>(plc.vertices.size());
+    plc.vertices.insert(plc.vertices.end(), solid.surface.vertices.begin(),
+                        solid.surface.vertices.end());
+    const size_t first_facet = plc.facets.size();
+    std::vector<int> patch_of;
+    for (const auto& patch : planar_patches(solid.surface, tol, patch_of)) {
+      PlcFacet facet;
+      for (const auto& ring : patch.polygons) {
+        facet.polygons.emplace_back();
+        for (int v : ring) facet.polygons.back().push_back(first + v);
+      }
+      plc.facets.push_back(std::move(facet));
+    }
+    for (size_t i = 0; i < spec.points.size(); ++i) {
+      if (point_surface[i] != static_cast<int>(s)) continue;
+      const Vector3d& x = spec.points[i].position;
+      switch (location[i].kind) {
+        case Kind::vertex:  // moved by at most tol so that the point is exact
+          result.point_vertex[i] = first + location[i].index;
+          plc.vertices[result.point_vertex[i]] = x;
+          break;
+        case Kind::triangle: {
+          const int v = static_cast<int>(plc.vertices.size());
+          plc.vertices.push_back(x);
+          result.point_vertex[i] = v;
+          // On an edge between two patches the point joins both facets' rings (TetGen crashes on a
+          // lone vertex on a facet's boundary); inside a patch it is a lone vertex of its facet.
+          const auto& tri = solid.surface.triangles[location[i].index];
+          const int own = patch_of[location[i].index];
+          bool on_crease = false;
+          for (int k = 0; k < 3 && !on_crease; ++k) {
+            const int a = tri[k], b = tri[(k + 1) % 3];
+            const Vector3d& xa = solid.surface.vertices[a];
+            const Vector3d& xb = solid.surface.vertices[b];
+            const double t = std::clamp((x - xa).dot(xb - xa) / (xb - xa).squaredNorm(), 0.0, 1.0);
+            if ((xa + t * (xb - xa) - x).norm() > tol) continue;
+            for (size_t f = 0; f < solid.surface.triangles.size(); ++f) {
+              const auto& u = solid.surface.triangles[f];
+              for (int e = 0; e < 3; ++e)
+                if (u[e] == b && u[(e + 1) % 3] == a && patch_of[f] != own) {
+                  on_crease = true;
+                  insert_on_edge(plc.facets[first_facet + own], first + a, first + b, v, plc.vertices);
+                  insert_on_edge(plc.facets[first_facet + patch_of[f]], first + a, first + b, v,
+                                 plc.vertices);
+                }
+            }
+          }
+          if (!on_crease) plc.facets[first_facet + own].polygons.push_back({v});
+          break;
+        }
+        case Kind::inside: plc.interior_points.push_back(x); break;
+        case Kind::outside: break;
+      }
+    }
+    const double h = spec.bodies[surfaces[s].body].max_edge;
+    plc.regions.push_back(PlcRegion{solid.inside_point, surfaces[s].body, h * h * h / (6.0 * std::sqrt(2.0))});
   }
   return result;
 }

@@ -14,7 +14,7 @@ namespace tt::mesh {
 struct BodyReport {
   std::string name;
   double volume = 0;         /// meshed volume [m^3]
-  double exact_volume = -1;  /// analytic volume of the primitive, -1 when not available [m^3]
+  double exact_volume = -1;  /// analytic (or closed-surface) volume, -1 when not available [m^3]
 };
 
 struct MeshReport {
