@@ -30,7 +30,9 @@ struct Rollers {
 
 /// The mesh with one named point per node on a roller plane, and the spec's point supports on
 /// them (an anchor support at the origin lets the case file itself pass the reader's check).
-Rollers roller_block(int order) {
+/// Rollers on x = 0 and x = lx (in x) and z = 0 (in z); on y = 0 (in y) when `y_rollers`, else
+/// only the origin is held in y.
+Rollers roller_block(int order, bool y_rollers = true) {
   BoxCase c;
   c.materials = {{"stiff", kE1, kNu, kAlpha}, {"soft", kE2, kNu, kAlpha}};
   const double yi = 0.5 * kSize.y();
@@ -43,11 +45,12 @@ Rollers roller_block(int order) {
   Rollers r{mesh::TetMesh{}, spec_of(c)};
   r.mesh = mesh::mesh_case(r.spec);
   r.spec.mechanical.point_supports.clear();
+  if (!y_rollers) r.spec.mechanical.point_supports.push_back({"O", {false, true, false}});
   const double tol = 1e-9;
   for (Eigen::Index i = 0; i < r.mesh.nodes.rows(); ++i) {
     const Eigen::Vector3d x = r.mesh.nodes.row(i).transpose();
     const std::array<bool, 3> held = {std::abs(x.x()) < tol || std::abs(x.x() - kSize.x()) < tol,
-                                      std::abs(x.y()) < tol, std::abs(x.z()) < tol};
+                                      y_rollers && std::abs(x.y()) < tol, std::abs(x.z()) < tol};
     if (!held[0] && !held[1] && !held[2]) continue;
     const std::string id = "roller" + std::to_string(i);
     r.mesh.points.push_back(mesh::NamedNode{id, x, static_cast<int>(i)});
@@ -93,6 +96,46 @@ TEST_P(Patch, RollerBlockReproducesConstantStrainExactly) {
   EXPECT_LT(err, 1e-10);
   EXPECT_LT(stress_err, 1e-9);
   EXPECT_GT(inside, 0);
+}
+
+// A linear stress field: the same rollers but y held only at the origin, and dT = a + b y. Then
+//   u = (0, (1 + nu) alpha (a y + b y^2 / 2 - b z^2 / 2), (1 + nu) alpha (a + b y) z),
+//   sigma_xx = -E_i alpha (a + b y), others 0
+// (eps_yz = 0 because the z^2 term cancels d u_z / dy; the y faces are free). The displacement
+// is quadratic, so tet10 is exact, and the nodal von Mises E_i alpha |a + b y| varies along y:
+// a stress evaluated at the wrong natural point of a node (e.g. a mid-edge node mixed up) or with
+// the wrong element temperature shows here, where the constant-stress tests above cannot see it.
+TEST(LinearStressPatch, RollerBlockWithLinearTemperatureIsExactOnTet10) {
+  const Rollers r = roller_block(2, false);
+  const double tref = r.spec.mechanical.reference_temperature_c, a = 10.0, b = 750.0;  // K, K/m
+  const Eigen::VectorXd temp =
+      nodal_temperature_k(r.mesh, [&](const Eigen::Vector3d& x) { return tref + a + b * x.y(); });
+  const Eigen::VectorXd u = solvers::elastic_history(r.mesh, r.spec, temp).displacement.col(0);
+
+  const double g = (1 + kNu) * kAlpha;
+  Eigen::VectorXd exact(u.size());
+  for (Eigen::Index i = 0; i < r.mesh.nodes.rows(); ++i) {
+    const double y = r.mesh.nodes(i, 1), z = r.mesh.nodes(i, 2);
+    exact.segment<3>(3 * i) =
+        Eigen::Vector3d(0, g * (a * y + 0.5 * b * (y * y - z * z)), g * (a + b * y) * z);
+  }
+  const double err = max_relative_error(u, exact);
+  const Eigen::VectorXd vm = solvers::von_mises_nodal(r.mesh, r.spec, u, temp);
+  const double yi = 0.5 * kSize.y();
+  double stress_err = 0;
+  for (Eigen::Index i = 0; i < r.mesh.nodes.rows(); ++i) {
+    const double y = r.mesh.nodes(i, 1);
+    if (std::abs(y - yi) < 1e-9) continue;
+    const double expected = (y < yi ? kE1 : kE2) * kAlpha * (a + b * y);
+    stress_err =
+        std::max(stress_err, std::abs(vm(i) - expected) / (kE1 * kAlpha * (a + b * kSize.y())));
+  }
+  std::printf(
+      "[patch] linear stress, tet10: %ld nodes, displacement error %.2e, max |von Mises "
+      "- E_i alpha dT(y)| / max = %.2e\n",
+      static_cast<long>(r.mesh.nodes.rows()), err, stress_err);
+  EXPECT_LT(err, 1e-10);
+  EXPECT_LT(stress_err, 1e-9);
 }
 
 INSTANTIATE_TEST_SUITE_P(Orders, Patch, ::testing::Values(1, 2),
