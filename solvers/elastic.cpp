@@ -179,6 +179,10 @@ ElasticModel::~ElasticModel() = default;
 ElasticModel::ElasticModel(ElasticModel&&) noexcept = default;
 
 Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) const {
+  if (temperature.rows() != impl_->coupling.cols())
+    throw core::SolverError("temperature fields have " + std::to_string(temperature.rows()) +
+                            " rows, expected one per mesh node (" + std::to_string(impl_->coupling.cols()) +
+                            "). Hint: on a 10-node mesh give mid-edge nodes too.");
   const Eigen::MatrixXd load = impl_->coupling * (temperature.array() - reference_k_).matrix();
   const int ndof = static_cast<int>(load.rows());
   Eigen::MatrixXd rhs(impl_->free_dofs, load.cols());
@@ -192,6 +196,10 @@ Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) 
 }
 
 Eigen::VectorXd ElasticModel::influence(int node, int direction) const {
+  if (node < 0 || node >= impl_->coupling.cols() || direction < 0 || direction > 2)
+    throw core::SolverError("influence at node " + std::to_string(node) + ", direction " +
+                            std::to_string(direction) + ": expected 0 <= node < " +
+                            std::to_string(impl_->coupling.cols()) + " and direction 0, 1 or 2");
   const int dof = 3 * node + direction;
   const int n = static_cast<int>(impl_->coupling.cols());
   if (impl_->free_index[dof] < 0) return Eigen::VectorXd::Zero(n);
@@ -218,10 +226,17 @@ ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spe
 
 Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& u,
                                 const Eigen::VectorXd& temp) {
+  if (u.size() != 3 * m.nodes.rows() || temp.size() != m.nodes.rows())
+    throw core::SolverError("von Mises: " + std::to_string(u.size()) + " displacements and " +
+                            std::to_string(temp.size()) + " temperatures, expected 3 and 1 per node (" +
+                            std::to_string(m.nodes.rows()) + " nodes)");
   return m.order == 1 ? von_mises_impl<4>(m, spec, u, temp) : von_mises_impl<10>(m, spec, u, temp);
 }
 
 Eigen::Vector3d displacement_at(const mesh::TetMesh& m, const Eigen::VectorXd& u, const Eigen::Vector3d& p) {
+  if (u.size() != 3 * m.nodes.rows())
+    throw core::SolverError("displacement vector has " + std::to_string(u.size()) + " entries, expected " +
+                            std::to_string(3 * m.nodes.rows()) + " (3 per node)");
   for (int t = 0; t < m.tets.rows(); ++t) {
     const auto x4 = coords<4>(m, t);
     Eigen::Vector3d lo = x4.rowwise().minCoeff(), hi = x4.rowwise().maxCoeff();

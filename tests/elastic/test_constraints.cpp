@@ -202,7 +202,6 @@ TEST(MultiTime, FactoredModelAndInfluenceVectorsAgreeWithTheHistory) {
 // corner nodes only (#corners rows on a 10-node mesh) is read out of bounds and gave non-finite
 // displacements, and extra rows are ignored. Skipped until the check is added.
 TEST(InputChecks, TemperatureWithWrongRowCountIsRefused) {
-  GTEST_SKIP() << "known bug: no row-count check on the temperature matrix (see report)";
   const auto spec = spec_of(two_body_block(kThreeTwoOne));
   const auto mesh = mesh::mesh_case(spec);
   for (Eigen::Index rows : {static_cast<Eigen::Index>(mesh.corner_count), mesh.nodes.rows() + 7}) {
