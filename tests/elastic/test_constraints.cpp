@@ -197,10 +197,8 @@ TEST(MultiTime, FactoredModelAndInfluenceVectorsAgreeWithTheHistory) {
   EXPECT_LT(worst, 1e-11);
 }
 
-// elastic_history / ElasticModel::displacements do not check that `temperature` has one row per
-// mesh node (solvers/elastic.cpp, ElasticModel::displacements): in Release a field with the
-// corner nodes only (#corners rows on a 10-node mesh) is read out of bounds and gave non-finite
-// displacements, and extra rows are ignored. Skipped until the check is added.
+// Temperature fields must have one row per mesh node: a field of the corner nodes only on a
+// 10-node mesh was once read out of bounds, and extra rows were ignored.
 TEST(InputChecks, TemperatureWithWrongRowCountIsRefused) {
   const auto spec = spec_of(two_body_block(kThreeTwoOne));
   const auto mesh = mesh::mesh_case(spec);
