@@ -1,0 +1,530 @@
+#include "io/measured_data.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string_view>
+
+#include "core/errors.hpp"
+#include "io/atomic_dir.hpp"
+
+namespace tt::io {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormat = "thermal-measurement/1";
+constexpr double kCelsiusOffset = 273.15;
+constexpr double kMetresPerMicrometre = 1e-6;
+
+/// What a data.csv column holds, once the header has been matched against meta.json.
+enum class ColumnRole { time, input, sensor, probe };
+
+struct ColumnSlot {
+  ColumnRole role = ColumnRole::time;
+  int index = 0;  /// into inputs, sensors or displacements
+};
+
+[[noreturn]] void meta_error(const fs::path& file, const std::string& key,
+                             const std::string& message) {
+  throw core::DataError(core::located(file.string(), 0, "key " + key + ": " + message));
+}
+
+std::string json_text(const json& value) {
+  const std::string text = value.dump();
+  return text.size() > 60 ? text.substr(0, 57) + "..." : text;
+}
+
+const json& required_key(const fs::path& file, const json& object, const std::string& key,
+                         const std::string& path) {
+  const auto it = object.find(key);
+  if (it == object.end())
+    meta_error(file, path, "missing: expected it (see docs/measured-data.md)");
+  return *it;
+}
+
+std::string string_value(const fs::path& file, const json& value, const std::string& key) {
+  if (!value.is_string()) meta_error(file, key, json_text(value) + " is not a string");
+  return value.get<std::string>();
+}
+
+/// A string unit key that must equal the one unit the format allows.
+void require_unit(const fs::path& file, const json& meta, const std::string& key,
+                  const std::string& expected) {
+  const std::string unit = string_value(file, required_key(file, meta, key, key), key);
+  if (unit != expected)
+    meta_error(file, key,
+               "unknown unit '" + unit + "': expected '" + expected +
+                   "' (values are converted before they are written in this format)");
+}
+
+std::optional<double> optional_number(const fs::path& file, const json& meta,
+                                      const std::string& key) {
+  const auto it = meta.find(key);
+  if (it == meta.end() || it->is_null()) return std::nullopt;
+  if (!it->is_number() || !std::isfinite(it->get<double>()))
+    meta_error(file, key, json_text(*it) + ": expected a finite number or null");
+  return it->get<double>();
+}
+
+/// A [x, y, z] triple, or nothing for null.
+std::optional<Eigen::Vector3d> optional_vector(const fs::path& file, const json& object,
+                                               const std::string& key, const std::string& path) {
+  const auto it = object.find(key);
+  if (it == object.end() || it->is_null()) return std::nullopt;
+  if (!it->is_array() || it->size() != 3)
+    meta_error(file, path, json_text(*it) + ": expected [x, y, z] in metres or null");
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    const json& c = (*it)[static_cast<std::size_t>(i)];
+    if (!c.is_number() || !std::isfinite(c.get<double>()))
+      meta_error(file, path,
+                 json_text(*it) + ": component " + std::to_string(i) + " is not a finite number");
+    v(i) = c.get<double>();
+  }
+  return v;
+}
+
+void require_inside(const fs::path& file, const std::optional<Eigen::AlignedBox3d>& box,
+                    const std::optional<Eigen::Vector3d>& p, const std::string& path,
+                    const std::string& machine) {
+  if (!box || !p) return;
+  constexpr double slack = 1e-9;  // points on the box faces are inside
+  if ((p->array() >= box->min().array() - slack).all() &&
+      (p->array() <= box->max().array() + slack).all())
+    return;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "position (%g, %g, %g) m is outside machine %s's bounding box x in [%g, %g], y in "
+                "[%g, %g], z in "
+                "[%g, %g] m; hint: positions are in metres in the machine's frame",
+                (*p)(0), (*p)(1), (*p)(2), machine.c_str(), box->min()(0), box->max()(0),
+                box->min()(1), box->max()(1), box->min()(2), box->max()(2));
+  meta_error(file, path, text);
+}
+
+const json& id_list(const fs::path& file, const json& meta, const std::string& key, bool required) {
+  static const json empty = json::array();
+  const auto it = meta.find(key);
+  if (it == meta.end()) {
+    if (required) meta_error(file, key, "missing: expected a list of {\"id\": ...} objects");
+    return empty;
+  }
+  if (!it->is_array())
+    meta_error(file, key, json_text(*it) + ": expected a list of {\"id\": ...} objects");
+  return *it;
+}
+
+std::string item_id(const fs::path& file, const json& item, const std::string& path) {
+  if (!item.is_object())
+    meta_error(file, path, json_text(item) + ": expected an object with an \"id\"");
+  const std::string id =
+      string_value(file, required_key(file, item, "id", path + ".id"), path + ".id");
+  if (id.empty() || id.find_first_of(",\"\r\n") != std::string::npos || id == "time_s")
+    meta_error(file, path + ".id", "'" + id + "' cannot name a data.csv column");
+  return id;
+}
+
+/// meta.json as a run with no samples yet.
+MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in)
+    throw core::IoError(file.string() +
+                        ": cannot open for reading; expected meta.json beside data.csv");
+  json meta;
+  try {
+    meta = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw core::DataError(
+        core::located(file.string(), 0, std::string("not valid JSON: ") + e.what()));
+  }
+  if (!meta.is_object())
+    throw core::DataError(core::located(file.string(), 0, "expected a JSON object"));
+  MeasuredRun run;
+  run.folder = file.parent_path();
+  const std::string format =
+      string_value(file, required_key(file, meta, "format", "format"), "format");
+  if (format != kFormat)
+    meta_error(file, "format", "unknown format '" + format + "': expected '" + kFormat + "'");
+  run.machine = string_value(file, required_key(file, meta, "machine", "machine"), "machine");
+  if (meta.contains("run")) run.run = string_value(file, meta["run"], "run");
+  require_unit(file, meta, "time_unit", "s");
+  require_unit(file, meta, "temperature_unit", "degC");
+  require_unit(file, meta, "displacement_unit", "um");
+  run.initial_temperature_c = optional_number(file, meta, "initial_temperature_degC");
+  run.nominal_ambient_c = optional_number(file, meta, "nominal_ambient_degC");
+
+  std::set<std::string> ids;
+  const auto unique = [&](const std::string& id, const std::string& path) {
+    if (!ids.insert(id).second)
+      meta_error(file, path, "id '" + id + "' is used twice; every column id must be unique");
+  };
+  const json& inputs = id_list(file, meta, "inputs", false);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string path = "inputs[" + std::to_string(i) + "]";
+    const std::string id = item_id(file, inputs[i], path);
+    unique(id, path + ".id");
+    const std::string unit =
+        string_value(file, required_key(file, inputs[i], "unit", path + ".unit"), path + ".unit");
+    if (unit != "rpm")
+      meta_error(file, path + ".unit", "unknown unit '" + unit + "': expected 'rpm'");
+    run.inputs.push_back(id);
+  }
+  const json& sensors = id_list(file, meta, "sensors", true);
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    const std::string path = "sensors[" + std::to_string(i) + "]";
+    MeasuredSensor s;
+    s.id = item_id(file, sensors[i], path);
+    unique(s.id, path + ".id");
+    s.position = optional_vector(file, sensors[i], "position", path + ".position");
+    require_inside(file, limits.machine_box, s.position, path + ".position", run.machine);
+    run.sensors.push_back(std::move(s));
+  }
+  const json& probes = id_list(file, meta, "displacements", true);
+  for (std::size_t i = 0; i < probes.size(); ++i) {
+    const std::string path = "displacements[" + std::to_string(i) + "]";
+    MeasuredProbe p;
+    p.id = item_id(file, probes[i], path);
+    unique(p.id, path + ".id");
+    p.point = optional_vector(file, probes[i], "point", path + ".point");
+    require_inside(file, limits.machine_box, p.point, path + ".point", run.machine);
+    p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
+    if (p.direction) {
+      const double norm = p.direction->norm();
+      if (!(norm > 0)) meta_error(file, path + ".direction", "[0, 0, 0]: expected a unit vector");
+      *p.direction /= norm;
+    }
+    run.displacements.push_back(std::move(p));
+  }
+  if (const auto it = meta.find("ambient_sensor"); it != meta.end() && !it->is_null()) {
+    const std::string id = string_value(file, *it, "ambient_sensor");
+    bool found = false;
+    for (const auto& s : run.sensors) found = found || s.id == id;
+    if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
+    run.ambient_sensor = id;
+  }
+  run.meta = std::move(meta);
+  return run;
+}
+
+std::string_view trimmed(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(" \t\r");
+  return text.substr(first, last - first + 1);
+}
+
+/// Streams data.csv line by line through a fixed buffer, so memory holds one chunk and the values.
+class LineReader {
+ public:
+  explicit LineReader(const fs::path& file)
+      : in_(file, std::ios::binary), buffer_(std::size_t(1) << 20) {}
+  bool is_open() const { return static_cast<bool>(in_); }
+
+  /// The next line without its end, or false at the end of the file.
+  bool next(std::string_view& line) {
+    while (true) {
+      const auto newline = std::string_view(buffer_.data() + begin_, end_ - begin_).find('\n');
+      if (newline != std::string_view::npos) {
+        line = std::string_view(buffer_.data() + begin_, newline);
+        begin_ += newline + 1;
+        ++number_;
+        return true;
+      }
+      if (eof_) {
+        if (begin_ == end_) return false;
+        line = std::string_view(buffer_.data() + begin_, end_ - begin_);
+        begin_ = end_;
+        ++number_;
+        return true;
+      }
+      refill();
+    }
+  }
+  int line_number() const { return number_; }
+
+ private:
+  void refill() {
+    const std::size_t rest = end_ - begin_;
+    if (begin_ > 0) std::copy(buffer_.begin() + begin_, buffer_.begin() + end_, buffer_.begin());
+    begin_ = 0;
+    end_ = rest;
+    if (end_ == buffer_.size())
+      buffer_.resize(buffer_.size() * 2);  // a line longer than the buffer
+    in_.read(buffer_.data() + end_, static_cast<std::streamsize>(buffer_.size() - end_));
+    end_ += static_cast<std::size_t>(in_.gcount());
+    if (!in_) eof_ = true;
+  }
+
+  std::ifstream in_;
+  std::vector<char> buffer_;
+  std::size_t begin_ = 0, end_ = 0;
+  bool eof_ = false;
+  int number_ = 0;
+};
+
+std::string cell_text(std::string_view cell) {
+  return cell.size() > 40 ? std::string(cell.substr(0, 37)) + "..." : std::string(cell);
+}
+
+/// The header's columns matched against meta.json's ids; every rejection names the column.
+std::vector<ColumnSlot> header_slots(const fs::path& file, std::string_view line,
+                                     const MeasuredRun& run, std::vector<std::string>& names) {
+  if (line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);  // a UTF-8 byte-order mark
+  std::map<std::string, ColumnSlot, std::less<>> expected{{"time_s", {ColumnRole::time, 0}}};
+  for (std::size_t i = 0; i < run.inputs.size(); ++i)
+    expected[run.inputs[i]] = {ColumnRole::input, static_cast<int>(i)};
+  for (std::size_t i = 0; i < run.sensors.size(); ++i)
+    expected[run.sensors[i].id] = {ColumnRole::sensor, static_cast<int>(i)};
+  for (std::size_t i = 0; i < run.displacements.size(); ++i)
+    expected[run.displacements[i].id] = {ColumnRole::probe, static_cast<int>(i)};
+  std::vector<ColumnSlot> slots;
+  std::map<std::string, int> seen;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    const std::string name(trimmed(line.substr(start, comma - start)));
+    const int column = static_cast<int>(slots.size()) + 1;
+    const std::string where = "column " + std::to_string(column) + " '" + name + "'";
+    if (const auto it = seen.find(name); it != seen.end())
+      throw core::DataError(core::located(file.string(), 1,
+                                          where + ": duplicated column (also column " +
+                                              std::to_string(it->second) +
+                                              "); every id appears once"));
+    const auto it = expected.find(name);
+    if (it == expected.end())
+      throw core::DataError(core::located(
+          file.string(), 1,
+          where + ": unknown column; expected time_s or an id of inputs, sensors or displacements "
+                  "in meta.json"));
+    if (column == 1 && it->second.role != ColumnRole::time)
+      throw core::DataError(
+          core::located(file.string(), 1, where + ": the first column must be time_s"));
+    if (column > 1 && it->second.role == ColumnRole::time)
+      throw core::DataError(
+          core::located(file.string(), 1, where + ": time_s must be the first column"));
+    seen[name] = column;
+    slots.push_back(it->second);
+    names.push_back(name);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  for (const auto& [name, slot] : expected)
+    if (!seen.contains(name))
+      throw core::DataError(core::located(
+          file.string(), 1, "missing column '" + name + "': every id of meta.json needs a column"));
+  return slots;
+}
+
+/// data.csv into run's matrices, converted to SI.
+void read_samples(const fs::path& file, const MeasuredReadLimits& limits, MeasuredRun& run) {
+  std::error_code ec;
+  const auto bytes = fs::file_size(file, ec);
+  if (ec) throw core::IoError(file.string() + ": cannot read: " + ec.message());
+  if (bytes > limits.max_bytes)
+    throw core::DataError(
+        core::located(file.string(), 0,
+                      "file size " + std::to_string(bytes) + " bytes exceeds the limit of " +
+                          std::to_string(limits.max_bytes) + " bytes; raise max_bytes to read it"));
+  LineReader reader(file);
+  if (!reader.is_open()) throw core::IoError(file.string() + ": cannot open for reading");
+  std::string_view line;
+  if (!reader.next(line))
+    throw core::DataError(
+        core::located(file.string(), 1, "empty file: expected a header row starting with time_s"));
+  std::vector<std::string> names;
+  const std::vector<ColumnSlot> slots = header_slots(file, line, run, names);
+  const std::size_t columns = slots.size();
+  // Row-major values in the file's column order; reshaped once at the end.
+  std::vector<double> values;
+  values.reserve(std::min<std::size_t>(bytes / 4, std::size_t(1) << 26));
+  std::size_t rows = 0;
+  double last_time = -std::numeric_limits<double>::infinity();
+  const double missing = std::numeric_limits<double>::quiet_NaN();
+  while (reader.next(line)) {
+    if (trimmed(line).empty()) continue;
+    const int number = reader.line_number();
+    if (++rows > limits.max_rows)
+      throw core::DataError(core::located(file.string(), number,
+                                          "more than " + std::to_string(limits.max_rows) +
+                                              " rows; raise max_rows to read this file"));
+    std::size_t start = 0, column = 0;
+    while (true) {
+      const auto comma = line.find(',', start);
+      if (column >= columns)
+        throw core::DataError(core::located(file.string(), number,
+                                            "column " + std::to_string(column + 1) +
+                                                ": more cells than the " + std::to_string(columns) +
+                                                " columns of the header"));
+      const std::string_view cell = trimmed(line.substr(start, comma - start));
+      const std::string where = "column " + std::to_string(column + 1) + " '" + names[column] + "'";
+      double value = missing;
+      if (!cell.empty()) {
+        const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
+        const auto result = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+        if (result.ec != std::errc() || result.ptr != digits.data() + digits.size() ||
+            digits.empty())
+          throw core::DataError(core::located(
+              file.string(), number, where + ": '" + cell_text(cell) + "' is not a number"));
+        if (!std::isfinite(value))
+          throw core::DataError(
+              core::located(file.string(), number,
+                            where + ": '" + cell_text(cell) +
+                                "' is not a finite number; leave the cell empty for a missing "
+                                "reading"));
+      } else if (column == 0) {
+        throw core::DataError(
+            core::located(file.string(), number, where + ": empty time; every row needs one"));
+      }
+      if (column == 0) {
+        if (!(value > last_time)) {
+          char text[160];
+          std::snprintf(text, sizeof text,
+                        "%s: time %.17g s does not increase (previous row: %.17g s)", where.c_str(),
+                        value, last_time);
+          throw core::DataError(core::located(file.string(), number, text));
+        }
+        last_time = value;
+      }
+      values.push_back(value);
+      ++column;
+      if (comma == std::string_view::npos) break;
+      start = comma + 1;
+    }
+    if (column != columns)
+      throw core::DataError(core::located(file.string(), number,
+                                          "column " + std::to_string(column + 1) + ": row has " +
+                                              std::to_string(column) + " cells: expected " +
+                                              std::to_string(columns)));
+  }
+  const auto n = static_cast<Eigen::Index>(rows);
+  run.time.resize(n);
+  run.input_values.resize(n, static_cast<Eigen::Index>(run.inputs.size()));
+  run.temperature.resize(n, static_cast<Eigen::Index>(run.sensors.size()));
+  run.displacement.resize(n, static_cast<Eigen::Index>(run.displacements.size()));
+  for (std::size_t c = 0; c < columns; ++c) {
+    const ColumnSlot slot = slots[c];
+    for (Eigen::Index r = 0; r < n; ++r) {
+      const double v = values[static_cast<std::size_t>(r) * columns + c];
+      switch (slot.role) {
+        case ColumnRole::time:
+          run.time(r) = v;
+          break;
+        case ColumnRole::input:
+          run.input_values(r, slot.index) = v;
+          break;
+        case ColumnRole::sensor:
+          run.temperature(r, slot.index) = v + kCelsiusOffset;
+          break;
+        case ColumnRole::probe:
+          run.displacement(r, slot.index) = v * kMetresPerMicrometre;
+          break;
+      }
+    }
+  }
+}
+
+json vector_json(const std::optional<Eigen::Vector3d>& v) {
+  if (!v) return nullptr;
+  return json::array({(*v)(0), (*v)(1), (*v)(2)});
+}
+
+/// Shortest text that reads back to the same double; empty for NaN (a missing reading).
+void append_number(std::string& out, double value) {
+  if (std::isnan(value)) return;
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, value);
+  out.append(text, result.ptr);
+}
+
+void require_shape(const MeasuredRun& run) {
+  const Eigen::Index n = run.time.size();
+  const auto bad = [&](const std::string& what, Eigen::Index rows, Eigen::Index cols,
+                       std::size_t expected) {
+    if (rows != n || cols != static_cast<Eigen::Index>(expected))
+      throw core::DataError("write_measured_run: " + what + " is " + std::to_string(rows) + " x " +
+                            std::to_string(cols) + ": expected " + std::to_string(n) + " x " +
+                            std::to_string(expected) + " (#samples x #ids)");
+  };
+  bad("input_values", run.input_values.rows(), run.input_values.cols(), run.inputs.size());
+  bad("temperature", run.temperature.rows(), run.temperature.cols(), run.sensors.size());
+  bad("displacement", run.displacement.rows(), run.displacement.cols(), run.displacements.size());
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isfinite(run.time(i)) || (i > 0 && !(run.time(i) > run.time(i - 1))))
+      throw core::DataError("write_measured_run: time[" + std::to_string(i) +
+                            "] = " + std::to_string(run.time(i)) +
+                            " s: times must be finite and strictly increasing");
+}
+
+}  // namespace
+
+MeasuredRun read_measured_run(const fs::path& folder, const MeasuredReadLimits& limits) {
+  MeasuredRun run = run_from_meta(folder / "meta.json", limits);
+  run.folder = folder;
+  read_samples(folder / "data.csv", limits, run);
+  return run;
+}
+
+void write_measured_run(const fs::path& folder, const MeasuredRun& run) {
+  require_shape(run);
+  json meta = run.meta.is_object() ? run.meta : json::object();
+  meta["format"] = kFormat;
+  meta["machine"] = run.machine;
+  meta["run"] = run.run;
+  meta["time_unit"] = "s";
+  meta["temperature_unit"] = "degC";
+  meta["displacement_unit"] = "um";
+  meta["sensors"] = json::array();
+  for (const auto& s : run.sensors)
+    meta["sensors"].push_back({{"id", s.id}, {"position", vector_json(s.position)}});
+  meta["displacements"] = json::array();
+  for (const auto& p : run.displacements)
+    meta["displacements"].push_back(
+        {{"id", p.id}, {"point", vector_json(p.point)}, {"direction", vector_json(p.direction)}});
+  meta["inputs"] = json::array();
+  for (const auto& id : run.inputs) meta["inputs"].push_back({{"id", id}, {"unit", "rpm"}});
+  if (run.ambient_sensor)
+    meta["ambient_sensor"] = *run.ambient_sensor;
+  else
+    meta.erase("ambient_sensor");
+  meta["initial_temperature_degC"] =
+      run.initial_temperature_c ? json(*run.initial_temperature_c) : json(nullptr);
+  meta["nominal_ambient_degC"] =
+      run.nominal_ambient_c ? json(*run.nominal_ambient_c) : json(nullptr);
+
+  std::string csv = "time_s";
+  for (const auto& id : run.inputs) csv += "," + id;
+  for (const auto& s : run.sensors) csv += "," + s.id;
+  for (const auto& p : run.displacements) csv += "," + p.id;
+  csv += '\n';
+  for (Eigen::Index r = 0; r < run.time.size(); ++r) {
+    append_number(csv, run.time(r));
+    for (Eigen::Index c = 0; c < run.input_values.cols(); ++c) {
+      csv += ',';
+      append_number(csv, run.input_values(r, c));
+    }
+    for (Eigen::Index c = 0; c < run.temperature.cols(); ++c) {
+      csv += ',';
+      append_number(csv, run.temperature(r, c) - kCelsiusOffset);
+    }
+    for (Eigen::Index c = 0; c < run.displacement.cols(); ++c) {
+      csv += ',';
+      append_number(csv, run.displacement(r, c) / kMetresPerMicrometre);
+    }
+    csv += '\n';
+  }
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec) throw core::IoError(folder.string() + ": cannot create the folder: " + ec.message());
+  write_file_atomically(folder / "data.csv", csv);
+  write_file_atomically(folder / "meta.json", meta.dump(1) + "\n");
+}
+
+}  // namespace tt::io
