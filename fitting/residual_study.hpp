@@ -1,0 +1,135 @@
+// What a fitted thermal-error model lacks, traced from its residual on held-out training data.
+// The model E = β0 + Σ β_k ΔT_k (the standard's form) is fitted on training segments; candidate
+// terms built from what a measured run holds (speed, time, temperatures) are added one at a time,
+// each scored by the share of the leave-one-segment-out residual it removes, and claimed only when
+// that share, less a penalty per added coefficient, beats the best share reached by surrogates of
+// the same term: the same amplitude spectrum with random phases (as smooth and as strong, with no
+// timing relation to the residual). A circular shift would not do: a 50 % on/off duty shifted by
+// half a cycle is the same regressor with its sign flipped.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fitting/linear.hpp"
+#include "fitting/segments.hpp"
+
+namespace tt::fitting {
+
+enum class EffectKind {
+  /// a drift that follows the current speed: n and n² (centrifugal growth, probe runout)
+  speed_dependent_offset,
+  /// heat input through a first-order lag: low_pass(n, τ)
+  lagged_speed,
+  /// the error lags the model's temperatures: low_pass(ΔT_k, τ) of each model sensor
+  lag,
+  /// the ambient sensor's increment (when the run names one)
+  ambient_temperature,
+  /// a temperature the model does not read: ΔT of one more sensor
+  missing_sensor,
+  /// drift linear in the time since the segment started
+  drift_in_time,
+};
+
+/// "speed_dependent_offset", "lagged_speed", "lag", "ambient_temperature", "missing_sensor",
+/// "drift_in_time".
+std::string effect_kind_name(EffectKind kind);
+
+/// One candidate term with its setting.
+struct EffectTerm {
+  EffectKind kind = EffectKind::drift_in_time;
+  /// low-pass time constant of lagged_speed and lag [s]
+  double time_constant = 0.0;
+  /// temperature column of missing_sensor and ambient_temperature
+  int sensor = -1;
+};
+
+/// A linear model: intercept, ΔT of `sensors`, then the regressors of each term in order.
+struct TermModel {
+  int target = 0;
+  std::vector<int> sensors;
+  std::vector<EffectTerm> terms;
+  /// intercept [m] and coefficients [m per regressor unit: K, krpm, krpm², h]
+  LinearFit fit;
+};
+
+/// #samples x #regressors of a model on a segment, without the intercept column.
+Eigen::MatrixXd term_regressors(const std::vector<int>& sensors,
+                                const std::vector<EffectTerm>& terms, const Segment& segment);
+
+/// Names of term_regressors' columns, e.g. "dT[t5]", "speed_krpm", "lp3600s(speed_krpm)".
+std::vector<std::string> term_regressor_names(const std::vector<int>& sensors,
+                                              const std::vector<EffectTerm>& terms,
+                                              const std::vector<std::string>& sensor_names);
+
+/// #samples predicted error [m] of the model's target on a segment.
+Eigen::VectorXd term_prediction(const TermModel& model, const Segment& segment);
+
+/// The model least-squares fitted on the segments' target column (all rows stacked).
+TermModel fitted_term_model(const std::vector<Segment>& segments, int target,
+                            const std::vector<int>& sensors, const std::vector<EffectTerm>& terms);
+
+struct ResidualStudyOptions {
+  /// the baseline picks up to this many sensors by forward selection on held-out residual
+  int max_sensors = 4;
+  /// time constants tried for lag and lagged_speed [s]
+  std::vector<double> time_constants{900.0, 1800.0, 3600.0, 7200.0, 14400.0};
+  /// phase-randomised surrogates per tested term; the claim threshold is their largest share (19
+  /// copies: a 5 % chance that a term with no relation beats all of them)
+  int null_draws = 19;
+  /// share of the held-out residual a term must explain per coefficient it adds, beyond the null
+  double penalty_per_parameter = 0.01;
+  /// at most this many effects
+  int max_effects = 4;
+  /// temperature column of the ambient sensor, -1 when the run names none
+  int ambient_sensor = -1;
+  /// master seed of the surrogates
+  std::uint64_t seed = 1;
+};
+
+/// One tested term: what it explains and what chance explains.
+struct Effect {
+  EffectTerm term;
+  /// coefficients it adds
+  int parameters = 0;
+  /// share of the held-out (leave-one-segment-out) training residual sum of squares it removes
+  /// from the model before it (the step it was tested at)
+  double step_fraction = 0.0;
+  /// the same reduction as a share of the baseline's held-out residual (comparable across effects)
+  double explained_fraction = 0.0;
+  /// the largest step share reached by its surrogates (the noise threshold); NaN when
+  /// not computed (its step share was below the penalty already)
+  double null_fraction = 0.0;
+  /// step_fraction − penalty·parameters > null_fraction
+  bool claimed = false;
+};
+
+struct ChannelStudy {
+  int target = 0;
+  std::string target_name;
+  /// the baseline: ΔT of forward-selected sensors, fitted on all training segments
+  TermModel before;
+  /// the baseline with the claimed effects, fitted on all training segments
+  TermModel after;
+  /// claimed effects in the order they were added
+  std::vector<Effect> effects;
+  /// per step, the best term of every kind tried (claimed or not), largest step share first; the
+  /// last step is where the study stopped
+  std::vector<std::vector<Effect>> steps;
+  /// leave-one-segment-out residual sum of squares of the training segments [m²]
+  double heldout_rss_before = 0.0;
+  double heldout_rss_after = 0.0;
+};
+
+/// The study for one error column of at least 2 training segments. Throws DataError on fewer
+/// segments or inconsistent ones.
+ChannelStudy residual_study(const std::vector<Segment>& training, int target,
+                            const ResidualStudyOptions& options);
+
+/// Leave-one-segment-out residual sum of squares [m²] of the model (sensors, terms).
+double heldout_rss(const std::vector<Segment>& segments, int target,
+                   const std::vector<int>& sensors, const std::vector<EffectTerm>& terms);
+
+}  // namespace tt::fitting
