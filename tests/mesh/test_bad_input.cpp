@@ -102,15 +102,61 @@ Plc crossing_facets() {
   return plc;
 }
 
-// Disabled: TetGen 1.5.0 (Debian libtet1.5 1.5.0-5) cannot report a failure to a library caller.
-// terminatetetgen() frees the mesh and throws; unwinding then runs ~tetgenmesh(), which frees it
-// again, so the process dies (SIGSEGV in memorypool::~memorypool) before the adapter's catch runs.
-// Enable once the adapter runs TetGen where such a crash cannot take the caller down.
-TEST(BadInput, DISABLED_TetgenFailureIsAMeshErrorNamingTetgenAndItsSwitches) {
+// TetGen 1.5.0 (Debian libtet1.5 1.5.0-5) frees its mesh before throwing and again while
+// unwinding, so run in the caller's process this input kills it; the adapter runs TetGen in a
+// child process and must turn the failure into a MeshError.
+TEST(BadInput, TetgenFailureIsAMeshErrorNamingTetgenAndItsSwitches) {
   const std::string msg =
       error_of<core::MeshError>([] { tetgen::tetrahedralize(crossing_facets(), TetgenOptions{}); });
   expect_has(msg, "TetGen failed with switches 'pzAaQq1.5/12'");
+  expect_has(msg, "16 vertices");
+  expect_has(msg, "8 facets");
+  expect_has(msg, "self-intersection");
+  expect_has(msg, "TetGen error code 3");
   expect_has(msg, "Hint");
+}
+
+TEST(BadInput, TetgenFailureMessageCarriesWhatTetgenPrinted) {
+  // The unit cube plus a triangle lying in its bottom face: TetGen names the two facets.
+  Plc plc = crossing_facets();
+  plc.facets.resize(6);
+  plc.vertices.resize(8);
+  plc.vertices.emplace_back(0.5, 0.5, 0.0);
+  plc.facets.push_back(PlcFacet{{{0, 1, 8}}, {}});
+  const std::string msg =
+      error_of<core::MeshError>([&] { tetgen::tetrahedralize(plc, TetgenOptions{}); });
+  expect_has(msg, "TetGen failed with switches 'pzAaQq1.5/12'");
+  expect_has(msg, "TetGen error code 3");
+  expect_has(msg, "Found two facets intersect each other. | 1st: [0, 1, 3] #5 | 2nd: [0, 1, 8] #7");
+}
+
+/// Sum of the tets' volumes [m^3].
+double volume_of(const LinearTets& mesh) {
+  double volume = 0;
+  for (const auto& t : mesh.tets) {
+    const Vector3d& a = mesh.nodes[t[0]];
+    volume += (mesh.nodes[t[1]] - a).cross(mesh.nodes[t[2]] - a).dot(mesh.nodes[t[3]] - a) / 6;
+  }
+  return volume;
+}
+
+TEST(BadInput, AfterATetgenFailureTheCallerStillMeshesAndGetsTheSameMeshTwice) {
+  EXPECT_THROW(tetgen::tetrahedralize(crossing_facets(), TetgenOptions{}), core::MeshError);
+  Plc cube = crossing_facets();
+  cube.facets.resize(6);  // the unit cube alone; the inner facets' vertices stay as free points
+  const LinearTets first = tetgen::tetrahedralize(cube, TetgenOptions{});
+  ASSERT_GT(first.tets.size(), 100u);
+  EXPECT_NEAR(volume_of(first), 1.0, 1e-12);
+  for (const auto& t : first.tets) {
+    const Vector3d& a = first.nodes[t[0]];
+    EXPECT_GT((first.nodes[t[1]] - a).cross(first.nodes[t[2]] - a).dot(first.nodes[t[3]] - a), 0);
+  }
+  EXPECT_EQ(first.region, std::vector<int>(first.tets.size(), 0));
+  for (size_t i = 0; i < cube.vertices.size(); ++i)
+    EXPECT_EQ(first.nodes[i], cube.vertices[i]) << "PLC vertex " << i << " moved";
+  const LinearTets second = tetgen::tetrahedralize(cube, TetgenOptions{});
+  EXPECT_EQ(second.nodes, first.nodes);
+  EXPECT_EQ(second.tets, first.tets);
 }
 
 TEST(BadInput, ImpossibleQualityBoundsAreAMeshErrorBeforeTetgenRuns) {
