@@ -15,6 +15,10 @@ struct MeshArgs {
 struct RunArgs {
   std::filesystem::path case_file, out;
   bool quiet = false;
+  bool resume = false;            /// continue from OUT.checkpoint when there is one
+  double checkpoint_every_s = 600;  /// wall time between checkpoints; < 0: none
+  int stop_after_steps = 0;       /// tests: save a checkpoint after this many steps and exit 3
+  std::filesystem::path dump;     /// tests: temperatures and displacements as raw doubles
 };
 
 struct ProbesArgs {

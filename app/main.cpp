@@ -26,6 +26,12 @@ int main(int argc, char** argv) {
   run->add_option("case", run_args.case_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
   run->add_option("--out", run_args.out, "output directory")->required();
   run->add_flag("--quiet", run_args.quiet, "no progress on stderr");
+  run->add_flag("--resume", run_args.resume, "continue from OUT.checkpoint, left by an interrupted run");
+  run->add_option("--checkpoint-every-s", run_args.checkpoint_every_s,
+                  "wall time between checkpoints of the time loop (default 600; negative: none)");
+  // Hidden (empty group): for the reliability tests.
+  run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
+  run->add_option("--dump", run_args.dump)->group("");
 
   ProbesArgs probes_args;
   auto* probes = cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");

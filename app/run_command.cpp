@@ -1,12 +1,15 @@
 // thermotwin mesh / run: the virtual machine's drivers.
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
+#include "io/checkpoint.hpp"
 #include "io/csv_out.hpp"
 #include "io/reports.hpp"
 #include "io/vtk_out.hpp"
@@ -77,6 +80,20 @@ void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const s
   writer.finish();
 }
 
+/// --dump: #nodes, #times, temperatures [K], then #dofs, #times, displacements [m] when there
+/// are any, as native int64 and doubles: results compared bit for bit by the reliability tests.
+void write_dump(const solvers::VirtualRun& run, const std::filesystem::path& path) {
+  std::string bytes;
+  const auto put_matrix = [&](const Eigen::MatrixXd& m) {
+    const std::int64_t shape[2] = {m.rows(), m.cols()};
+    bytes.append(reinterpret_cast<const char*>(shape), sizeof shape);
+    bytes.append(reinterpret_cast<const char*>(m.data()), static_cast<size_t>(m.size()) * sizeof(double));
+  };
+  put_matrix(run.thermal.temperature);
+  if (run.elastic) put_matrix(run.elastic->displacement);
+  io::write_file_atomically(path, bytes);
+}
+
 }  // namespace
 
 void plot(const std::vector<std::string>& args) {
@@ -119,12 +136,31 @@ int run_command(const RunArgs& args) {
   if (!args.quiet)
     std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets ("
               << mesh_s << " s)\n";
-  // 3. Simulate: heat transfer, then thermo-elasticity.
+  // 3. Simulate: heat transfer, then thermo-elasticity. The time loop saves its state beside
+  //    DIR (DIR.checkpoint) so that --resume continues a run that was killed.
+  const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
+  const io::CheckpointKey key = io::checkpoint_key(spec, mesh);
+  std::optional<solvers::ThermalCheckpoint> resumed;
+  if (args.resume && std::filesystem::exists(checkpoint)) {
+    resumed = io::read_checkpoint(checkpoint, key);
+    std::cerr << "thermotwin: resuming at t = " << resumed->time << " s (step " << resumed->steps << ")\n";
+  } else if (args.resume) {
+    std::cerr << "thermotwin: note: no checkpoint at " << checkpoint.string() << "; starting at t = 0\n";
+  }
+  solvers::Checkpointing checkpointing;
+  checkpointing.interval_s = args.stop_after_steps > 0 ? 0 : args.checkpoint_every_s;
+  checkpointing.resume = resumed ? &*resumed : nullptr;
+  if (checkpointing.interval_s >= 0)
+    checkpointing.save = [&](const solvers::ThermalCheckpoint& state) {
+      io::write_checkpoint(checkpoint, key, state);
+      if (args.stop_after_steps > 0 && state.steps >= args.stop_after_steps) std::_Exit(3);  // as if killed
+    };
   const auto t_sim = Clock::now();
-  const solvers::VirtualRun run = solvers::simulate(mesh, spec, [&](double t, double end) {
-    if (!args.quiet) report_progress("thermal", t, end);
-  });
+  const solvers::VirtualRun run = solvers::simulate(
+      mesh, spec, [&](double t, double end) { if (!args.quiet) report_progress("thermal", t, end); },
+      checkpointing);
   const double sim_s = seconds_since(t_sim);
+  if (!args.dump.empty()) write_dump(run, args.dump);
   // 4. Write everything into DIR.partial, then publish it as DIR.
   io::OutputDir out(args.out);
   const auto& dir = out.path();
@@ -181,6 +217,8 @@ int run_command(const RunArgs& args) {
     plot({"thermal_error", (dir / "thermal_error.csv").string(), (dir / "thermal_error.png").string(),
           "--columns", "dx_um,dy_um,dz_um", "--title", spec.name + ": thermal error at the TCP"});
   out.commit();
+  std::error_code no_checkpoint;
+  std::filesystem::remove(checkpoint, no_checkpoint);
   std::cerr << "thermotwin: run: done in " << seconds_since(t_start) << " s -> " << args.out.string() << "\n";
   return 0;
 }

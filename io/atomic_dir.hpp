@@ -1,5 +1,11 @@
-// Results appear whole or not at all: a run writes into DIR.partial/ and renames it to DIR when
+// Results appear whole or not at all: a run writes into DIR.partial/ and publishes it as DIR when
 // complete; files are written to a temporary name and renamed.
+//
+// Killed at any moment, a run leaves at DIR either the previous complete result or none (when
+// there was none), never a mixture. Publishing swaps DIR.partial and DIR in one renameat2
+// (RENAME_EXCHANGE) and then removes the old result, now at DIR.partial. Where the file system
+// cannot exchange, the previous result is first renamed to DIR.old; a kill between that rename and
+// the next leaves DIR.old, which the next OutputDir for DIR renames back to DIR before it starts.
 #pragma once
 
 #include <filesystem>
@@ -11,6 +17,7 @@ namespace tt::io {
 /// directory (replacing a previous complete result); destruction without commit() removes it.
 class OutputDir {
  public:
+  /// Restores a previous result left at DIR.old by a killed commit, then starts DIR.partial afresh.
   explicit OutputDir(std::filesystem::path final_dir);
   ~OutputDir();
   OutputDir(const OutputDir&) = delete;

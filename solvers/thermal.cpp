@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string>
 
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
@@ -216,9 +217,24 @@ Eigen::VectorXd load_vector(const core::CaseSpec& spec, const ThermalOperators& 
   return f;
 }
 
+/// Checks that a saved state belongs to this mesh and time grid before the loop trusts it.
+void check_resume(const ThermalCheckpoint& c, int nodes, const std::vector<double>& grid, size_t times) {
+  const auto fail = [](const std::string& what) {
+    throw core::SolverError("checkpoint does not fit this run: " + what +
+                            "; remove the checkpoint or run without --resume");
+  };
+  if (c.temperature.size() != nodes || c.outputs.rows() != nodes)
+    fail("it has " + std::to_string(c.temperature.size()) + " nodes, the mesh " + std::to_string(nodes));
+  if (c.steps < 1 || static_cast<size_t>(c.steps) >= grid.size() || grid[c.steps - 1] != c.time)
+    fail("step " + std::to_string(c.steps) + " at t = " + std::to_string(c.time) +
+         " s is not an inner step of the time grid (" + std::to_string(grid.size()) + " steps)");
+  if (c.outputs.cols() < 1 || static_cast<size_t>(c.outputs.cols()) > times)
+    fail(std::to_string(c.outputs.cols()) + " output columns, at most " + std::to_string(times) + " expected");
+}
+
 template <int N>
 ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, const ThermalOperators& ops,
-                         const Progress& progress) {
+                         const Progress& progress, const Checkpointing& checkpointing) {
   using Scheme = core::TimeScheme;
   const Scheme scheme = spec.thermal.scheme;
   if (scheme == Scheme::bdf2)
@@ -268,8 +284,22 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
   const auto t_solve = Clock::now();
   double t_prev = 0, prev_speed = std::nan("");
   double lost_rate_prev = 0;  // heat rate out at t_prev under the current interval's h (CN)
+  size_t first_step = 0;
+  if (const ThermalCheckpoint* c = checkpointing.resume) {
+    check_resume(*c, n, grid, hist.times.size());
+    first_step = static_cast<size_t>(c->steps);
+    t_prev = c->time;
+    prev_speed = c->speed;
+    temp = c->temperature;
+    next_out = static_cast<size_t>(c->outputs.cols());
+    hist.temperature.leftCols(c->outputs.cols()) = c->outputs;
+    hist.energy.heat_in = c->heat_in;
+    hist.energy.lost = c->lost;
+    hist.timings.steps = c->steps;
+  }
+  auto t_saved = Clock::now();
   Eigen::VectorXd rhs(n), f_prev, f_new;
-  for (size_t i = 0; i < grid.size(); ++i) {
+  for (size_t i = first_step; i < grid.size(); ++i) {
     const double t = grid[i], dt = t - t_prev, mid = 0.5 * (t_prev + t);
     const LoadState s_new = load_state(spec, ops, mid, t, temp, t0_k);
     // Crank–Nicolson restarts with one backward-Euler step after every load discontinuity.
@@ -311,6 +341,12 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     prev_speed = s_new.speed;
     hist.timings.steps += 1;
     if (progress) progress(t, end);
+    if (checkpointing.save && i + 1 < grid.size() && seconds_since(t_saved) >= checkpointing.interval_s) {
+      const auto cols = static_cast<Eigen::Index>(next_out);
+      checkpointing.save({static_cast<int>(i + 1), t, prev_speed, temp, hist.temperature.leftCols(cols),
+                          hist.energy.heat_in, hist.energy.lost});
+      t_saved = Clock::now();
+    }
   }
   hist.timings.solve_s = seconds_since(t_solve) - hist.timings.factor_s;
   hist.energy.stored = stored_heat_total<N>(m, spec, temp, t0_k);
@@ -338,9 +374,10 @@ ThermalOperators thermal_operators(const mesh::TetMesh& mesh, const core::CaseSp
 }
 
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-                               const ThermalOperators& ops, const Progress& progress) {
-  return mesh.order == 1 ? integrate<4>(mesh, spec, ops, progress)
-                         : integrate<10>(mesh, spec, ops, progress);
+                               const ThermalOperators& ops, const Progress& progress,
+                               const Checkpointing& checkpointing) {
+  return mesh.order == 1 ? integrate<4>(mesh, spec, ops, progress, checkpointing)
+                         : integrate<10>(mesh, spec, ops, progress, checkpointing);
 }
 
 Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet) {

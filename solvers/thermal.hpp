@@ -54,9 +54,32 @@ struct ThermalHistory {
 /// Progress: (simulated time [s], end time [s]).
 using Progress = std::function<void(double, double)>;
 
-/// Integrates the transient from the uniform initial temperature to the duty cycle's end.
+/// The time loop's whole state after `steps` steps: enough to continue and end with the same
+/// numbers as a run that was never interrupted.
+struct ThermalCheckpoint {
+  int steps = 0;                /// time steps done (index of the next step in the time grid)
+  double time = 0;              /// simulated time reached [s]
+  double speed = 0;             /// spindle speed of the last step [rpm] (CN restarts on a change)
+  Eigen::VectorXd temperature;  /// #nodes [K] at `time`
+  Eigen::MatrixXd outputs;      /// #nodes x #output times written so far [K], t = 0 first
+  double heat_in = 0, lost = 0; /// energy accumulators so far [J]
+};
+
+/// Checkpoints during the time loop: `save` gets the state after a step when `interval_s` of wall
+/// time have passed since the start or the last save (0: after every step; no save after the
+/// last step). `resume`, when given, is a state saved earlier for the same mesh and case.
+struct Checkpointing {
+  double interval_s = 600;
+  std::function<void(const ThermalCheckpoint&)> save;
+  const ThermalCheckpoint* resume = nullptr;
+};
+
+/// Integrates the transient from the uniform initial temperature (or from `checkpointing.resume`)
+/// to the duty cycle's end. Throws SolverError when the resume state does not fit the mesh and
+/// the case's time grid.
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-                               const ThermalOperators& ops, const Progress& progress = {});
+                               const ThermalOperators& ops, const Progress& progress = {},
+                               const Checkpointing& checkpointing = {});
 
 /// Element coordinates gathered from the mesh: 3 x nodes-per-element [m].
 Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet);

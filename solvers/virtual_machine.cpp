@@ -4,12 +4,13 @@
 
 namespace tt::solvers {
 
-VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress) {
+VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress,
+                    const Checkpointing& checkpointing) {
   VirtualRun run;
   const auto t0 = std::chrono::steady_clock::now();
   run.operators = thermal_operators(mesh, spec);
   run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  run.thermal = thermal_history(mesh, spec, run.operators, progress);
+  run.thermal = thermal_history(mesh, spec, run.operators, progress, checkpointing);
   run.thermal.timings.assemble_s = run.operators_s;
   if (spec.mechanical.enabled) {
     run.elastic = elastic_history(mesh, spec, run.thermal.temperature);

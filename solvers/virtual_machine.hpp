@@ -18,6 +18,8 @@ struct VirtualRun {
 };
 
 /// Thermal transient, then (if enabled) thermo-elastic displacements at every output time.
-VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress = {});
+/// `checkpointing` saves (and resumes) the thermal time loop's state.
+VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress = {},
+                    const Checkpointing& checkpointing = {});
 
 }  // namespace tt::solvers

@@ -1,0 +1,169 @@
+#include "io/checkpoint.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+#include "core/errors.hpp"
+#include "io/atomic_dir.hpp"
+#include "io/case_reader.hpp"
+
+namespace tt::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kMagic[8] = {'T', 'T', 'C', 'K', 'P', 'T', '0', '1'};
+
+std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ull) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+  return h;
+}
+
+/// Appends plain values and arrays of doubles to a byte string.
+struct Writer {
+  std::string bytes;
+  template <class T>
+  void put(const T& v) {
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  void put_doubles(const double* p, std::size_t n) {
+    bytes.append(reinterpret_cast<const char*>(p), n * sizeof(double));
+  }
+};
+
+/// Reads them back, refusing to run past the end.
+struct Reader {
+  std::string_view bytes;
+  const fs::path& file;
+  std::size_t at = 0;
+  void take(void* out, std::size_t n) {
+    if (n > bytes.size() - at)
+      throw core::DataError(file.string() + ": checkpoint truncated at byte " + std::to_string(at) +
+                            "; remove it and run again without --resume");
+    std::memcpy(out, bytes.data() + at, n);
+    at += n;
+  }
+  template <class T>
+  T get() {
+    T v;
+    take(&v, sizeof v);
+    return v;
+  }
+};
+
+std::string key_text(const CheckpointKey& k) {
+  std::ostringstream o;
+  o << "case hash " << std::hex << k.case_hash << ", mesh hash " << k.mesh_hash << std::dec << ", "
+    << k.nodes << " nodes, " << k.tets << " tets, order " << k.order;
+  return o.str();
+}
+
+}  // namespace
+
+CheckpointKey checkpoint_key(const core::CaseSpec& spec, const mesh::TetMesh& mesh) {
+  CheckpointKey k;
+  // The first line names the case file's path: a moved case is still the same case.
+  const std::string toml = resolved_case_toml(spec);
+  const auto body = std::string_view(toml).substr(std::min(toml.size(), toml.find('\n') + 1));
+  k.case_hash = fnv1a(body.data(), body.size());
+  const Eigen::MatrixXd nodes = mesh.nodes;  // column-major copy: hashed in a fixed layout
+  const Eigen::MatrixXi tets = mesh.tets.cast<int>();
+  k.mesh_hash = fnv1a(nodes.data(), static_cast<std::size_t>(nodes.size()) * sizeof(double));
+  k.mesh_hash =
+      fnv1a(tets.data(), static_cast<std::size_t>(tets.size()) * sizeof(int), k.mesh_hash);
+  k.nodes = mesh.nodes.rows();
+  k.tets = mesh.tets.rows();
+  k.order = mesh.order;
+  return k;
+}
+
+fs::path checkpoint_path(const fs::path& out_dir) {
+  fs::path p = out_dir.lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();  // "out/run/" -> "out/run"
+  p += ".checkpoint";
+  return p;
+}
+
+void write_checkpoint(const fs::path& file, const CheckpointKey& key,
+                      const solvers::ThermalCheckpoint& s) {
+  Writer w;
+  w.bytes.append(kMagic, sizeof kMagic);
+  w.put(key.case_hash);
+  w.put(key.mesh_hash);
+  w.put(key.nodes);
+  w.put(key.tets);
+  w.put(key.order);
+  w.put(std::int32_t(s.steps));
+  w.put(s.time);
+  w.put(s.speed);
+  w.put(s.heat_in);
+  w.put(s.lost);
+  w.put(std::int64_t(s.temperature.size()));
+  w.put(std::int64_t(s.outputs.cols()));
+  w.put_doubles(s.temperature.data(), static_cast<std::size_t>(s.temperature.size()));
+  w.put_doubles(s.outputs.data(), static_cast<std::size_t>(s.outputs.size()));
+  w.put(fnv1a(w.bytes.data(), w.bytes.size()));
+  write_file_atomically(file, w.bytes);
+}
+
+solvers::ThermalCheckpoint read_checkpoint(const fs::path& file, const CheckpointKey& key) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::IoError(file.string() + ": cannot open the checkpoint");
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  if (in.bad()) throw core::IoError(file.string() + ": cannot read the checkpoint");
+  const std::string bytes = buf.str();
+  const auto corrupt = [&](const std::string& what) {
+    return core::DataError(file.string() + ": " + what +
+                           "; remove it and run again without --resume");
+  };
+  if (bytes.size() < sizeof kMagic + sizeof(std::uint64_t) ||
+      std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw corrupt("not a thermotwin checkpoint (expected the header TTCKPT01)");
+  std::uint64_t stored_sum;
+  std::memcpy(&stored_sum, bytes.data() + bytes.size() - sizeof stored_sum, sizeof stored_sum);
+  if (fnv1a(bytes.data(), bytes.size() - sizeof stored_sum) != stored_sum)
+    throw corrupt("checkpoint corrupted (checksum mismatch)");
+
+  Reader r{std::string_view(bytes).substr(0, bytes.size() - sizeof stored_sum), file,
+           sizeof kMagic};
+  CheckpointKey k;
+  k.case_hash = r.get<std::uint64_t>();
+  k.mesh_hash = r.get<std::uint64_t>();
+  k.nodes = r.get<std::int64_t>();
+  k.tets = r.get<std::int64_t>();
+  k.order = r.get<std::int32_t>();
+  if (!(k == key))
+    throw core::DataError(file.string() + ": checkpoint written for another case or mesh (" +
+                          key_text(k) + "), this run has " + key_text(key) +
+                          "; remove it, or resume with the case it was written for");
+  solvers::ThermalCheckpoint s;
+  s.steps = r.get<std::int32_t>();
+  s.time = r.get<double>();
+  s.speed = r.get<double>();
+  s.heat_in = r.get<double>();
+  s.lost = r.get<double>();
+  const auto n = r.get<std::int64_t>();
+  const auto cols = r.get<std::int64_t>();
+  if (n != key.nodes || cols < 1 || cols > (1 << 24))
+    throw corrupt("checkpoint holds " + std::to_string(n) + " nodes x " + std::to_string(cols) +
+                  " outputs, expected " + std::to_string(key.nodes) + " nodes");
+  // The sizes are checked against the bytes left before anything is allocated.
+  if (static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(1 + cols) * sizeof(double) !=
+      r.bytes.size() - r.at)
+    throw corrupt("checkpoint size does not match its " + std::to_string(n) + " x " +
+                  std::to_string(cols) + " outputs");
+  s.temperature.resize(n);
+  r.take(s.temperature.data(), static_cast<std::size_t>(n) * sizeof(double));
+  s.outputs.resize(n, cols);
+  r.take(s.outputs.data(), static_cast<std::size_t>(n * cols) * sizeof(double));
+  return s;
+}
+
+}  // namespace tt::io

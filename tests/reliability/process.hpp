@@ -1,0 +1,127 @@
+// Runs build/thermotwin as a child process, as a user or a crash would: to the end, or killed.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace tt::reliability_test {
+
+namespace fs = std::filesystem;
+
+inline const fs::path kThermotwin = fs::path(TT_BINARY_DIR) / "thermotwin";
+inline const fs::path kCoarseCase = fs::path(TT_SOURCE_DIR) / "cases" / "sb1_coarse.toml";
+
+/// A fresh scratch folder for one test, under the build tree.
+inline fs::path scratch(const std::string& name) {
+  const fs::path d = fs::path(TT_BINARY_DIR) / "reliability_scratch" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+/// Starts thermotwin with `args`; `env` entries ("K=V") are added to (or override) the
+/// environment. stdout and stderr go to `log`.
+inline pid_t start(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+                   const fs::path& log = "/dev/null") {
+  std::vector<std::string> envs;
+  for (char** e = environ; *e; ++e) {
+    const std::string s(*e);
+    bool overridden = false;
+    for (const auto& o : env) overridden |= s.substr(0, s.find('=')) == o.substr(0, o.find('='));
+    if (!overridden) envs.push_back(s);
+  }
+  envs.insert(envs.end(), env.begin(), env.end());
+  std::vector<std::string> argv{kThermotwin.string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> cargv, cenv;
+  for (auto& a : argv) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  for (auto& e : envs) cenv.push_back(e.data());
+  cenv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, cargv[0], &actions, nullptr, cargv.data(), cenv.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
+  return pid;
+}
+
+/// Exit code of a child, or 128 + signal when a signal ended it.
+inline int wait_for(pid_t pid) {
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+inline int run(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+               const fs::path& log = "/dev/null") {
+  return wait_for(start(args, env, log));
+}
+
+/// Every regular file under `dir` (relative path -> bytes).
+inline std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  if (!fs::exists(dir)) return files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    files[fs::relative(e.path(), dir).string()] = s.str();
+  }
+  return files;
+}
+
+inline std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A --dump file: the matrices it holds, as (rows, cols, values).
+struct Dumped {
+  std::int64_t rows = 0, cols = 0;
+  std::vector<double> values;
+};
+inline std::vector<Dumped> read_dump(const fs::path& file) {
+  const std::string bytes = read_text(file);
+  std::vector<Dumped> out;
+  std::size_t at = 0;
+  while (at + 16 <= bytes.size()) {
+    Dumped d;
+    std::memcpy(&d.rows, bytes.data() + at, 8);
+    std::memcpy(&d.cols, bytes.data() + at + 8, 8);
+    at += 16;
+    d.values.resize(static_cast<std::size_t>(d.rows * d.cols));
+    if (at + d.values.size() * 8 > bytes.size())
+      throw std::runtime_error(file.string() + ": truncated dump");
+    std::memcpy(d.values.data(), bytes.data() + at, d.values.size() * 8);
+    at += d.values.size() * 8;
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+}  // namespace tt::reliability_test

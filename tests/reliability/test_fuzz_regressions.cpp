@@ -1,0 +1,89 @@
+// Inputs that made a fuzz target fail (fuzz/regressions/<reader>/) stay as tests: each is read by
+// the same entry point and must end in success or a typed project error, never anything else.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "io/case_reader.hpp"
+#include "io/measured_data.hpp"
+#include "tests/reliability/process.hpp"
+#ifdef TT_HAVE_CGAL_SURFACE
+#include "mesh/cgal/surface_body.hpp"
+#endif
+
+namespace tt::reliability_test {
+namespace {
+
+const fs::path kRegressions = fs::path(TT_SOURCE_DIR) / "fuzz" / "regressions";
+
+std::vector<fs::path> inputs(const std::string& reader) {
+  std::vector<fs::path> files;
+  if (fs::is_directory(kRegressions / reader))
+    for (const auto& e : fs::directory_iterator(kRegressions / reader))
+      if (e.is_regular_file()) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// "" when `read` ends in success or a project error, else what escaped.
+template <class Read>
+std::string escaped(Read&& read) {
+  try {
+    read();
+  } catch (const core::Error&) {
+  } catch (const std::exception& e) {
+    return std::string("std::exception: ") + e.what();
+  } catch (...) {
+    return "a non-standard exception";
+  }
+  return "";
+}
+
+TEST(FuzzRegressions, CaseReader) {
+  const auto files = inputs("case");
+  EXPECT_FALSE(files.empty());
+  for (const auto& f : files)
+    EXPECT_EQ(escaped([&] { io::case_from_toml(read_text(f), "/nonexistent-tt-fuzz/case.toml"); }),
+              "")
+        << f;
+}
+
+TEST(FuzzRegressions, MeasuredDataReader) {
+  const auto files = inputs("measured");
+  EXPECT_FALSE(files.empty());
+  const fs::path dir = scratch("fuzz_measured");
+  for (const auto& f : files) {
+    // Same split and limits as fuzz/measured_data_fuzz.cpp.
+    const std::string input = read_text(f), separator = "\n=====\n";
+    const auto cut = input.find(separator);
+    std::ofstream(dir / "meta.json", std::ios::binary) << input.substr(0, cut);
+    std::ofstream(dir / "data.csv", std::ios::binary)
+        << (cut == std::string::npos ? std::string() : input.substr(cut + separator.size()));
+    io::MeasuredReadLimits limits;
+    limits.max_bytes = 64 * 1024;
+    limits.max_rows = 500;
+    if (input.size() % 2 == 0)
+      limits.machine_box =
+          Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
+    EXPECT_EQ(escaped([&] { io::read_measured_run(dir, limits); }), "") << f;
+  }
+}
+
+#ifdef TT_HAVE_CGAL_SURFACE
+TEST(FuzzRegressions, SurfaceReader) {
+  const fs::path dir = scratch("fuzz_surface");
+  for (const auto& f : inputs("surface")) {
+    const std::string input = read_text(f);
+    if (input.empty()) continue;
+    static const char* const extensions[] = {".stl", ".off", ".ply"};
+    const fs::path file =
+        dir / (std::string("surface") + extensions[static_cast<unsigned char>(input[0]) % 3]);
+    std::ofstream(file, std::ios::binary) << input.substr(1);
+    EXPECT_EQ(escaped([&] { mesh::cgal::surface_solid(file, 1e-3, "fuzz body"); }), "") << f;
+  }
+}
+#endif
+
+}  // namespace
+}  // namespace tt::reliability_test
