@@ -38,7 +38,27 @@ struct FitArgs {
   bool quick = false, quiet = false;
 };
 
+/// fit --data RUN...: measured runs with no machine model (app/fit_data_command.cpp).
+struct FitDataArgs {
+  std::vector<std::filesystem::path> runs;
+  std::filesystem::path out;
+  std::optional<double> test_from_s, test_to_s;  /// test window; default: the published one, if any
+  bool quick = false, quiet = false;
+};
+
+/// calibrate: with --case the model-based path, without it the data-driven one.
+struct CalibrateArgs {
+  std::filesystem::path case_file, out;
+  std::vector<std::filesystem::path> train, test;
+  std::optional<double> split_s;  /// a run given as --train and --test: train before, test from
+  bool quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int fit_data_command(const FitDataArgs& args);
+int calibrate_data_command(const CalibrateArgs& args);
+/// calibrate --case CASE (implemented in calibration's driver; a stub until it is wired).
+int calibrate_command_with_case(const CalibrateArgs& args);
 int fit_command(const FitArgs& args);
 int place_command(const PlaceArgs& args);
 int probes_command(const ProbesArgs& args);

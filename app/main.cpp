@@ -61,12 +61,28 @@ int main(int argc, char** argv) {
 
   FitArgs fit_args;
   auto* fit = cli.add_subcommand("fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
-  fit->add_option("case", fit_args.case_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
+  FitDataArgs fit_data_args;
+  auto* fit_case = fit->add_option("case", fit_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
+  auto* fit_data = fit->add_option("--data", fit_data_args.runs, "measured runs (docs/measured-data.md) instead of a case")
+                       ->check(CLI::ExistingDirectory);
+  fit_case->excludes(fit_data);
+  fit->add_option("--test-from-s", fit_data_args.test_from_s, "with --data: test window start (default: published)");
+  fit->add_option("--test-to-s", fit_data_args.test_to_s, "with --data: test window end");
   fit->add_option("--out", fit_args.out, "output directory")->required();
   fit->add_option("--hours", fit_args.hours, "length of each campaign run (the standard's minimum: 5)");
   fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it");
   fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
+
+  CalibrateArgs calibrate_args;
+  auto* calibrate = cli.add_subcommand("calibrate", "Close the loop on measured runs: what the model lacks, before/after");
+  calibrate->add_option("--case", calibrate_args.case_file, "case file (TOML): the model-based path")
+      ->check(CLI::ExistingFile);
+  calibrate->add_option("--train", calibrate_args.train, "measured runs to fit and study on")->check(CLI::ExistingDirectory);
+  calibrate->add_option("--test", calibrate_args.test, "held-out measured runs")->check(CLI::ExistingDirectory);
+  calibrate->add_option("--split-s", calibrate_args.split_s, "a run in both --train and --test: train before, test from");
+  calibrate->add_option("--out", calibrate_args.out, "output directory")->required();
+  calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
 
   CLI11_PARSE(cli, argc, argv);
   // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
@@ -80,7 +96,19 @@ int main(int argc, char** argv) {
         throw tt::core::CaseError("place: give a case file or --from RUNDIR");
       return place_command(place_args);
     }
-    if (*fit) return fit_command(fit_args);
+    if (*fit) {
+      if (!fit_data_args.runs.empty()) {
+        fit_data_args.out = fit_args.out;
+        fit_data_args.quick = fit_args.quick;
+        fit_data_args.quiet = fit_args.quiet;
+        return fit_data_command(fit_data_args);
+      }
+      if (fit_args.case_file.empty()) throw tt::core::CaseError("fit: give a case file or --data RUN...");
+      return fit_command(fit_args);
+    }
+    if (*calibrate)
+      return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
+                                              : calibrate_command_with_case(calibrate_args);
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

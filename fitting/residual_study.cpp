@@ -354,12 +354,14 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   study.target = target;
   study.target_name = training.front().group.target_names[static_cast<std::size_t>(target)];
 
-  // 1. Baseline: forward selection of sensors on the held-out residual; each must remove 1 %.
+  // 1. Baseline: forward selection of sensors on the held-out residual. The first sensor is taken
+  //    even when it alone does not beat the intercept (a pair can when neither alone does); each
+  //    further one must remove 1 %.
   std::vector<int> sensors;
   double rss = heldout_rss(training, target, sensors, {});
   while (static_cast<int>(sensors.size()) < std::min(options.max_sensors, sensor_count)) {
     int best = -1;
-    double best_rss = rss;
+    double best_rss = std::numeric_limits<double>::infinity();
     for (int c = 0; c < sensor_count; ++c) {
       if (std::find(sensors.begin(), sensors.end(), c) != sensors.end()) continue;
       std::vector<int> trial = sensors;
@@ -374,8 +376,6 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
     sensors.push_back(best);
     rss = best_rss;
   }
-  if (sensors.empty())
-    sensors.push_back(sensors_by_correlation(segment_groups(training), target, 1).front());
   rss = heldout_rss(training, target, sensors, {});
   study.heldout_rss_before = rss;
   const double baseline_rss = rss;
