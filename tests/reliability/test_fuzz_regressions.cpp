@@ -6,7 +6,6 @@
 
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
-#include "io/measured_data.hpp"
 #include "tests/reliability/process.hpp"
 #ifdef TT_HAVE_CGAL_SURFACE
 #include "mesh/cgal/surface_body.hpp"
@@ -47,27 +46,6 @@ TEST(FuzzRegressions, CaseReader) {
     EXPECT_EQ(escaped([&] { io::case_from_toml(read_text(f), "/nonexistent-tt-fuzz/case.toml"); }),
               "")
         << f;
-}
-
-TEST(FuzzRegressions, MeasuredDataReader) {
-  const auto files = inputs("measured");
-  EXPECT_FALSE(files.empty());
-  const fs::path dir = scratch("fuzz_measured");
-  for (const auto& f : files) {
-    // Same split and limits as fuzz/measured_data_fuzz.cpp.
-    const std::string input = read_text(f), separator = "\n=====\n";
-    const auto cut = input.find(separator);
-    std::ofstream(dir / "meta.json", std::ios::binary) << input.substr(0, cut);
-    std::ofstream(dir / "data.csv", std::ios::binary)
-        << (cut == std::string::npos ? std::string() : input.substr(cut + separator.size()));
-    io::MeasuredReadLimits limits;
-    limits.max_bytes = 64 * 1024;
-    limits.max_rows = 500;
-    if (input.size() % 2 == 0)
-      limits.machine_box =
-          Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1));
-    EXPECT_EQ(escaped([&] { io::read_measured_run(dir, limits); }), "") << f;
-  }
 }
 
 #ifdef TT_HAVE_CGAL_SURFACE

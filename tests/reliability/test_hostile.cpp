@@ -1,9 +1,7 @@
-// Hostile numbers from the shop floor: each gets a clear typed error naming the value, or is
-// handled within bounded memory. NaN and infinities in case files and measured data, a time step
-// longer than the run, zero conductivity, a heat source on a region with no elements, 10 000
-// sensors, and a data.csv beyond its size or row limit (the 1 GB file is in test_big_csv, long).
+// Hostile numbers in case files: each gets a clear typed error naming the value. NaN and
+// infinities, a time step longer than the run, zero conductivity, a heat source on a region with
+// no elements. Measured data: test_hostile_data.cpp.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +12,6 @@
 
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
-#include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/thermal.hpp"
 
@@ -166,119 +163,6 @@ enabled = false
     EXPECT_NE(std::string(e.what()).find("pad heat"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("no elements"), std::string::npos) << e.what();
   }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Measured data
-
-struct Folder {
-  fs::path dir;
-  explicit Folder(const std::string& name)
-      : dir(fs::path(TT_BINARY_DIR) / "reliability_scratch" / name) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  void write(const std::string& file, const std::string& text) const {
-    std::ofstream(dir / file) << text;
-  }
-};
-
-std::string meta_with_sensors(int n) {
-  std::string m = R"({"format": "thermal-measurement/1", "machine": "bench", "run": "r1",
-    "time_unit": "s", "temperature_unit": "degC", "displacement_unit": "um",
-    "displacements": [], "inputs": [{"id": "speed_rpm", "unit": "rpm"}], "sensors": [)";
-  for (int i = 0; i < n; ++i)
-    m += (i ? ", " : "") + std::string("{\"id\": \"T") + std::to_string(i) +
-         "\", \"position\": null}";
-  return m + "]}";
-}
-
-std::string data_error(const Folder& f, const io::MeasuredReadLimits& limits = {}) {
-  try {
-    io::read_measured_run(f.dir, limits);
-  } catch (const core::DataError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-TEST(HostileData, NonFiniteCellsAreRefusedWithLineAndColumn) {
-  for (const std::string cell : {"nan", "NaN", "inf", "-inf", "1e999"}) {
-    Folder f("data_nonfinite");
-    f.write("meta.json", meta_with_sensors(2));
-    f.write("data.csv", "time_s,speed_rpm,T0,T1\n0,0,20,20\n10,0,20.5," + cell + "\n");
-    const std::string msg = data_error(f);
-    EXPECT_NE(msg.find("data.csv"), std::string::npos) << cell << " -> " << msg;
-    EXPECT_NE(msg.find(":3"), std::string::npos) << cell << " -> " << msg;
-    EXPECT_NE(msg.find("T1"), std::string::npos) << cell << " -> " << msg;
-  }
-}
-
-TEST(HostileData, NonFiniteTimeAndMetaNumbersAreRefused) {
-  Folder f("data_nonfinite_time");
-  f.write("meta.json", meta_with_sensors(1));
-  f.write("data.csv", "time_s,speed_rpm,T0\n0,0,20\ninf,0,20\n");
-  EXPECT_NE(data_error(f).find("time_s"), std::string::npos) << data_error(f);
-  // JSON has no NaN: the reader names the file.
-  std::string meta = meta_with_sensors(1);
-  meta.insert(meta.size() - 1, ", \"initial_temperature_degC\": NaN");
-  f.write("meta.json", meta);
-  f.write("data.csv", "time_s,speed_rpm,T0\n0,0,20\n");
-  EXPECT_NE(data_error(f).find("meta.json"), std::string::npos) << data_error(f);
-}
-
-TEST(HostileData, TenThousandSensorsReadInBoundedMemory) {
-  constexpr int kSensors = 10000, kRows = 200;
-  Folder f("data_10k_sensors");
-  f.write("meta.json", meta_with_sensors(kSensors));
-  std::string csv = "time_s,speed_rpm";
-  for (int i = 0; i < kSensors; ++i) csv += ",T" + std::to_string(i);
-  csv += "\n";
-  for (int r = 0; r < kRows; ++r) {
-    csv += std::to_string(10 * r) + ",3000";
-    for (int i = 0; i < kSensors; ++i) csv += (i % 97 == 0) ? "," : ",20.25";
-    csv += "\n";
-  }
-  f.write("data.csv", csv);
-  rusage before{};
-  getrusage(RUSAGE_SELF, &before);
-  const io::MeasuredRun run = io::read_measured_run(f.dir);
-  rusage after{};
-  getrusage(RUSAGE_SELF, &after);
-  ASSERT_EQ(run.temperature.rows(), kRows);
-  ASSERT_EQ(run.temperature.cols(), kSensors);
-  EXPECT_TRUE(std::isnan(run.temperature(5, 97)));  // empty cell: missing, never zero
-  EXPECT_DOUBLE_EQ(run.temperature(5, 98), 20.25 + 273.15);
-  // 2 M values are 16 MB; the reader may hold a few copies, never hundreds of MB.
-  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 200 * 1024)
-      << "peak RSS grew by " << after.ru_maxrss - before.ru_maxrss << " kB";
-}
-
-TEST(HostileData, CsvBeyondTheByteLimitIsRefusedBeforeReading) {
-  Folder f("data_bytes");
-  f.write("meta.json", meta_with_sensors(1));
-  std::string csv = "time_s,speed_rpm,T0\n";
-  for (int r = 0; r < 2000; ++r) csv += std::to_string(r) + ",0,20\n";
-  f.write("data.csv", csv);
-  io::MeasuredReadLimits limits;
-  limits.max_bytes = 4096;
-  const std::string msg = data_error(f, limits);
-  EXPECT_NE(msg.find("exceeds the limit of 4096 bytes"), std::string::npos) << msg;
-}
-
-TEST(HostileData, CsvBeyondTheRowLimitIsRefusedAtThatRow) {
-  Folder f("data_rows");
-  f.write("meta.json", meta_with_sensors(1));
-  std::string csv = "time_s,speed_rpm,T0\n";
-  for (int r = 0; r < 2000; ++r) csv += std::to_string(r) + ",0,20\n";
-  f.write("data.csv", csv);
-  io::MeasuredReadLimits limits;
-  limits.max_rows = 100;
-  const std::string msg = data_error(f, limits);
-  EXPECT_NE(msg.find("more than 100 rows"), std::string::npos) << msg;
-  EXPECT_NE(msg.find(":102"), std::string::npos) << msg;  // header is line 1, row 101 is line 102
-  limits.max_rows = 2000;
-  EXPECT_EQ(io::read_measured_run(f.dir, limits).time.size(), 2000);
 }
 
 }  // namespace
