@@ -40,11 +40,9 @@ fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResul
   g.name = r.name;
   g.time = h.times;
   g.temperature = h.temperature;
-  g.error.resize(h.times.size(), 2);
-  g.error.col(0) = h.dy;
-  g.error.col(1) = h.dz;
+  g.error = h.targets;
   g.sensor_names = h.names;
-  g.target_names = {"dy", "dz"};
+  g.target_names = h.target_names;
   return g;
 }
 
@@ -67,7 +65,8 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
   in.positions_m = positions;
   in.times_s.resize(rows);
   in.temperatures_K.resize(rows, g0.temperature.cols());
-  Eigen::VectorXd dy(rows), dz(rows);
+  const Eigen::Index targets = g0.error.cols();
+  Eigen::MatrixXd error(rows, targets);
   Eigen::Index r = 0;
   double offset = 0;
   for (int i : fit) {
@@ -75,12 +74,12 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
     const Eigen::Index n = g.time.size();
     in.times_s.segment(r, n) = g.time.array() + offset;
     in.temperatures_K.middleRows(r, n) = g.temperature;
-    dy.segment(r, n) = g.error.col(0);
-    dz.segment(r, n) = g.error.col(1);
+    error.middleRows(r, n) = g.error;
     offset += g.time(n - 1) + 1.0;
     r += n;
   }
-  in.targets = {{"dy", dy}, {"dz", dz}};
+  for (Eigen::Index k = 0; k < targets; ++k)
+    in.targets.push_back({g0.target_names[k], error.col(k)});
   placement::PlacementOptions options;
   options.samples = 0;  // every reading of the campaign, not the patent's 100
   options.seed = seed;
@@ -132,7 +131,7 @@ int fit_command(const FitArgs& args) {
   std::vector<fitting::Evaluation> evals;
   std::vector<fitting::SensorCountTable> tables;
   nlohmann::json summary = nlohmann::json::object();
-  for (int target = 0; target < 2; ++target) {
+  for (int target = 0; target < static_cast<int>(groups[0].target_names.size()); ++target) {
     std::vector<fitting::SensorSet> at_most_4 = sensor_sets(placed, target, 4);
     const auto corr = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, 4);
     at_most_4.insert(at_most_4.end(), corr.begin(), corr.end());

@@ -32,7 +32,8 @@ placement::PlacementInput placement_input(const Histories& h) {
   in.positions_m = h.positions;
   in.times_s = h.times;
   in.temperatures_K = h.temperature;
-  in.targets = {{"dy", h.dy}, {"dz", h.dz}};
+  for (size_t k = 0; k < h.target_names.size(); ++k)
+    in.targets.push_back({h.target_names[k], h.targets.col(static_cast<Eigen::Index>(k))});
   return in;
 }
 

@@ -15,11 +15,22 @@ std::vector<int> candidate_points(const core::CaseSpec& spec) {
   for (size_t i = 0; i < spec.points.size(); ++i) {
     const auto& id = spec.points[i].id;
     const auto& probes = spec.mechanical.probe_points;
-    if (id == spec.mechanical.tcp_point || std::find(probes.begin(), probes.end(), id) != probes.end()) continue;
+    const auto& axis = spec.mechanical.axis_points;
+    if (id == spec.mechanical.tcp_point ||
+        std::find(probes.begin(), probes.end(), id) != probes.end() ||
+        std::find(axis.begin(), axis.end(), id) != axis.end())
+      continue;
     out.push_back(static_cast<int>(i));
   }
   if (out.empty()) throw core::CaseError(spec.source.string() + ": no named points to use as candidate sensors");
   return out;
+}
+
+int target_column(const std::string& target) {
+  if (target == "dx") return solvers::kDx;
+  if (target == "dy") return solvers::kDy;
+  if (target == "dz") return solvers::kDz;
+  throw core::CaseError("target '" + target + "': expected \"dx\", \"dy\" or \"dz\"");
 }
 
 Histories histories_from_points(const core::CaseSpec& spec, const std::vector<double>& times,
@@ -34,8 +45,10 @@ Histories histories_from_points(const core::CaseSpec& spec, const std::vector<do
     h.positions.row(static_cast<Eigen::Index>(c)) = spec.points[cand[c]].position.transpose();
     h.temperature.col(static_cast<Eigen::Index>(c)) = point_temperature.col(cand[c]);
   }
-  h.dy = error.col(solvers::kDy);
-  h.dz = error.col(solvers::kDz);
+  h.target_names = spec.mechanical.targets;
+  h.targets.resize(error.rows(), static_cast<Eigen::Index>(h.target_names.size()));
+  for (size_t k = 0; k < h.target_names.size(); ++k)
+    h.targets.col(static_cast<Eigen::Index>(k)) = error.col(target_column(h.target_names[k]));
   return h;
 }
 
@@ -51,8 +64,8 @@ Histories histories_from_run(const std::filesystem::path& dir) {
     point_temperature.col(static_cast<Eigen::Index>(i)) = temps.rows.col(col).array() + solvers::kCelsiusOffset;
   }
   Eigen::MatrixXd error = Eigen::MatrixXd::Zero(err.rows.rows(), solvers::kThermalErrorColumns);
-  error.col(solvers::kDy) = 1e-6 * err.column("dy_um");
-  error.col(solvers::kDz) = 1e-6 * err.column("dz_um");
+  for (const auto& t : spec.mechanical.targets)
+    error.col(target_column(t)) = 1e-6 * err.column(t + "_um");
   const Eigen::VectorXd t = temps.column("time_s");
   return histories_from_points(spec, std::vector<double>(t.data(), t.data() + t.size()), point_temperature, error);
 }

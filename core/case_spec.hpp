@@ -93,6 +93,19 @@ struct DutyCycle {
   double end = 0;                 /// [s]
 };
 
+/// A feed axis's motion over time: piecewise segments, each standing at `from` or reciprocating
+/// between `from` and `to` at a constant feed speed (starting at `from`, towards `to`).
+struct FeedAxis {
+  struct Segment {
+    double start = 0;         /// [s]
+    double from = 0, to = 0;  /// positions along the axis [m]; from == to: standing
+    double feed = 0;          /// feed speed [m/s]; 0: standing at `from`
+  };
+  std::string name;               /// "X"
+  int direction = 0;              /// coordinate it moves along: 0 x, 1 y, 2 z
+  std::vector<Segment> segments;  /// start times ascending, first at 0; empty: no feed axis
+};
+
 /// A time series sampled at points and linearly interpolated (constant outside).
 struct TimeTable {
   std::vector<double> time;   /// [s]
@@ -103,7 +116,7 @@ struct TimeTable {
 struct HeatSource {
   std::string name;
   int body = -1;
-  enum class Law { speed_power, constant, palmgren };
+  enum class Law { speed_power, constant, palmgren, feed_power };
   Law law = Law::speed_power;
   double power_ref = 0;       /// [W] at ref_speed (speed_power) or always (constant)
   double ref_speed_rpm = 0;   /// [rpm]
@@ -111,6 +124,10 @@ struct HeatSource {
   /// Palmgren: M = M0 + M1, M0 = 1e-7 f0 (nu n)^(2/3) dm^3 (nu n >= 2000), M1 = f1 P1 dm; Q = M w
   double palmgren_f0 = 0, palmgren_nu_cSt = 0, palmgren_dm = 0, palmgren_f1 = 0, palmgren_p1 = 0;
   double temperature_coefficient = 0;  /// [1/K]: Q multiplied by (1 + c (T_mean - T0))
+  double ref_feed = 0;       /// [m/s] feed_power: Q = power_ref (v / ref_feed)^exponent, 0 at v = 0
+  double window = 0;         /// [m] > 0: moves with the feed axis, only the body's part within
+                             /// window/2 of (axis position + window_offset) is heated
+  double window_offset = 0;  /// [m] window centre relative to the axis position
 };
 
 struct Convection {
@@ -155,6 +172,10 @@ struct MechanicalSpec {
   std::vector<int> fixed_groups;         /// boundary groups fixed in all directions
   std::string tcp_point;                 /// id of the tool centre point
   std::vector<std::string> probe_points; /// ids of the two axial probe points (z1, z2)
+  /// TCP error directions ("dx", "dy", "dz") that placement and fitting aim at, each on its own
+  std::vector<std::string> targets = {"dy", "dz"};
+  std::vector<std::string> axis_points;  /// ids of measurement points along the feed axis
+  int axis_polynomial_degree = 3;        /// degree of the error polynomial in axis position
 };
 
 struct OutputSpec {
@@ -174,6 +195,7 @@ struct CaseSpec {
   std::vector<NamedPoint> points;
   MeshOptions mesh;
   DutyCycle duty_cycle;
+  FeedAxis feed_axis;
   ThermalSpec thermal;
   MechanicalSpec mechanical;
   OutputSpec outputs;

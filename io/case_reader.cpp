@@ -780,6 +780,18 @@ void read_duty_cycle(const Tab& root, CaseSpec& spec) {
                    number_text(spec.duty_cycle.segments.back().start));
 }
 
+/// A feed speed in m/s from `<stem>_m_min` (as people write it) or `<stem>_m_s` (as the resolved
+/// case writes it, exactly), one of the two.
+double feed_speed(const Tab& t, const std::string& stem, Sign sign) {
+  const std::string per_min = stem + "_m_min", per_s = stem + "_m_s";
+  const toml::node* a = t.get(per_min);
+  const toml::node* b = t.get(per_s);
+  if (a && b)
+    fail_value(*t.ctx, *b, t.at(per_s), "give either " + per_min + " or " + per_s + ", not both");
+  if (b) return number(t, per_s, sign, "feed speed in m/s");
+  return number(t, per_min, sign, "feed speed in m/min") / 60.0;
+}
+
 core::TimeTable sink_table(const Ctx& c, const toml::node& n, const std::string& path) {
   const auto& a = as_array(c, n, path, "[[t_s, degC], ...]");
   if (a.empty()) fail_value(c, n, path, "must hold at least one [t_s, degC] row");
@@ -859,9 +871,13 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
   const Names law_keys_const = {"power_ref_W"};
   const Names law_keys_palm = {"palmgren_f0", "palmgren_nu_cSt", "palmgren_dm", "palmgren_f1",
                                "palmgren_p1_N"};
+  const Names law_keys_feed = {"power_ref_W", "ref_feed_m_min", "ref_feed_m_s", "exponent"};
   Names all_keys = {"name",        "body",          "law",     "temperature_coefficient_per_K",
                     "power_ref_W", "ref_speed_rpm", "exponent"};
   all_keys.insert(all_keys.end(), law_keys_palm.begin(), law_keys_palm.end());
+  all_keys.push_back("ref_feed_m_min");
+  all_keys.push_back("ref_feed_m_s");
+  all_keys.push_back("moving");  // after the law keys: not a law key itself
   each_table(t, "heat_sources", [&](const Tab& h, std::size_t) {
     h.allow(all_keys);
     core::HeatSource src;
@@ -871,14 +887,16 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
     src.law = choice_or<Law>(h, "law", Law::speed_power,
                              {{"speed_power", Law::speed_power},
                               {"constant", Law::constant},
-                              {"palmgren", Law::palmgren}});
-    const Names& used = src.law == Law::speed_power ? law_keys_speed
-                        : src.law == Law::constant  ? law_keys_const
-                                                    : law_keys_palm;
+                              {"palmgren", Law::palmgren},
+                              {"feed_power", Law::feed_power}});
+    const Names& used = src.law == Law::speed_power  ? law_keys_speed
+                        : src.law == Law::constant   ? law_keys_const
+                        : src.law == Law::feed_power ? law_keys_feed
+                                                     : law_keys_palm;
     const std::string law_name = h.get("law") ? as_string(c, *h.get("law"), "") : "speed_power";
     for (auto&& [k, v] : *h.t) {
-      const bool law_key =
-          std::find(all_keys.begin() + 4, all_keys.end(), k.str()) != all_keys.end();
+      const bool law_key = k.str() != "moving" && std::find(all_keys.begin() + 4, all_keys.end(),
+                                                            k.str()) != all_keys.end();
       if (law_key && std::find(used.begin(), used.end(), k.str()) == used.end())
         fail(c, line_of(v),
              h.at(k.str()) + " = " + value_text(v) + ": not used by law = \"" + law_name +
@@ -890,6 +908,13 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
       src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
     } else if (src.law == Law::constant) {
       src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat in W");
+    } else if (src.law == Law::feed_power) {
+      if (spec.feed_axis.segments.empty())
+        fail_value(c, *h.get("law"), h.at("law"), "needs a [feed_axis] table",
+                   "declare the axis's motion in [feed_axis]");
+      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_feed_m_min in W");
+      src.ref_feed = feed_speed(h, "ref_feed", Sign::positive);
+      src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
     } else {
       src.palmgren_f0 = number(h, "palmgren_f0", Sign::positive, "bearing type factor f0");
       src.palmgren_nu_cSt =
@@ -899,6 +924,16 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
       src.palmgren_p1 = number(h, "palmgren_p1_N", Sign::non_negative, "equivalent load in N");
     }
     src.temperature_coefficient = number_or(h, "temperature_coefficient_per_K", 0.0);
+    if (const auto* mv = h.get("moving")) {
+      const Tab w = as_tab(c, *mv, h.at("moving"), "an inline table { window, offset }");
+      w.allow({"window", "offset"});
+      if (spec.feed_axis.segments.empty())
+        fail_value(c, *mv, h.at("moving"), "needs a [feed_axis] table to move with");
+      if (src.temperature_coefficient != 0)
+        fail_value(c, *mv, h.at("moving"), "cannot be combined with temperature_coefficient_per_K");
+      src.window = length(w, "window", Sign::positive, "length of the heated part in length_unit");
+      src.window_offset = number_or(w, "offset", 0.0) / c.length_divisor;
+    }
     th.sources.push_back(src);
   });
 
@@ -931,6 +966,84 @@ void check_step(const Tab& root, const CaseSpec& spec) {
            "; set step_s in [thermal]");
 }
 
+/// [feed_axis]: segments = [{ start_s, from, to, feed_m_min } | { start_s, position }, ...].
+void read_feed_axis(const Tab& root, CaseSpec& spec) {
+  const toml::node* n = root.get("feed_axis");
+  if (!n) return;
+  const Tab f = as_tab(*root.ctx, *n, "feed_axis");
+  const Ctx& c = *f.ctx;
+  f.allow({"name", "direction", "segments"});
+  auto& ax = spec.feed_axis;
+  ax.name = f.get("name") ? name(f, "name") : "X";
+  ax.direction = choice_or<int>(f, "direction", 0, {{"x", 0}, {"y", 1}, {"z", 2}});
+  const auto& sn = f.need("segments", "segments = [{ start_s, from, to, feed_m_min }, ...]");
+  each_table(f, "segments", [&](const Tab& s, std::size_t i) {
+    s.allow({"start_s", "from", "to", "feed_m_min", "feed_m_s", "position"});
+    core::FeedAxis::Segment seg;
+    const auto& st = s.need("start_s", "a time in s");
+    seg.start = as_number(c, st, s.at("start_s"));
+    if (i == 0 && seg.start != 0)
+      fail_value(c, st, s.at("start_s"), "the first segment must start at 0");
+    if (i > 0 && !(seg.start > ax.segments.back().start))
+      fail_value(c, st, s.at("start_s"),
+                 "must exceed the previous start " + number_text(ax.segments.back().start),
+                 "segments must be in ascending time order");
+    if (!(seg.start < spec.duty_cycle.end))
+      fail_value(c, st, s.at("start_s"),
+                 "must be before duty_cycle.end_s = " + number_text(spec.duty_cycle.end));
+    if (const auto* pos = s.get("position")) {
+      for (const char* k : {"from", "to", "feed_m_min", "feed_m_s"})
+        if (const auto* x = s.get(k))
+          fail_value(c, *x, s.at(k), "not used with position (a standing axis)");
+      seg.from = seg.to = checked(c, *pos, s.at("position"), Sign::any, "") / c.length_divisor;
+    } else {
+      seg.from = number(s, "from", Sign::any, "where the stroke starts, in length_unit") /
+                 c.length_divisor;
+      seg.to =
+          number(s, "to", Sign::any, "where the stroke turns, in length_unit") / c.length_divisor;
+      seg.feed = feed_speed(s, "feed", Sign::non_negative);
+    }
+    ax.segments.push_back(seg);
+  });
+  if (ax.segments.empty()) fail_value(c, sn, f.at("segments"), "must hold at least one segment");
+}
+
+/// mechanical.targets, axis_points and axis_polynomial_degree.
+void read_axis_keys(const Tab& m, CaseSpec& spec) {
+  const Ctx& c = *m.ctx;
+  auto& me = spec.mechanical;
+  if (const auto* t = m.get("targets")) {
+    const auto& a = as_array(c, *t, m.at("targets"), "an array of directions [\"dy\", \"dz\"]");
+    if (a.empty()) fail_value(c, *t, m.at("targets"), "must name at least one direction");
+    me.targets.clear();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const std::string p = m.at("targets") + "[" + std::to_string(i) + "]";
+      const std::string d =
+          choice<std::string>(c, a[i], p, {{"dx", "dx"}, {"dy", "dy"}, {"dz", "dz"}});
+      if (std::find(me.targets.begin(), me.targets.end(), d) != me.targets.end())
+        fail_value(c, a[i], p, "listed twice");
+      me.targets.push_back(d);
+    }
+  }
+  if (const auto* a = m.get("axis_points")) {
+    if (spec.feed_axis.segments.empty())
+      fail_value(c, *a, m.at("axis_points"), "needs a [feed_axis] table (the axis they lie along)");
+    for (int i : references(c, *a, m.at("axis_points"), point_ids(spec), "point"))
+      me.axis_points.push_back(spec.points[i].id);
+  }
+  if (const auto* d = m.get("axis_polynomial_degree")) {
+    const auto v = integer(c, *d, m.at("axis_polynomial_degree"));
+    if (v < 0 || v > 9) fail_value(c, *d, m.at("axis_polynomial_degree"), "must lie in [0, 9]");
+    me.axis_polynomial_degree = static_cast<int>(v);
+  }
+  if (!me.axis_points.empty() &&
+      static_cast<int>(me.axis_points.size()) <= me.axis_polynomial_degree)
+    fail_value(c, *m.get("axis_points"), m.at("axis_points"),
+               "needs more points (" + std::to_string(me.axis_points.size()) +
+                   ") than the polynomial degree " + std::to_string(me.axis_polynomial_degree),
+               "add points or lower axis_polynomial_degree");
+}
+
 void read_mechanical(const Tab& root, CaseSpec& spec) {
   auto& me = spec.mechanical;
   const toml::node* n = root.get("mechanical");
@@ -943,7 +1056,8 @@ void read_mechanical(const Tab& root, CaseSpec& spec) {
   }
   const Tab m = as_tab(*root.ctx, *n, "mechanical");
   const Ctx& c = *m.ctx;
-  m.allow({"enabled", "reference_temperature_degC", "fixed", "point_supports", "tcp", "probes"});
+  m.allow({"enabled", "reference_temperature_degC", "fixed", "point_supports", "tcp", "probes",
+           "targets", "axis_points", "axis_polynomial_degree"});
   me.enabled = flag_or(m, "enabled", me.enabled);
   me.reference_temperature_c =
       number_or(m, "reference_temperature_degC", me.reference_temperature_c);
@@ -988,6 +1102,7 @@ void read_mechanical(const Tab& root, CaseSpec& spec) {
       fail_value(c, *p, m.at("probes"), "expected two point ids [z1, z2]");
     for (int i : idx) me.probe_points.push_back(spec.points[i].id);
   }
+  read_axis_keys(m, spec);
 }
 
 void read_outputs(const Tab& root, CaseSpec& spec) {
@@ -1007,7 +1122,7 @@ void read_outputs(const Tab& root, CaseSpec& spec) {
 CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file) {
   const Tab r{&ctx, &root, ""};
   r.allow({"case", "geometry", "materials", "bodies", "mesh", "boundary", "points", "duty_cycle",
-           "thermal", "mechanical", "outputs"});
+           "thermal", "mechanical", "outputs", "feed_axis"});
   CaseSpec spec;
   spec.source = file;
   read_header(r, spec);
@@ -1021,6 +1136,7 @@ CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file)
   read_boundary(r, spec);
   read_points(r, spec);
   read_duty_cycle(r, spec);
+  read_feed_axis(r, spec);
   read_thermal(r, spec);
   check_step(r, spec);
   read_mechanical(r, spec);
@@ -1193,6 +1309,10 @@ std::string resolved_case_toml(const CaseSpec& spec) {
         << "\nexponent = " << number_text(s.exponent) << "\n";
     } else if (s.law == Law::constant) {
       o << "\"constant\"\npower_ref_W = " << number_text(s.power_ref) << "\n";
+    } else if (s.law == Law::feed_power) {
+      o << "\"feed_power\"\npower_ref_W = " << number_text(s.power_ref)
+        << "\nref_feed_m_s = " << number_text(s.ref_feed)
+        << "\nexponent = " << number_text(s.exponent) << "\n";
     } else {
       o << "\"palmgren\"\npalmgren_f0 = " << number_text(s.palmgren_f0)
         << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
@@ -1201,6 +1321,9 @@ std::string resolved_case_toml(const CaseSpec& spec) {
         << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
     }
     o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
+    if (s.window > 0)
+      o << "moving = { window = " << number_text(s.window)
+        << ", offset = " << number_text(s.window_offset) << " }\n";
   }
   for (const auto& f : th.fluxes) {
     o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
@@ -1212,8 +1335,18 @@ std::string resolved_case_toml(const CaseSpec& spec) {
   for (const auto& s : spec.duty_cycle.segments)
     o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
       << " },\n";
+  o << "]\n";
+  if (!spec.feed_axis.segments.empty()) {
+    const auto& ax = spec.feed_axis;
+    o << "\n[feed_axis]\nname = " << toml_string(ax.name) << "\ndirection = \""
+      << "xyz"[ax.direction] << "\"\nsegments = [\n";
+    for (const auto& s : ax.segments)
+      o << "  { start_s = " << number_text(s.start) << ", from = " << number_text(s.from)
+        << ", to = " << number_text(s.to) << ", feed_m_s = " << number_text(s.feed) << " },\n";
+    o << "]\n";
+  }
   const auto& me = spec.mechanical;
-  o << "]\n\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
+  o << "\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
     << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
     << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
   for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
@@ -1227,6 +1360,10 @@ std::string resolved_case_toml(const CaseSpec& spec) {
   o << "]\n";
   if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
   o << "probes = " << strings_text(me.probe_points) << "\n";
+  o << "targets = " << strings_text(me.targets) << "\n";
+  if (!me.axis_points.empty())
+    o << "axis_points = " << strings_text(me.axis_points)
+      << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
   o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
     << "\nfields = " << (spec.outputs.fields ? "true" : "false")
     << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval)

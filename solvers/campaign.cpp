@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "core/rng.hpp"
 #include "solvers/elastic.hpp"
+#include "solvers/loads.hpp"
 #include "solvers/thermal_error.hpp"
 
 namespace tt::solvers {
@@ -12,8 +13,35 @@ namespace {
 
 using Segment = core::DutyCycle::Segment;
 
+/// A feed-axis program that follows the spindle: while it runs, the axis reciprocates over the
+/// base case's first stroke at that stroke's feed scaled by n / n_base (a constant feed per tooth);
+/// while it stands, the axis stands where the base case's first standing segment puts it.
+std::vector<core::FeedAxis::Segment> feed_following(const core::CaseSpec& base,
+                                                    const std::vector<Segment>& spindle) {
+  const auto& segs = base.feed_axis.segments;
+  const auto stroke = std::find_if(segs.begin(), segs.end(),
+                                   [](const auto& s) { return s.feed > 0 && s.from != s.to; });
+  const auto rest = std::find_if(segs.begin(), segs.end(),
+                                 [](const auto& s) { return s.feed <= 0 || s.from == s.to; });
+  const double park = rest != segs.end() ? rest->from : stroke->from;
+  const double n_base = speed_at(base.duty_cycle, stroke->start);
+  std::vector<core::FeedAxis::Segment> out;
+  for (const auto& s : spindle) {
+    if (s.speed_rpm > 0)
+      out.push_back({s.start, stroke->from, stroke->to,
+                     stroke->feed * (n_base > 0 ? s.speed_rpm / n_base : 1.0)});
+    else
+      out.push_back({s.start, park, park, 0.0});
+  }
+  return out;
+}
+
 core::CaseSpec with_cycle(const core::CaseSpec& base, std::vector<Segment> segments, double end) {
   core::CaseSpec s = base;
+  const auto& feed = base.feed_axis.segments;
+  if (std::any_of(feed.begin(), feed.end(),
+                  [](const auto& f) { return f.feed > 0 && f.from != f.to; }))
+    s.feed_axis.segments = feed_following(base, segments);
   s.duty_cycle.segments = std::move(segments);
   s.duty_cycle.end = end;
   return s;

@@ -22,7 +22,9 @@ struct CampaignRun {
 /// At least eight runs of `hours` each (the standard's minimum is 5 h), derived from `base`:
 /// P-1 extended, speed staircases up and down, irregular on/off cycles at several speeds (seeded
 /// from `seed`), a run starting at a warmer uniform ambient, one whose ambient drifts, a
-/// run-then-cool-down. The base case's own duty cycle is ignored.
+/// run-then-cool-down. The base case's own duty cycle is ignored; a feed axis that moves in the
+/// base case reciprocates over its first stroke while the spindle runs (feed scaled with the
+/// spindle speed) and stands while it stops.
 std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed);
 
 struct CampaignResult {

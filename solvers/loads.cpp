@@ -17,9 +17,16 @@ double speed_at(const core::DutyCycle& cycle, double t) {
 }
 
 double source_power(const core::HeatSource& s, double n) {
+  return source_power(s, n, 0.0);
+}
+
+double source_power(const core::HeatSource& s, double n, double feed) {
   using Law = core::HeatSource::Law;
   switch (s.law) {
     case Law::constant: return s.power_ref;
+    case Law::feed_power:
+      if (feed <= 0) return 0.0;
+      return s.power_ref * std::pow(feed / s.ref_feed, s.exponent);
     case Law::speed_power:
       if (n <= 0) return 0.0;
       return s.power_ref * std::pow(n / s.ref_speed_rpm, s.exponent);
@@ -35,6 +42,37 @@ double source_power(const core::HeatSource& s, double n) {
     }
   }
   return 0.0;
+}
+
+namespace {
+
+/// The feed-axis segment in force at t (a switch at t belongs to the segment that starts there).
+const core::FeedAxis::Segment* feed_segment_at(const core::FeedAxis& axis, double t) {
+  const core::FeedAxis::Segment* seg = axis.segments.empty() ? nullptr : &axis.segments.front();
+  for (const auto& s : axis.segments)
+    if (s.start <= t) seg = &s;
+  return seg;
+}
+
+bool standing(const core::FeedAxis::Segment& s) {
+  return s.feed <= 0 || s.from == s.to;
+}
+
+}  // namespace
+
+double feed_speed_at(const core::FeedAxis& axis, double t) {
+  const auto* s = feed_segment_at(axis, t);
+  return s && !standing(*s) ? s->feed : 0.0;
+}
+
+double axis_position_at(const core::FeedAxis& axis, double t) {
+  const auto* s = feed_segment_at(axis, t);
+  if (!s) return 0.0;
+  if (standing(*s)) return s->from;
+  const double stroke = std::abs(s->to - s->from);
+  const double travelled = std::fmod(std::max(0.0, t - s->start) * s->feed, 2 * stroke);
+  const double along = travelled <= stroke ? travelled : 2 * stroke - travelled;
+  return s->from + (s->to > s->from ? along : -along);
 }
 
 double film_coefficient(const core::Convection& c, double n) {
@@ -56,6 +94,8 @@ std::vector<double> switch_times(const core::CaseSpec& spec) {
   const double end = spec.duty_cycle.end;
   std::vector<double> s;
   for (const auto& seg : spec.duty_cycle.segments)
+    if (seg.start > 0 && seg.start < end) s.push_back(seg.start);
+  for (const auto& seg : spec.feed_axis.segments)
     if (seg.start > 0 && seg.start < end) s.push_back(seg.start);
   for (const auto& c : spec.thermal.convection)
     if (c.sink.time.size() > 1)
@@ -91,12 +131,15 @@ std::vector<double> output_times(const core::CaseSpec& spec) {
 }
 
 double heat_delivered(const core::CaseSpec& spec) {
-  const auto& segs = spec.duty_cycle.segments;
-  double total = 0;
-  for (size_t i = 0; i < segs.size(); ++i) {
-    const double a = segs[i].start;
-    const double b = i + 1 < segs.size() ? segs[i + 1].start : spec.duty_cycle.end;
-    for (const auto& s : spec.thermal.sources) total += source_power(s, segs[i].speed_rpm) * (b - a);
+  // Spindle and feed speeds are constant between consecutive switches.
+  std::vector<double> marks = switch_times(spec);
+  marks.push_back(spec.duty_cycle.end);
+  double total = 0, a = 0;
+  for (double b : marks) {
+    const double mid = 0.5 * (a + b);
+    const double n = speed_at(spec.duty_cycle, mid), v = feed_speed_at(spec.feed_axis, mid);
+    for (const auto& s : spec.thermal.sources) total += source_power(s, n, v) * (b - a);
+    a = b;
   }
   return total;
 }

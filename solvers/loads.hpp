@@ -12,8 +12,20 @@ namespace tt::solvers {
 /// segment that starts there).
 double speed_at(const core::DutyCycle& cycle, double t);
 
-/// Heat of a source [W] at spindle speed n [rpm] (before any temperature dependence).
+/// Heat of a source [W] at spindle speed n [rpm] (before any temperature dependence); a
+/// feed_power source gives 0 here (no feed).
 double source_power(const core::HeatSource& source, double speed_rpm);
+
+/// Heat of a source [W] at spindle speed n [rpm] and feed speed v [m/s].
+double source_power(const core::HeatSource& source, double speed_rpm, double feed_m_s);
+
+/// Feed speed [m/s] of the axis on the open interval that contains t (0 while it stands, and
+/// without a feed axis).
+double feed_speed_at(const core::FeedAxis& axis, double t);
+
+/// Position of the axis [m] at t: standing at `from`, or reciprocating from `from` towards `to`
+/// and back at the feed speed, restarting at `from` when a segment starts.
+double axis_position_at(const core::FeedAxis& axis, double t);
 
 /// Film coefficient [W/(m^2 K)] of a convection entry at spindle speed n [rpm].
 double film_coefficient(const core::Convection& convection, double speed_rpm);
@@ -21,8 +33,8 @@ double film_coefficient(const core::Convection& convection, double speed_rpm);
 /// Linear interpolation in a table, constant beyond its ends.
 double table_value(const core::TimeTable& table, double t);
 
-/// The times at which the load can change: segment starts after 0, and the table points of
-/// every time-varying sink, inside (0, end).
+/// The times at which the load can change: duty-cycle and feed-axis segment starts after 0, and
+/// the table points of every time-varying sink, inside (0, end).
 std::vector<double> switch_times(const core::CaseSpec& spec);
 
 /// Step end times t_1 < ... < t_N = end: every switch is a step end; between switches the steps

@@ -1,0 +1,42 @@
+// Heat that travels with a feed axis: a ball-screw nut or a carriage's guide blocks heat only the
+// part of the screw (rails) under them. The matrix does not change as the axis moves, only the
+// load: per step, the heat is spread over the tets whose centroid lies in the window around the
+// axis position, averaged over the positions the axis passes through during the step, with the
+// total power exact at every instant.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::solvers {
+
+/// One moving source's body, cut into its tets sorted along the axis.
+struct MovingSourceShape {
+  int source = -1;         /// index into spec.thermal.sources
+  Eigen::VectorXd centre;  /// #pieces tet centroid coordinate along the axis, ascending [m]
+  Eigen::VectorXd volume;  /// #pieces tet volume [m^3]
+  Eigen::MatrixXi nodes;   /// #pieces x nodes-per-tet mesh nodes
+  Eigen::MatrixXd weight;  /// #pieces x nodes-per-tet int N dV [m^3] (rows sum to volume)
+};
+
+/// The shapes of every source with a window (moving with spec.feed_axis). Throws SolverError for
+/// a moving source on a body without elements.
+std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
+                                                    const core::CaseSpec& spec);
+
+/// Per piece, the fraction of the source's power it receives averaged over [t0, t1] [-] (sums to
+/// 1): at each of a set of sub-instants the pieces in the window share the power by volume (the
+/// piece nearest the window's centre takes it all when the window holds no centroid).
+Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
+                                       double t0, double t1);
+
+/// Nodal heat load [W] of every moving source averaged over the step [t0, t1]: sums to the sources'
+/// total power (spindle and feed speeds are constant within a step of the time grid).
+Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
+                                 const std::vector<MovingSourceShape>& shapes, Eigen::Index nodes,
+                                 double t0, double t1);
+
+}  // namespace tt::solvers

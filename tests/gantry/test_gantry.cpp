@@ -1,0 +1,285 @@
+// The feed axis (issue: GM-1 gantry): its motion law, heat that moves with it (total power exact
+// at every step, centred on the axis position), energy closure with moving sources, the thermal
+// error along the axis and its polynomial (reproduces the points within the residual it reports),
+// and the GM-1 case files (read, resolved round trip, named points on the axis).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "app/study.hpp"
+#include "core/errors.hpp"
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/axis_error.hpp"
+#include "solvers/feed_axis.hpp"
+#include "solvers/loads.hpp"
+#include "solvers/thermal.hpp"
+#include "solvers/thermal_error.hpp"
+
+namespace tt::gantry_test {
+namespace {
+
+/// A steel bar 1 m along x on [0, 1] with a moving source in it (window 0.2 m) and a fixed
+/// feed-speed source in a pad; the axis reciprocates over [0.2, 0.8] at 6 m/min, then stands.
+std::string bar_case(int order, const std::string& scheme = "backward_euler") {
+  std::string t = "[case]\nname = \"bar\"\n[geometry]\nlength_unit = \"m\"\n";
+  t += "[materials.steel]\ndensity_kg_m3 = 7850.0\nspecific_heat_J_kgK = 460.0\nconductivity_W_mK "
+       "= 42.0\n"
+       "youngs_modulus_Pa = 2.1e11\npoisson_ratio = 0.3\nexpansion_per_K = 1.2e-5\n";
+  t += "[[bodies]]\nname = \"bar\"\nmaterial = \"steel\"\nmax_edge = 0.04\n"
+       "add = [ { box = { min = [0.0, 0.0, 0.0], max = [1.0, 0.05, 0.05] } } ]\n";
+  t += "[[bodies]]\nname = \"pad\"\nmaterial = \"steel\"\nmax_edge = 0.04\n"
+       "add = [ { box = { min = [-0.05, 0.0, 0.0], max = [0.0, 0.05, 0.05] } } ]\n";
+  t += "[mesh]\norder = " + std::to_string(order) + "\n";
+  t += "[[boundary]]\nname = \"all\"\nrest = true\nselect = [ {} ]\n";
+  t += "[thermal]\nscheme = \"" + scheme + "\"\nstep_s = 10.0\noutput_interval_s = 60.0\n";
+  t += "[[thermal.convection]]\ngroup = \"all\"\nh_W_m2K = 10.0\nsink_degC = 20.0\n";
+  t += "[[thermal.heat_sources]]\nname = \"nut\"\nbody = \"bar\"\nlaw = "
+       "\"feed_power\"\npower_ref_W = 30.0\n"
+       "ref_feed_m_min = 10.0\nmoving = { window = 0.2 }\n";
+  t += "[[thermal.heat_sources]]\nname = \"bearing\"\nbody = \"pad\"\nlaw = "
+       "\"feed_power\"\npower_ref_W = 8.0\n"
+       "ref_feed_m_min = 10.0\nexponent = 2.0\n";
+  t += "[duty_cycle]\nend_s = 600.0\nsegments = [ { start_s = 0.0, speed_rpm = 0.0 } ]\n";
+  t += "[feed_axis]\nname = \"X\"\ndirection = \"x\"\nsegments = [ { start_s = 0.0, from = 0.2, to "
+       "= 0.8, "
+       "feed_m_min = 6.0 }, { start_s = 300.0, position = 0.7 } ]\n";
+  t += "[mechanical]\nenabled = false\n";
+  return t;
+}
+
+core::CaseSpec bar_spec(int order, const std::string& scheme = "backward_euler") {
+  return io::case_from_toml(bar_case(order, scheme), "bar.toml");
+}
+
+/// Load-weighted mean x of a nodal load [m].
+double load_centre(const mesh::TetMesh& m, const Eigen::VectorXd& f) {
+  return f.dot(m.nodes.col(0)) / f.sum();
+}
+
+TEST(FeedAxis, PositionReciprocatesAndStands) {
+  const core::CaseSpec s = bar_spec(1);
+  const auto& ax = s.feed_axis;
+  const double v = 0.1;  // 6 m/min [m/s]
+  EXPECT_DOUBLE_EQ(solvers::feed_speed_at(ax, 10.0), v);
+  EXPECT_NEAR(solvers::axis_position_at(ax, 0.0), 0.2, 1e-12);
+  EXPECT_NEAR(solvers::axis_position_at(ax, 3.0), 0.5, 1e-12);
+  EXPECT_NEAR(solvers::axis_position_at(ax, 6.0), 0.8, 1e-12);   // turns at `to`
+  EXPECT_NEAR(solvers::axis_position_at(ax, 9.0), 0.5, 1e-12);   // on the way back
+  EXPECT_NEAR(solvers::axis_position_at(ax, 12.0), 0.2, 1e-12);  // one full cycle
+  EXPECT_NEAR(solvers::axis_position_at(ax, 300.0), 0.7, 1e-12);
+  EXPECT_EQ(solvers::feed_speed_at(ax, 300.0), 0.0);
+  // Segment starts are switches of the time grid.
+  const auto sw = solvers::switch_times(s);
+  ASSERT_EQ(sw.size(), 1u);
+  EXPECT_EQ(sw[0], 300.0);
+}
+
+TEST(FeedAxis, FeedPowerLawAndHeatDelivered) {
+  const core::CaseSpec s = bar_spec(1);
+  const auto& nut = s.thermal.sources[0];
+  const auto& bearing = s.thermal.sources[1];
+  EXPECT_NEAR(solvers::source_power(nut, 0.0, 0.1), 30.0 * 0.6, 1e-12);
+  EXPECT_NEAR(solvers::source_power(bearing, 0.0, 0.1), 8.0 * 0.36, 1e-12);
+  EXPECT_EQ(solvers::source_power(nut, 3000.0, 0.0), 0.0);  // standing axis: no feed heat
+  EXPECT_EQ(solvers::source_power(nut, 3000.0), 0.0);       // the speed-only overload
+  EXPECT_NEAR(solvers::heat_delivered(s), (18.0 + 2.88) * 300.0, 1e-9);
+}
+
+TEST(FeedAxis, MovingLoadHasExactPowerAndFollowsTheAxis) {
+  const core::CaseSpec s = bar_spec(2);
+  const mesh::TetMesh m = mesh::mesh_case(s);
+  const auto shapes = solvers::moving_source_shapes(m, s);
+  ASSERT_EQ(shapes.size(), 1u);
+  EXPECT_EQ(shapes[0].source, 0);
+  EXPECT_NEAR(shapes[0].volume.sum(), 1.0 * 0.05 * 0.05, 1e-12);
+  // Short steps at several instants: the whole power, centred on the axis position.
+  for (double t0 : {0.0, 1.0, 2.5, 4.0, 7.0, 10.0}) {
+    const double t1 = t0 + 0.05;
+    const Eigen::VectorXd f = solvers::moving_heat_load(s, shapes, m.nodes.rows(), t0, t1);
+    EXPECT_NEAR(f.sum(), 18.0, 1e-10) << "t0 = " << t0;
+    const double p = solvers::axis_position_at(s.feed_axis, 0.5 * (t0 + t1));
+    EXPECT_NEAR(load_centre(m, f), p, 0.03) << "t0 = " << t0;
+  }
+  // A step over a whole cycle spreads the heat over the stroke [0.2, 0.8] (window included).
+  const Eigen::VectorXd cycle = solvers::moving_heat_load(s, shapes, m.nodes.rows(), 0.0, 12.0);
+  EXPECT_NEAR(cycle.sum(), 18.0, 1e-10);
+  EXPECT_NEAR(load_centre(m, cycle), 0.5, 0.01);
+  double outside = 0;
+  for (Eigen::Index i = 0; i < m.nodes.rows(); ++i)
+    if (m.nodes(i, 0) < 0.05 || m.nodes(i, 0) > 0.95) outside += std::abs(cycle(i));
+  EXPECT_LT(outside, 1e-9);
+  // Standing: no feed, so no heat; the fractions still sit at the standing position.
+  EXPECT_EQ(solvers::moving_heat_load(s, shapes, m.nodes.rows(), 300.0, 310.0).sum(), 0.0);
+  const Eigen::VectorXd frac = solvers::moving_piece_fractions(s, shapes[0], 300.0, 310.0);
+  EXPECT_NEAR(frac.sum(), 1.0, 1e-12);
+  EXPECT_NEAR(frac.dot(shapes[0].centre), 0.7, 0.03);
+}
+
+TEST(FeedAxis, WindowNarrowerThanTheMeshStillDeliversEverything) {
+  core::CaseSpec s = bar_spec(1);
+  s.thermal.sources[0].window = 1e-4;  // holds no centroid: the nearest tet takes the heat
+  const mesh::TetMesh m = mesh::mesh_case(s);
+  const auto shapes = solvers::moving_source_shapes(m, s);
+  const Eigen::VectorXd f = solvers::moving_heat_load(s, shapes, m.nodes.rows(), 2.0, 2.01);
+  EXPECT_NEAR(f.sum(), 18.0, 1e-10);
+  EXPECT_NEAR(load_centre(m, f), solvers::axis_position_at(s.feed_axis, 2.005), 0.05);
+}
+
+TEST(FeedAxis, EnergyClosesWithMovingSources) {
+  for (const char* scheme : {"backward_euler", "crank_nicolson"}) {
+    const core::CaseSpec s = bar_spec(1, scheme);
+    const mesh::TetMesh m = mesh::mesh_case(s);
+    const auto ops = solvers::thermal_operators(m, s);
+    const auto h = solvers::thermal_history(m, s, ops);
+    EXPECT_NEAR(h.energy.heat_in, h.energy.heat_in_law, 1e-9 * h.energy.heat_in_law) << scheme;
+    EXPECT_NEAR(h.energy.heat_in_law, (18.0 + 2.88) * 300.0, 1e-6);
+    EXPECT_LT(std::abs(h.energy.closure()), 2e-3) << scheme;
+    // The middle of the stroke [0.2, 0.8] ends warmer than the far end of the bar.
+    double hot = 0, cold = 0;
+    int nh = 0, nc = 0;
+    const Eigen::VectorXd end = h.temperature.col(h.temperature.cols() - 1);
+    for (Eigen::Index i = 0; i < m.nodes.rows(); ++i) {
+      const double x = m.nodes(i, 0);
+      if (x > 0.45 && x < 0.55) hot += end(i), ++nh;
+      if (x > 0.95) cold += end(i), ++nc;
+    }
+    EXPECT_GT(hot / nh, cold / nc + 0.05) << scheme;
+  }
+}
+
+TEST(AxisPolynomial, RecoversACubicExactly) {
+  solvers::AxisError e;
+  const int n = 11;
+  e.positions.resize(n);
+  e.values.resize(2, 3 * n);
+  for (int i = 0; i < n; ++i) {
+    const double p = -1.25 + 0.25 * i;
+    e.points.push_back("A" + std::to_string(i + 1));
+    e.positions(i) = p;
+    for (int t = 0; t < 2; ++t) {
+      e.values(t, 3 * i + 0) = t * (2e-6 + 3e-6 * p - 1e-6 * p * p + 0.5e-6 * p * p * p);
+      e.values(t, 3 * i + 1) = t * 1e-6 * p;
+      e.values(t, 3 * i + 2) = t * -4e-6;
+    }
+  }
+  const auto poly = solvers::axis_polynomial(e, 3);
+  EXPECT_NEAR(poly.coefficients[0](1, 0), 2e-6, 1e-18);
+  EXPECT_NEAR(poly.coefficients[0](1, 1), 3e-6, 1e-18);
+  EXPECT_NEAR(poly.coefficients[0](1, 2), -1e-6, 1e-18);
+  EXPECT_NEAR(poly.coefficients[0](1, 3), 0.5e-6, 1e-18);
+  EXPECT_NEAR(poly.coefficients[1](1, 1), 1e-6, 1e-18);
+  EXPECT_NEAR(poly.coefficients[2](1, 0), -4e-6, 1e-18);
+  for (int d = 0; d < 3; ++d) EXPECT_LT(poly.max[d].maxCoeff(), 1e-18);
+  EXPECT_THROW(solvers::axis_polynomial(e, 11), core::SolverError);
+}
+
+TEST(AxisPolynomial, ReproducesThePointsWithinTheReportedResidual) {
+  solvers::AxisError e;
+  const int n = 9;
+  e.positions.resize(n);
+  e.values.resize(3, 3 * n);
+  for (int i = 0; i < n; ++i) {
+    const double p = 0.3 * i;
+    e.points.push_back("P" + std::to_string(i));
+    e.positions(i) = p;
+    for (int t = 0; t < 3; ++t)
+      for (int d = 0; d < 3; ++d)
+        e.values(t, 3 * i + d) = 1e-6 * (t + 1) * std::sin(2.1 * p + d) + 1e-5 * d;
+  }
+  const auto poly = solvers::axis_polynomial(e, 3);
+  for (int t = 0; t < 3; ++t)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd fit = solvers::axis_polynomial_value(poly, d, t, e.positions);
+      double worst = 0, sq = 0;
+      for (int i = 0; i < n; ++i) {
+        const double r = fit(i) - e.values(t, 3 * i + d);
+        worst = std::max(worst, std::abs(r));
+        sq += r * r;
+      }
+      EXPECT_GT(poly.max[d](t), 1e-9);  // a sine is not a cubic: the residual is real
+      EXPECT_LE(worst, poly.max[d](t) * (1 + 1e-9) + 1e-15);
+      EXPECT_NEAR(std::sqrt(sq / n), poly.rms[d](t), 1e-9 * poly.rms[d](t) + 1e-15);
+    }
+}
+
+TEST(Gm1Case, ReadsResolvesAndRoundTrips) {
+  for (const char* file : {"cases/gm1.toml", "cases/gm1_coarse.toml"}) {
+    const core::CaseSpec s = io::read_case(std::string(TT_SOURCE_DIR) + "/" + file);
+    EXPECT_EQ(s.machine, "GM-1");
+    EXPECT_EQ(s.feed_axis.direction, 0);
+    EXPECT_EQ(s.feed_axis.segments.size(), 5u);
+    EXPECT_NEAR(s.feed_axis.segments[0].feed, 4.0 / 60.0, 1e-15);
+    EXPECT_EQ(s.mechanical.axis_points.size(), 11u);
+    EXPECT_EQ(s.mechanical.axis_polynomial_degree, 3);
+    EXPECT_EQ(s.mechanical.targets, (std::vector<std::string>{"dy", "dz"}));
+    int moving = 0;
+    for (const auto& src : s.thermal.sources) moving += src.window > 0;
+    EXPECT_EQ(moving, 2);
+    const std::string text = io::resolved_case_toml(s);
+    const core::CaseSpec back = io::case_from_toml(text, "resolved.toml");
+    const std::string again = io::resolved_case_toml(back);
+    EXPECT_EQ(text.substr(text.find('\n')), again.substr(again.find('\n'))) << file;
+    EXPECT_EQ(back.feed_axis.segments[2].to, s.feed_axis.segments[2].to);
+    EXPECT_EQ(back.thermal.sources[3].window, s.thermal.sources[3].window);
+  }
+}
+
+TEST(Gm1Case, TargetsComeFromTheCaseAndAxisPointsAreNoCandidates) {
+  core::CaseSpec s = io::read_case(std::string(TT_SOURCE_DIR) + "/cases/gm1_coarse.toml");
+  const auto cand = app::candidate_points(s);
+  EXPECT_EQ(cand.size(), 37u);
+  for (int c : cand) {
+    EXPECT_NE(s.points[c].id[0], 'A') << s.points[c].id;
+    EXPECT_NE(s.points[c].id, "TCP");
+  }
+  s.mechanical.targets = {"dx", "dz"};
+  const std::vector<double> times{0.0, 60.0, 120.0};
+  const Eigen::MatrixXd temps =
+      Eigen::MatrixXd::Random(3, static_cast<Eigen::Index>(s.points.size()));
+  Eigen::MatrixXd error = Eigen::MatrixXd::Random(3, solvers::kThermalErrorColumns);
+  const app::Histories h = app::histories_from_points(s, times, temps, error);
+  EXPECT_EQ(h.target_names, (std::vector<std::string>{"dx", "dz"}));
+  ASSERT_EQ(h.targets.cols(), 2);
+  EXPECT_EQ(h.targets.col(0), error.col(solvers::kDx));
+  EXPECT_EQ(h.targets.col(1), error.col(solvers::kDz));
+  EXPECT_EQ(h.temperature.cols(), 37);
+  EXPECT_THROW(app::target_column("tilt"), core::CaseError);
+}
+
+TEST(Gm1Case, BadFeedAxisInputIsRefused) {
+  const std::string base = bar_case(1);
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = base;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  auto refused = [](const std::string& text, const std::string& fragment) {
+    try {
+      io::case_from_toml(text, "bad.toml");
+      ADD_FAILURE() << "accepted; expected a message with: " << fragment;
+    } catch (const core::CaseError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  refused(with("direction = \"x\"", "direction = \"w\""), "feed_axis.direction");
+  refused(with("{ start_s = 300.0, position = 0.7 }",
+               "{ start_s = 300.0, position = 0.7, feed_m_min = 1.0 }"),
+          "not used with position");
+  refused(with("{ start_s = 300.0, position = 0.7 }", "{ start_s = 700.0, position = 0.7 }"),
+          "must be before duty_cycle.end_s");
+  refused(with("feed_m_min = 6.0", "feed_m_min = -6.0"), "must be >= 0");
+  refused(with("moving = { window = 0.2 }", "moving = { window = 0.0 }"), "must be > 0");
+  refused(with("ref_feed_m_min = 10.0\nmoving", "ref_speed_rpm = 10.0\nmoving"), "not used by law");
+  std::string no_axis =
+      base.substr(0, base.find("[feed_axis]")) + "[mechanical]\nenabled = false\n";
+  refused(no_axis, "needs a [feed_axis] table");
+  refused(with("[mechanical]\nenabled = false\n",
+               "[mechanical]\nenabled = false\ntargets = [\"dq\"]\n"),
+          "mechanical.targets[0]");
+}
+
+}  // namespace
+}  // namespace tt::gantry_test
