@@ -8,12 +8,14 @@
 
 #include "app/commands.hpp"
 #include "io/atomic_dir.hpp"
+#include "io/axis_out.hpp"
 #include "io/case_reader.hpp"
 #include "io/checkpoint.hpp"
 #include "io/csv_out.hpp"
 #include "io/reports.hpp"
 #include "io/vtk_out.hpp"
 #include "mesh/mesher.hpp"
+#include "solvers/axis_error.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/virtual_machine.hpp"
 
@@ -44,15 +46,22 @@ void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory
   io::write_csv(path, header, rows);
 }
 
+/// thermal_error.csv: the TCP and probe columns, then the feed axis's points when there are any.
 void write_thermal_error(const solvers::ThermalHistory& th, const solvers::ThermalError& e,
-                         const std::filesystem::path& path) {
-  const std::vector<std::string> header{"time_s",   "dx_um",    "dy_um",    "dz_um",
-                                        "dx_z1_um", "dy_z1_um", "dx_z2_um", "dy_z2_um",
-                                        "tilt_about_x_urad", "tilt_about_y_urad"};
-  Eigen::MatrixXd rows(e.values.rows(), 10);
+                         const solvers::AxisError* axis, const std::filesystem::path& path) {
+  std::vector<std::string> header{"time_s",   "dx_um",    "dy_um",    "dz_um",
+                                  "dx_z1_um", "dy_z1_um", "dx_z2_um", "dy_z2_um",
+                                  "tilt_about_x_urad", "tilt_about_y_urad"};
+  const Eigen::Index extra = axis ? axis->values.cols() : 0;
+  Eigen::MatrixXd rows(e.values.rows(), 10 + extra);
   for (Eigen::Index t = 0; t < e.values.rows(); ++t) {
     rows(t, 0) = th.times[t];
-    rows.row(t).tail(9) = e.values.row(t) * 1e6;  // m -> um, rad -> urad
+    rows.row(t).segment(1, 9) = e.values.row(t) * 1e6;  // m -> um, rad -> urad
+  }
+  if (axis) {
+    const auto names = io::axis_error_header(*axis);
+    header.insert(header.end(), names.begin(), names.end());
+    rows.rightCols(extra) = io::axis_error_rows_um(*axis);
   }
   io::write_csv(path, header, rows);
 }
@@ -167,7 +176,16 @@ int run_command(const RunArgs& args) {
   const auto t_write = Clock::now();
   write_mesh_files(mesh, spec, dir);
   write_temperatures(mesh, run.thermal, dir / "temperatures.csv");
-  if (run.error) write_thermal_error(run.thermal, *run.error, dir / "thermal_error.csv");
+  // The feed axis's error at its measurement points, and its compensation polynomial.
+  std::optional<solvers::AxisError> axis;
+  std::optional<solvers::AxisPolynomial> axis_poly;
+  if (run.elastic && !spec.mechanical.axis_points.empty()) {
+    axis = solvers::axis_error(mesh, spec, run.elastic->displacement);
+    axis_poly = solvers::axis_polynomial(*axis, spec.mechanical.axis_polynomial_degree);
+    io::write_axis_polynomial_csv(dir / "axis_polynomial.csv", run.thermal.times, *axis_poly);
+  }
+  if (run.error)
+    write_thermal_error(run.thermal, *run.error, axis ? &*axis : nullptr, dir / "thermal_error.csv");
   if (spec.outputs.fields) write_fields(mesh, spec, run, dir);
   const double write_s = seconds_since(t_write);
 
@@ -202,6 +220,7 @@ int run_command(const RunArgs& args) {
     const auto last = run.error->values.bottomRows(1);
     summary["thermal_error_at_end_um"] = {{"dx", last(0, 0) * 1e6}, {"dy", last(0, 1) * 1e6}, {"dz", last(0, 2) * 1e6}};
   }
+  if (axis) summary["feed_axis_error"] = io::axis_summary_json(*axis, *axis_poly);
   timings["total_s"] = seconds_since(t_start);
   summary["timings"] = timings;
   io::write_json(dir / "summary.json", summary);

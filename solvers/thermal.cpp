@@ -148,6 +148,7 @@ ThermalOperators assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
                               "' has no elements, so its heat cannot go anywhere");
     ops.source_shape.push_back(w / volume);
   }
+  ops.moving = moving_source_shapes(m, spec);
   return ops;
 }
 
@@ -197,7 +198,9 @@ LoadState load_state(const core::CaseSpec& spec, const ThermalOperators& ops, do
   }
   for (size_t i = 0; i < spec.thermal.sources.size(); ++i) {
     const auto& src = spec.thermal.sources[i];
-    double p = source_power(src, s.speed);
+    // Moving sources enter through moving_heat_load, not through source_shape.
+    const double feed = feed_speed_at(spec.feed_axis, t_load);
+    double p = src.window > 0 ? 0.0 : source_power(src, s.speed, feed);
     if (src.temperature_coefficient != 0)
       p *= 1 + src.temperature_coefficient * (ops.source_shape[i].dot(temperature) - t0_k);
     s.power.push_back(p);
@@ -306,10 +309,12 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     const bool restart = i == 0 || s_new.speed != prev_speed;
     const bool cn = scheme == Scheme::crank_nicolson && !restart;
     const Eigen::SparseMatrix<double>& kk = stiffness_at(s_new);
-    f_new = load_vector(spec, ops, s_new);
+    // Heat moving with the feed axis: averaged over the step, the same for both ends of CN.
+    const Eigen::VectorXd f_moving = moving_heat_load(spec, ops.moving, n, t_prev, t);
+    f_new = load_vector(spec, ops, s_new) + f_moving;
     if (cn) {
       const LoadState s_old = load_state(spec, ops, mid, t_prev, temp, t0_k);
-      f_prev = load_vector(spec, ops, s_old);
+      f_prev = load_vector(spec, ops, s_old) + f_moving;
       rhs = ops.capacity * temp - (0.5 * dt) * (kk * temp) + (0.5 * dt) * (f_prev + f_new);
       lost_rate_prev = convected_rate(ops, temp, s_old.h, s_old.sink_k);
     } else {
@@ -322,7 +327,7 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     double power = 0;
     for (double p : s_new.power) power += p;
     const double lost_new = convected_rate(ops, next, s_new.h, s_new.sink_k);
-    hist.energy.heat_in += dt * power;
+    hist.energy.heat_in += dt * (power + f_moving.sum());
     hist.energy.lost += cn ? 0.5 * dt * (lost_rate_prev + lost_new) : dt * lost_new;
     // Surface fluxes enter as heat too.
     for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {

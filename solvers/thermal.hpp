@@ -10,6 +10,7 @@
 
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "solvers/feed_axis.hpp"
 
 namespace tt::solvers {
 
@@ -23,6 +24,7 @@ struct ThermalOperators {
   std::vector<Eigen::VectorXd> film_area;            /// per convection entry: int N dA [m^2]
   std::vector<Eigen::VectorXd> source_shape;         /// per source: int N dV / V_body [-], sums to 1
   std::vector<Eigen::VectorXd> flux_area;            /// per surface flux: int N dA [m^2]
+  std::vector<MovingSourceShape> moving;             /// sources that move with the feed axis
 };
 
 /// Assembles the operators (element loops in parallel, deterministic order). Throws SolverError
