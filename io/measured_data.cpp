@@ -141,7 +141,8 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   json meta;
   try {
     meta = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for numbers too large for a double (found by fuzzing).
     throw core::DataError(
         core::located(file.string(), 0, std::string("not valid JSON: ") + e.what()));
   }
