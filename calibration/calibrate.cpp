@@ -1,0 +1,350 @@
+#include "calibration/calibrate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/loads.hpp"
+
+namespace tt::calibration {
+
+namespace {
+
+int group_index(const core::CaseSpec& spec, const std::string& name) {
+  for (size_t g = 0; g < spec.groups.size(); ++g)
+    if (spec.groups[g].name == name) return static_cast<int>(g);
+  return -1;
+}
+
+std::string unique_group_name(const core::CaseSpec& spec, const std::string& stem) {
+  std::string name = stem;
+  for (int k = 2; group_index(spec, name) >= 0; ++k) name = stem + "_" + std::to_string(k);
+  return name;
+}
+
+/// Inserts `g` at `at`, shifting every reference to later groups.
+void insert_group(core::CaseSpec& spec, int at, core::BoundaryGroup g) {
+  auto shift = [at](int& i) {
+    if (i >= at) ++i;
+  };
+  for (auto& c : spec.thermal.convection) shift(c.group);
+  for (auto& f : spec.thermal.fluxes) shift(f.group);
+  for (auto& i : spec.mechanical.fixed_groups) shift(i);
+  for (auto& p : spec.points) shift(p.on_group);
+  spec.groups.insert(spec.groups.begin() + at, std::move(g));
+}
+
+nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p) {
+  nlohmann::json j;
+  switch (c.kind) {
+    case EffectKind::ambient_temperature:
+      j["knots_s"] = c.knots;
+      j["delta_air_K"] = p;
+      break;
+    case EffectKind::heat_input:
+      j["law"] = c.law;
+      j["flux_W_m2"] = p.at(0);
+      j["power_W"] = p.at(0) * c.area;
+      if (c.law == "speed") j["ref_speed_rpm"] = c.ref_speed_rpm;
+      break;
+    case EffectKind::speed_dependent_convection:
+      j["h_speed_gain_W_m2K"] = p.at(0);
+      j["speed_ref_rpm"] = c.ref_speed_rpm;
+      j["speed_exponent"] = 1.0;
+      break;
+    case EffectKind::temperature_dependent_heat:
+      j["temperature_coefficient_per_K"] = p.at(0);
+      break;
+    case EffectKind::boundary_conductance:
+      j["delta_h_W_m2K"] = p.at(0);
+      break;
+    case EffectKind::material_parameter:
+      j["relative_change"] = p.at(0);
+      break;
+    case EffectKind::sensor_offset:
+      j["offset_K"] = p.at(0);
+      break;
+    case EffectKind::sensor_lag:
+      j["time_constant_s"] = c.time_constant;
+      break;
+  }
+  return j;
+}
+
+}  // namespace
+
+AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
+                             const std::vector<double>& p, const Readout& r) {
+  AugmentedCase out = base;
+  core::CaseSpec& s = out.spec;
+  auto& conv = s.thermal.convection;
+  switch (c.kind) {
+    case EffectKind::ambient_temperature:
+      for (int e : c.entries) {
+        core::TimeTable t;
+        for (size_t k = 0; k < c.knots.size(); ++k) {
+          t.time.push_back(c.knots[k]);
+          t.value.push_back(solvers::table_value(conv[e].sink, c.knots[k]) + p.at(k));
+        }
+        conv[e].sink = t;
+      }
+      break;
+    case EffectKind::heat_input: {
+      for (const auto& gname : c.location.at("groups")) {
+        const int g = group_index(s, gname.get<std::string>());
+        if (g < 0) continue;
+        core::BoundaryGroup ng;
+        ng.name = unique_group_name(s, "heat_input_" + gname.get<std::string>());
+        ng.rest = s.groups[g].rest;
+        for (core::FaceSelector sel : s.groups[g].select) {
+          sel.within_min = sel.within_min ? sel.within_min->cwiseMax(c.box_min) : c.box_min;
+          sel.within_max = sel.within_max ? sel.within_max->cwiseMin(c.box_max) : c.box_max;
+          ng.select.push_back(sel);
+        }
+        insert_group(s, g, ng);  // the covered group is now at g + 1
+        const int covered = g + 1;
+        std::vector<core::Convection> copies;
+        for (const auto& cv : conv)
+          if (cv.group == covered) {
+            core::Convection copy = cv;
+            copy.group = g;
+            copies.push_back(copy);
+          }
+        conv.insert(conv.end(), copies.begin(), copies.end());
+        std::vector<core::SurfaceFlux> fcopies;
+        for (const auto& fl : s.thermal.fluxes)
+          if (fl.group == covered) {
+            core::SurfaceFlux copy = fl;
+            copy.group = g;
+            fcopies.push_back(copy);
+          }
+        s.thermal.fluxes.insert(s.thermal.fluxes.end(), fcopies.begin(), fcopies.end());
+        auto& fixed = s.mechanical.fixed_groups;
+        if (std::find(fixed.begin(), fixed.end(), covered) != fixed.end()) fixed.push_back(g);
+        core::SurfaceFlux f;
+        f.group = g;
+        f.flux = p.at(0);
+        f.follows_speed = c.law == "speed";
+        f.ref_speed_rpm = f.follows_speed ? c.ref_speed_rpm : 0.0;
+        s.thermal.fluxes.push_back(f);
+        // A named point inside the patch may now sit on the new group only.
+        for (auto& pt : s.points)
+          if (pt.on_group == covered && (pt.position.array() >= c.box_min.array() - 1e-9).all() &&
+              (pt.position.array() <= c.box_max.array() + 1e-9).all())
+            pt.on_group = -1;
+      }
+      break;
+    }
+    case EffectKind::speed_dependent_convection: {
+      auto& cv = conv.at(static_cast<size_t>(c.group));
+      cv.h_speed_gain = std::max(0.0, cv.h_speed_gain + p.at(0));
+      cv.speed_ref_rpm = c.ref_speed_rpm;
+      cv.speed_exponent = 1.0;
+      break;
+    }
+    case EffectKind::temperature_dependent_heat:
+      s.thermal.sources.at(static_cast<size_t>(c.source)).temperature_coefficient += p.at(0);
+      break;
+    case EffectKind::boundary_conductance: {
+      auto& cv = conv.at(static_cast<size_t>(c.group));
+      cv.h = std::max(0.05 * cv.h, cv.h + p.at(0));
+      break;
+    }
+    case EffectKind::material_parameter: {
+      auto& mat = s.materials.at(static_cast<size_t>(c.material));
+      const double factor = std::max(0.1, 1 + p.at(0));
+      if (c.field == "conductivity")
+        mat.conductivity *= factor;
+      else if (c.field == "heat_capacity")
+        mat.specific_heat *= factor;
+      else
+        mat.expansion *= factor;
+      break;
+    }
+    case EffectKind::sensor_offset:
+    case EffectKind::sensor_lag: {
+      const std::string id = r.ids.at(static_cast<size_t>(c.sensor));
+      auto it = std::find_if(out.sensors.begin(), out.sensors.end(),
+                             [&](const auto& x) { return x.sensor == id; });
+      if (it == out.sensors.end())
+        it = out.sensors.insert(out.sensors.end(), SensorCorrection{id, 0, 0});
+      if (c.kind == EffectKind::sensor_offset)
+        it->offset_K += p.at(0);
+      else
+        it->lag_s = c.time_constant;
+      break;
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd corrected(const Eigen::MatrixXd& ch, const Eigen::VectorXd& times, const Readout& r,
+                          const std::vector<SensorCorrection>& corrections) {
+  Eigen::MatrixXd out = ch;
+  for (const auto& c : corrections) {
+    const auto it = std::find(r.ids.begin(), r.ids.end(), c.sensor);
+    if (it == r.ids.end()) continue;
+    const Eigen::Index k = it - r.ids.begin();
+    if (c.lag_s > 0) out.col(k) = lagged(times, out.col(k), c.lag_s);
+    out.col(k).array() += c.offset_K;
+  }
+  return out;
+}
+
+RmsFigures rms_figures(const std::vector<Eigen::MatrixXd>& measured,
+                       const std::vector<Eigen::MatrixXd>& simulated, int sensors) {
+  double st = 0, su = 0, nt = 0, nu = 0;
+  for (size_t r = 0; r < measured.size(); ++r)
+    for (Eigen::Index c = 0; c < measured[r].cols(); ++c)
+      for (Eigen::Index i = 0; i < measured[r].rows(); ++i) {
+        const double e = measured[r](i, c) - simulated[r](i, c);
+        if (!std::isfinite(e)) continue;
+        if (c < sensors) {
+          st += e * e;
+          nt += 1;
+        } else {
+          su += e * e;
+          nu += 1;
+        }
+      }
+  return {nt > 0 ? std::sqrt(st / nt) : 0.0, nu > 0 ? 1e6 * std::sqrt(su / nu) : 0.0};
+}
+
+CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+                            const Catalogue& train, const std::vector<io::MeasuredRun>& test,
+                            const CalibrationOptions& o) {
+  CalibrationResult res;
+  res.selection = select_effects(train, o);
+  const Readout& r = train.readout;
+  // Per-run effects need their own fit on each test run (the air temperature is a signal of the
+  // run, not of the machine): the ambient columns for the test runs.
+  bool per_run = false;
+  for (const auto& f : res.selection.claimed) per_run |= train.candidates[f.candidate].per_run;
+  Catalogue test_cat;
+  if (per_run && !test.empty()) test_cat = catalogue(mesh, declared, r, test, o, true);
+
+  std::vector<Eigen::MatrixXd> meas, before, after;
+  for (size_t ti = 0; ti < test.size(); ++ti) {
+    const io::MeasuredRun& run = test[ti];
+    TestRun tr;
+    tr.name = run.run;
+    tr.times = run.time;
+    const Readout rt = readout(mesh, declared, run);
+    if (rt.ids != r.ids)
+      throw core::DataError("test run '" + run.run +
+                            "' has other located channels than the training runs; " +
+                            "every run must list the same sensors and probes");
+    tr.measured = measured_channels(run, rt);
+    const core::CaseSpec spec = case_for_run(declared, run);
+    tr.before = simulated_channels(mesh, spec, rt, run.time);
+    AugmentedCase aug{spec, {}};
+    for (const auto& f : res.selection.claimed) {
+      const Candidate& c = train.candidates[f.candidate];
+      std::vector<double> p = f.parameters;
+      if (c.per_run) {
+        const auto it = std::find_if(test_cat.candidates.begin(), test_cat.candidates.end(),
+                                     [&](const Candidate& x) { return x.name == c.name; });
+        p = fit_run_parameters(*it, static_cast<int>(ti), test_cat.runs[ti], r, res.selection.sigma,
+                               o);
+        aug = augmented_case(aug, *it, p, r);
+      } else {
+        aug = augmented_case(aug, c, p, r);
+      }
+    }
+    // What the written file says: read back its TOML, mesh it, simulate it.
+    const core::CaseSpec again =
+        io::case_from_toml(io::resolved_case_toml(aug.spec), "augmented.toml");
+    if (res.selection.claimed.empty()) {
+      tr.after = tr.before;
+    } else {
+      const mesh::TetMesh m2 = mesh::mesh_case(again);
+      const Readout r2 = readout(m2, again, run);
+      tr.after = corrected(simulated_channels(m2, again, r2, run.time), run.time, r2, aug.sensors);
+    }
+    tr.augmented = aug;
+    meas.push_back(tr.measured);
+    before.push_back(tr.before);
+    after.push_back(tr.after);
+    res.tests.push_back(std::move(tr));
+  }
+  res.before = rms_figures(meas, before, r.sensors);
+  res.after = rms_figures(meas, after, r.sensors);
+
+  auto describe = [&](const EffectFit& f, bool claimed) {
+    const Candidate& c = train.candidates[f.candidate];
+    nlohmann::json j;
+    j["kind"] = kind_name(c.kind);
+    j["name"] = c.name;
+    j["location"] = c.location;
+    if (c.per_run) {
+      nlohmann::json runs = nlohmann::json::array();
+      for (size_t k = 0; k < f.run_parameters.size(); ++k)
+        runs.push_back(
+            {{"run", train.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
+      j["parameters"] = {{"per_training_run", runs}};
+      if (claimed) {
+        nlohmann::json tests = nlohmann::json::array();
+        for (const auto& t : res.tests) {
+          const auto& sinks = t.augmented.spec.thermal.convection;
+          nlohmann::json table = nlohmann::json::array();
+          if (!c.entries.empty())
+            for (size_t k = 0; k < sinks[c.entries[0]].sink.time.size(); ++k)
+              table.push_back(
+                  {sinks[c.entries[0]].sink.time[k], sinks[c.entries[0]].sink.value[k]});
+          tests.push_back({{"run", t.name}, {"sink_table_s_degC", table}});
+        }
+        j["parameters"]["per_test_run"] = tests;
+      }
+    } else {
+      j["parameters"] = parameters_json(c, f.parameters);
+    }
+    j["explained_fraction"] = f.explained_fraction;
+    j["heldout_gain"] = f.heldout_gain;
+    j["score"] = f.score;
+    j["model_form_floor"] = f.floor;
+    j["claimed"] = claimed;
+    return j;
+  };
+  res.effects = nlohmann::json::array();
+  for (const auto& f : res.selection.claimed) res.effects.push_back(describe(f, true));
+  res.runners_up = nlohmann::json::array();
+  for (const auto& f : res.selection.ranking) {
+    const bool is_claimed =
+        !res.selection.claimed.empty() && f.candidate == res.selection.claimed.front().candidate;
+    if (!is_claimed) res.runners_up.push_back(describe(f, false));
+  }
+  return res;
+}
+
+nlohmann::json calibration_json(const CalibrationResult& res,
+                                const std::vector<std::string>& train_names) {
+  nlohmann::json j;
+  j["format"] = "thermotwin-calibration/1";
+  j["training_runs"] = train_names;
+  nlohmann::json tests = nlohmann::json::array();
+  for (const auto& t : res.tests) tests.push_back(t.name);
+  j["test_runs"] = tests;
+  j["before"] = {{"temperature_rms_K", res.before.temperature_rms_K},
+                 {"displacement_rms_um", res.before.displacement_rms_um}};
+  j["after"] = {{"temperature_rms_K", res.after.temperature_rms_K},
+                {"displacement_rms_um", res.after.displacement_rms_um}};
+  j["effects"] = res.effects;
+  j["runners_up"] = res.runners_up;
+  nlohmann::json sigma = nlohmann::json::array();
+  for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
+    sigma.push_back(res.selection.sigma(c));
+  j["decision"] = {
+      {"rule",
+       "an effect is claimed when its leave-one-run-out gain minus the complexity penalty "
+       "(whitened sum "
+       "of squares) beats both the best score of every candidate fitted to pure white noise at the "
+       "estimated noise level and the model-form floor of the channels it moves"},
+      {"null_score", res.selection.null_score},
+      {"training_residual_whitened_ss", res.selection.residual_ss},
+      {"noise_sigma_per_channel", sigma}};
+  return j;
+}
+
+}  // namespace tt::calibration

@@ -1,0 +1,77 @@
+// Closing the loop: the declared model against measured runs, the effect it misses, and the
+// augmented model written as a case file, with RMS figures on test runs before and after.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calibration/effects.hpp"
+#include "core/case_spec.hpp"
+#include "io/measured_data.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::calibration {
+
+/// Post-processing of one sensor's simulated reading that the case file cannot express.
+struct SensorCorrection {
+  std::string sensor;
+  double offset_K = 0;  /// added to the reading [K]
+  double lag_s = 0;     /// first-order lag of the reading [s], 0 for none
+};
+
+/// The case with effects declared: `spec` (a valid case; read_case of its resolved TOML gives it
+/// back) and the sensor corrections applied to its readings.
+struct AugmentedCase {
+  core::CaseSpec spec;
+  std::vector<SensorCorrection> sensors;
+};
+
+/// `spec` with one fitted effect declared. Heat inputs become boundary groups (the patch's box
+/// intersected with each group it covers, inserted just before that group so they take its
+/// faces) with the covered group's convection and a surface flux; air temperature becomes sink
+/// tables; conductances, gains, coefficients and material values are changed in place.
+AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
+                             const std::vector<double>& parameters, const Readout& r);
+
+/// Readings corrected for sensor offsets and lags: #samples x #channels.
+Eigen::MatrixXd corrected(const Eigen::MatrixXd& channels, const Eigen::VectorXd& times,
+                          const Readout& r, const std::vector<SensorCorrection>& corrections);
+
+struct RmsFigures {
+  double temperature_rms_K = 0;
+  double displacement_rms_um = 0;
+};
+/// RMS over the finite samples of measured - simulated (temperatures, displacements).
+RmsFigures rms_figures(const std::vector<Eigen::MatrixXd>& measured,
+                       const std::vector<Eigen::MatrixXd>& simulated, int sensors);
+
+struct TestRun {
+  std::string name;
+  Eigen::VectorXd times;
+  Eigen::MatrixXd measured, before, after;  /// #samples x #channels [K | m]
+  AugmentedCase augmented;
+};
+
+struct CalibrationResult {
+  Selection selection;
+  std::vector<TestRun> tests;
+  RmsFigures before, after;
+  std::vector<std::vector<double>> training_run_parameters;  /// per claimed effect, per-run fits
+  nlohmann::json effects;  /// claimed: {kind, parameters, location, explained_fraction, ...}
+  nlohmann::json runners_up;
+};
+
+/// Selects effects on `train` (a catalogue built from the training runs) and evaluates the
+/// augmented model on `test` runs through the project's pipeline (mesh_case of the augmented case,
+/// thermal_history, elastic influence vectors), exactly as the written case file reads back.
+CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+                            const Catalogue& train, const std::vector<io::MeasuredRun>& test,
+                            const CalibrationOptions& options);
+
+/// The calibration.json document.
+nlohmann::json calibration_json(const CalibrationResult& result,
+                                const std::vector<std::string>& train_names);
+
+}  // namespace tt::calibration

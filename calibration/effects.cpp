@@ -1,0 +1,686 @@
+#include "calibration/effects.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+
+#include "core/errors.hpp"
+#include "core/rng.hpp"
+#include "solvers/loads.hpp"
+#include "solvers/thermal.hpp"
+
+namespace tt::calibration {
+
+namespace {
+
+constexpr double kCelsius = 273.15;
+
+double sink_k(const core::Convection& c, double t) {
+  return solvers::table_value(c.sink, t) + kCelsius;
+}
+
+/// Whitened residual rows of one run: vec(#samples x #channels) / sigma, with the mask of rows.
+struct Whitened {
+  Eigen::VectorXd y;               /// kept rows
+  std::vector<Eigen::Index> rows;  /// indices into the column-major vec
+  std::vector<int> channel;        /// channel of each kept row
+};
+
+Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma) {
+  Whitened w;
+  const Eigen::Index ns = run.times.size();
+  std::vector<double> v;
+  for (Eigen::Index c = 0; c < run.measured.cols(); ++c)
+    for (Eigen::Index i = 0; i < ns; ++i) {
+      const double m = run.measured(i, c);
+      if (!std::isfinite(m)) continue;
+      v.push_back((m - run.base(i, c)) / sigma(c));
+      w.rows.push_back(c * ns + i);
+      w.channel.push_back(static_cast<int>(c));
+    }
+  w.y = Eigen::Map<Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  return w;
+}
+
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& a, const Whitened& w, const Eigen::VectorXd& sigma) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(w.rows.size()), a.cols());
+  for (size_t k = 0; k < w.rows.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) = a.row(w.rows[k]) / sigma(w.channel[k]);
+  return out;
+}
+
+/// Normal-equation pieces of one candidate on one run.
+struct Normal {
+  Eigen::MatrixXd g;  /// A^T A
+  Eigen::VectorXd b;  /// A^T y
+  double s = 0;       /// y^T y
+};
+
+Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, double ridge) {
+  const Eigen::Index p = g.rows();
+  const double scale = std::max(g.diagonal().mean(), 1e-300);
+  Eigen::MatrixXd a = g + (ridge * scale) * Eigen::MatrixXd::Identity(p, p);
+  return a.ldlt().solve(b);
+}
+
+double gain_of(const Normal& n, const Eigen::VectorXd& theta) {
+  return 2 * theta.dot(n.b) - theta.dot(n.g * theta);
+}
+
+/// Channels a candidate moves (response norm above 1e-3 of its largest channel).
+std::vector<char> touched(const Candidate& c, Eigen::Index samples_first_run,
+                          Eigen::Index channels) {
+  std::vector<char> t(static_cast<size_t>(channels), 0);
+  const Eigen::MatrixXd& a = c.columns.front();
+  Eigen::VectorXd norm(channels);
+  for (Eigen::Index ch = 0; ch < channels; ++ch)
+    norm(ch) = a.middleRows(ch * samples_first_run, samples_first_run).norm();
+  const double mx = norm.maxCoeff();
+  for (Eigen::Index ch = 0; ch < channels; ++ch)
+    t[static_cast<size_t>(ch)] = mx > 0 && norm(ch) > 1e-3 * mx;
+  return t;
+}
+
+}  // namespace
+
+std::string kind_name(EffectKind kind) {
+  switch (kind) {
+    case EffectKind::ambient_temperature:
+      return "ambient_temperature";
+    case EffectKind::heat_input:
+      return "heat_input";
+    case EffectKind::speed_dependent_convection:
+      return "speed_dependent_convection";
+    case EffectKind::temperature_dependent_heat:
+      return "temperature_dependent_heat";
+    case EffectKind::boundary_conductance:
+      return "boundary_conductance";
+    case EffectKind::material_parameter:
+      return "material_parameter";
+    case EffectKind::sensor_offset:
+      return "sensor_offset";
+    case EffectKind::sensor_lag:
+      return "sensor_lag";
+  }
+  return "unknown";
+}
+
+Eigen::VectorXd lagged(const Eigen::VectorXd& times, const Eigen::VectorXd& x, double tau) {
+  Eigen::VectorXd y(x.size());
+  if (x.size() == 0) return y;
+  y(0) = x(0);
+  for (Eigen::Index k = 0; k + 1 < x.size(); ++k) {
+    const double d = times(k + 1) - times(k);
+    const double s = (x(k + 1) - x(k)) / d;
+    y(k + 1) = x(k + 1) - s * tau + (y(k) - x(k) + s * tau) * std::exp(-d / tau);
+  }
+  return y;
+}
+
+Eigen::VectorXd face_load(const mesh::TetMesh& m, const std::vector<int>& faces) {
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(m.nodes.rows());
+  for (int f : faces) {
+    const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), p = m.nodes.row(m.faces(f, 1)),
+                          q = m.nodes.row(m.faces(f, 2));
+    const double area = 0.5 * (p - a).cross(q - a).norm();
+    // int N dA: corners of a linear triangle A/3 each; a quadratic one puts A/3 on each mid-edge
+    // node.
+    const int first = m.order == 1 ? 0 : 3;
+    for (int k = 0; k < 3; ++k) b(m.faces(f, first + k)) += area / 3;
+  }
+  return b;
+}
+
+std::vector<Patch> surface_patches(const mesh::TetMesh& m, double spacing, double half) {
+  std::vector<int> ext;
+  std::vector<Eigen::Vector3d> centroid;
+  std::vector<double> area;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
+    if (m.face_other_tet[f] >= 0 || core::index_of(m.face_group[f]) < 0) continue;
+    const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), p = m.nodes.row(m.faces(f, 1)),
+                          q = m.nodes.row(m.faces(f, 2));
+    ext.push_back(static_cast<int>(f));
+    centroid.push_back((a + p + q) / 3);
+    area.push_back(0.5 * (p - a).cross(q - a).norm());
+    lo = lo.cwiseMin(centroid.back());
+    hi = hi.cwiseMax(centroid.back());
+  }
+  std::vector<Patch> out;
+  std::set<std::vector<int>> seen;
+  const Eigen::Vector3i count = (((hi - lo) / spacing).array().floor().cast<int>() + 1).matrix();
+  const Eigen::Vector3d start =
+      0.5 * (lo + hi) - 0.5 * spacing * (count.cast<double>() - Eigen::Vector3d::Ones());
+  for (int i = 0; i < count(0); ++i)
+    for (int j = 0; j < count(1); ++j)
+      for (int k = 0; k < count(2); ++k) {
+        const Eigen::Vector3d c = start + spacing * Eigen::Vector3d(i, j, k);
+        // One patch per boundary group in the box: heat through the bore is not heat through the
+        // housing's outside, and a patch mixing them would sit at neither.
+        std::map<int, Patch> by_group;
+        for (size_t e = 0; e < ext.size(); ++e) {
+          if ((centroid[e].array() < (c.array() - half)).any() ||
+              (centroid[e].array() > (c.array() + half)).any())
+            continue;
+          Patch& p = by_group[core::index_of(m.face_group[ext[e]])];
+          p.faces.push_back(ext[e]);
+          p.area += area[e];
+          p.centre += area[e] * centroid[e];
+        }
+        for (auto& [g, p] : by_group) {
+          if (p.area < 0.15 * (2 * half) * (2 * half) || !seen.insert(p.faces).second) continue;
+          p.box_min = c.array() - half;
+          p.box_max = c.array() + half;
+          p.centre /= p.area;
+          p.groups = {g};
+          out.push_back(std::move(p));
+        }
+      }
+  return out;
+}
+
+Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
+                            const CalibrationOptions& o) {
+  const Eigen::Index nc = runs.front().measured.cols();
+  Eigen::VectorXd sigma(nc);
+  for (Eigen::Index c = 0; c < nc; ++c) {
+    std::vector<double> d2;
+    for (const auto& r : runs) {
+      const Eigen::VectorXd e = r.measured.col(c) - r.base.col(c);
+      for (Eigen::Index i = 1; i + 1 < e.size(); ++i) {
+        const double v = e(i + 1) - 2 * e(i) + e(i - 1);
+        if (std::isfinite(v)) d2.push_back(std::abs(v));
+      }
+    }
+    double s = 0;
+    if (!d2.empty()) {
+      std::nth_element(d2.begin(), d2.begin() + d2.size() / 2, d2.end());
+      s = 1.4826 * d2[d2.size() / 2] / std::sqrt(6.0);
+    }
+    sigma(c) = std::max(s, c < sensors ? o.noise_floor_K : o.noise_floor_m);
+  }
+  return sigma;
+}
+
+Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, const Readout& r,
+                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
+                    bool ambient_only) {
+  Catalogue cat;
+  cat.readout = r;
+  const auto& conv = declared.thermal.convection;
+  const solvers::ThermalOperators ops = solvers::thermal_operators(m, declared);
+  double ref_speed = 0;
+  for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
+  if (ref_speed <= 0) {
+    for (const auto& run : runs) {
+      const core::CaseSpec s = case_for_run(declared, run);
+      for (const auto& seg : s.duty_cycle.segments) ref_speed = std::max(ref_speed, seg.speed_rpm);
+    }
+  }
+  if (ref_speed <= 0) ref_speed = 1;
+
+  // 1. The candidates' identities and their unit loads.
+  std::vector<Candidate> cands;
+  std::vector<SeparableColumn> sep;
+  std::vector<LoadColumn> loads;
+  std::vector<Eigen::MatrixXd> extra;
+  // Column bookkeeping: candidate -> (kind of column source, indices).
+  struct Source {
+    enum { separable, load, extra_readout, ambient, none } type;
+    std::vector<int> index;
+  };
+  std::vector<Source> sources;
+
+  double end_max = 0;
+  for (const auto& run : runs) end_max = std::max(end_max, run.time(run.time.size() - 1));
+  // Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
+  // whose group is not mechanically fixed (a bed that keeps its own temperature).
+  std::vector<double> knots;
+  const int intervals = std::max(1, static_cast<int>(std::ceil(end_max / o.ambient_knot_interval)));
+  for (int k = 0; k <= intervals; ++k) knots.push_back(end_max * k / intervals);
+  std::vector<std::vector<int>> variants;
+  std::vector<int> all, free;
+  for (size_t c = 0; c < conv.size(); ++c) {
+    all.push_back(static_cast<int>(c));
+    const auto& fixed = declared.mechanical.fixed_groups;
+    if (std::find(fixed.begin(), fixed.end(), conv[c].group) == fixed.end())
+      free.push_back(static_cast<int>(c));
+  }
+  if (!all.empty()) variants.push_back(all);
+  if (!free.empty() && free.size() != all.size()) variants.push_back(free);
+  for (size_t v = 0; v < variants.size(); ++v) {
+    Candidate c;
+    c.kind = EffectKind::ambient_temperature;
+    c.per_run = true;
+    c.knots = knots;
+    c.entries = variants[v];
+    c.name = v == 0 ? "air temperature on every convective sink"
+                    : "air temperature on the sinks of unfixed groups";
+    nlohmann::json groups = nlohmann::json::array();
+    for (int e : c.entries) groups.push_back(declared.groups[conv[e].group].name);
+    c.location = {{"convection_groups", groups}};
+    Source src{Source::load, {}};
+    for (size_t k = 0; k < knots.size(); ++k) {
+      c.parameters.push_back("delta_air_K at t = " + std::to_string(knots[k]) + " s");
+      const std::vector<int> entries = c.entries;
+      const double tk = knots[k], dk = end_max / intervals;
+      src.index.push_back(static_cast<int>(loads.size()));
+      // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
+      LoadColumn lc;
+      lc.name = c.name + " knot " + std::to_string(k);
+      lc.rhs = [&ops, &conv, entries, tk, dk](const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                              double t, double speed, double) {
+        const double hat = std::max(0.0, 1 - std::abs(t - tk) / dk);
+        Eigen::VectorXd f = Eigen::VectorXd::Zero(ops.conduction.rows());
+        if (hat == 0) return f;
+        for (int e : entries)
+          f += (hat * solvers::film_coefficient(conv[e], speed)) * ops.film_area[e];
+        return f;
+      };
+      loads.push_back(std::move(lc));
+    }
+    cands.push_back(std::move(c));
+    sources.push_back(src);
+  }
+
+  if (!ambient_only) {
+    // Heat entering through an undeclared surface patch, under each law.
+    for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
+      const Eigen::VectorXd shape = face_load(m, p.faces);
+      for (const std::string law : {"speed", "constant"}) {
+        Candidate c;
+        c.kind = EffectKind::heat_input;
+        c.law = law;
+        c.box_min = p.box_min;
+        c.box_max = p.box_max;
+        c.area = p.area;
+        c.ref_speed_rpm = ref_speed;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "heat input at (%.3f, %.3f, %.3f) m, %s", p.centre(0),
+                      p.centre(1), p.centre(2), law.c_str());
+        c.name = buf;
+        nlohmann::json groups = nlohmann::json::array();
+        for (int g : p.groups) groups.push_back(declared.groups[g].name);
+        c.location = {{"centre_m", {p.centre(0), p.centre(1), p.centre(2)}},
+                      {"box_min_m", {p.box_min(0), p.box_min(1), p.box_min(2)}},
+                      {"box_max_m", {p.box_max(0), p.box_max(1), p.box_max(2)}},
+                      {"area_m2", p.area},
+                      {"groups", groups}};
+        c.parameters = {law == "speed" ? "flux_W_m2 at " + std::to_string(ref_speed) + " rpm"
+                                       : "flux_W_m2"};
+        SeparableColumn col;
+        col.name = c.name;
+        col.shape = shape;
+        if (law == "speed")
+          col.law = [ref_speed](double, double speed) {
+            return speed > 0 ? speed / ref_speed : 0.0;
+          };
+        else
+          col.law = [](double, double) { return 1.0; };
+        sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
+        sep.push_back(std::move(col));
+        cands.push_back(std::move(c));
+      }
+    }
+    // Per convection entry: a wrong conductance, and a conductance growing with speed.
+    for (size_t e = 0; e < conv.size(); ++e) {
+      const std::string gname = declared.groups[conv[e].group].name;
+      for (int speed_law = 0; speed_law < 2; ++speed_law) {
+        Candidate c;
+        c.kind =
+            speed_law ? EffectKind::speed_dependent_convection : EffectKind::boundary_conductance;
+        c.group = static_cast<int>(e);
+        c.ref_speed_rpm = ref_speed;
+        c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
+        c.location = {{"group", gname}};
+        c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
+                                  : "delta_h_W_m2K"};
+        LoadColumn lc;
+        lc.name = c.name;
+        lc.rhs = [&ops, &conv, e, speed_law, ref_speed](const Eigen::VectorXd& t_new,
+                                                        const Eigen::VectorXd&, double t,
+                                                        double speed, double) {
+          const double scale = speed_law ? (speed > 0 ? speed / ref_speed : 0.0) : 1.0;
+          if (scale == 0) return Eigen::VectorXd::Zero(t_new.size()).eval();
+          return Eigen::VectorXd(-scale *
+                                 (ops.film[e] * t_new - sink_k(conv[e], t) * ops.film_area[e]));
+        };
+        sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+        loads.push_back(std::move(lc));
+        cands.push_back(std::move(c));
+      }
+    }
+    // Heat that grows with the source's temperature.
+    const double t0_k = declared.thermal.initial_temperature_c + kCelsius;
+    for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
+      const auto& srcspec = declared.thermal.sources[i];
+      Candidate c;
+      c.kind = EffectKind::temperature_dependent_heat;
+      c.source = static_cast<int>(i);
+      c.name = "heat of " + srcspec.name + " growing with its temperature";
+      c.location = {{"source", srcspec.name}, {"body", declared.bodies[srcspec.body].name}};
+      c.parameters = {"temperature_coefficient_per_K"};
+      LoadColumn lc;
+      lc.name = c.name;
+      lc.rhs = [&ops, &declared, i, t0_k](const Eigen::VectorXd& t_new, const Eigen::VectorXd&,
+                                          double, double speed, double) {
+        const double q = solvers::source_power(declared.thermal.sources[i], speed);
+        return Eigen::VectorXd(q * (ops.source_shape[i].dot(t_new) - t0_k) * ops.source_shape[i]);
+      };
+      sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+      loads.push_back(std::move(lc));
+      cands.push_back(std::move(c));
+    }
+    // Material parameters, each as a relative change: conductivity, heat capacity, expansion.
+    for (size_t mi = 0; mi < declared.materials.size(); ++mi) {
+      core::CaseSpec doubled = declared;
+      doubled.materials[mi].conductivity *= 2;
+      doubled.materials[mi].density *= 2;
+      const solvers::ThermalOperators dops = solvers::thermal_operators(m, doubled);
+      const auto km =
+          std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
+      const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
+      if (km->norm() == 0) continue;  // a material no body uses
+      const std::string mname = declared.materials[mi].name;
+      for (const std::string field : {"conductivity", "heat_capacity", "expansion"}) {
+        if (field == "expansion" && (r.displacement.rows() == 0 || !declared.mechanical.enabled))
+          continue;
+        Candidate c;
+        c.kind = EffectKind::material_parameter;
+        c.material = static_cast<int>(mi);
+        c.field = field;
+        c.name = field + " of " + mname;
+        c.location = {{"material", mname}, {"field", field}};
+        c.parameters = {"relative_change"};
+        if (field == "expansion") {
+          core::CaseSpec a2 = declared;
+          a2.materials[mi].expansion *= 2;
+          io::MeasuredRun probe_run = runs.front();
+          extra.push_back(displacement_readout(m, a2, probe_run, r) - r.displacement);
+          sources.push_back({Source::extra_readout, {static_cast<int>(extra.size()) - 1}});
+        } else {
+          LoadColumn lc;
+          lc.name = c.name;
+          if (field == "conductivity")
+            lc.rhs = [km](const Eigen::VectorXd& t_new, const Eigen::VectorXd&, double, double,
+                          double) { return Eigen::VectorXd(-(*km * t_new)); };
+          else
+            lc.rhs = [cm](const Eigen::VectorXd& t_new, const Eigen::VectorXd& t_old, double,
+                          double,
+                          double dt) { return Eigen::VectorXd(-(*cm * (t_new - t_old)) / dt); };
+          sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+          loads.push_back(std::move(lc));
+        }
+        cands.push_back(std::move(c));
+      }
+    }
+  }
+
+  // 2. One march per run with every column; sensors' own effects from the base histories.
+  std::vector<Responses> resp;
+  for (const auto& run : runs) {
+    RunModel rm;
+    rm.name = run.run;
+    rm.spec = case_for_run(declared, run);
+    rm.times = run.time;
+    rm.measured = measured_channels(run, r);
+    Responses rs = march(m, rm.spec, r, run.time, sep, loads, extra);
+    rm.base = rs.base;
+    cat.runs.push_back(std::move(rm));
+    resp.push_back(std::move(rs));
+  }
+  auto vec = [](const Eigen::MatrixXd& a) {
+    return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size()).eval();
+  };
+  for (size_t ci = 0; ci < cands.size(); ++ci) {
+    Candidate& c = cands[ci];
+    for (size_t ri = 0; ri < runs.size(); ++ri) {
+      const Responses& rs = resp[ri];
+      const Eigen::Index rows = rs.base.size();
+      Eigen::MatrixXd a(rows, static_cast<Eigen::Index>(sources[ci].index.size()));
+      for (size_t k = 0; k < sources[ci].index.size(); ++k) {
+        const int idx = sources[ci].index[k];
+        const Eigen::MatrixXd& m_k = sources[ci].type == Source::separable ? rs.columns[idx]
+                                     : sources[ci].type == Source::load
+                                         ? rs.columns[sep.size() + static_cast<size_t>(idx)]
+                                         : rs.extra[idx];
+        a.col(static_cast<Eigen::Index>(k)) = vec(m_k);
+      }
+      c.columns.push_back(std::move(a));
+    }
+  }
+  if (!ambient_only) {
+    for (int s = 0; s < r.sensors; ++s) {
+      Candidate c;
+      c.kind = EffectKind::sensor_offset;
+      c.sensor = s;
+      c.name = "offset of sensor " + r.ids[s];
+      c.location = {{"sensor", r.ids[s]}};
+      c.parameters = {"offset_K"};
+      for (const auto& rm : cat.runs) {
+        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
+        a.block(s * rm.times.size(), 0, rm.times.size(), 1).setOnes();
+        c.columns.push_back(a);
+      }
+      cands.push_back(std::move(c));
+      for (double tau : o.lag_grid_s) {
+        Candidate l;
+        l.kind = EffectKind::sensor_lag;
+        l.sensor = s;
+        l.fixed = true;
+        l.time_constant = tau;
+        l.name = "lag of sensor " + r.ids[s] + " (" + std::to_string(static_cast<int>(tau)) + " s)";
+        l.location = {{"sensor", r.ids[s]}};
+        l.parameters = {"time_constant_s"};
+        for (const auto& rm : cat.runs) {
+          Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
+          const Eigen::VectorXd x = rm.base.col(s);
+          a.block(s * rm.times.size(), 0, rm.times.size(), 1) = lagged(rm.times, x, tau) - x;
+          l.columns.push_back(a);
+        }
+        cands.push_back(std::move(l));
+      }
+    }
+  }
+  cat.candidates = std::move(cands);
+  return cat;
+}
+
+std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,
+                                       const Readout& r, const Eigen::VectorXd& sigma,
+                                       const CalibrationOptions& o) {
+  Whitened w = whitened(model, sigma);
+  // Temperatures only when the run has them: the displacements stay a check.
+  std::vector<Eigen::Index> keep;
+  for (size_t k = 0; k < w.rows.size(); ++k)
+    if (r.sensors == 0 || w.channel[k] < r.sensors) keep.push_back(static_cast<Eigen::Index>(k));
+  const Eigen::MatrixXd a_all = rows_of(c.columns[run], w, sigma);
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(keep.size()), a_all.cols());
+  Eigen::VectorXd y(static_cast<Eigen::Index>(keep.size()));
+  for (size_t k = 0; k < keep.size(); ++k) {
+    a.row(static_cast<Eigen::Index>(k)) = a_all.row(keep[k]);
+    y(static_cast<Eigen::Index>(k)) = w.y(keep[k]);
+  }
+  const Eigen::VectorXd theta =
+      solve_ridge(a.transpose() * a, a.transpose() * y, std::max(o.ridge, 1e-6));
+  return std::vector<double>(theta.data(), theta.data() + theta.size());
+}
+
+namespace {
+
+/// Scores every candidate on whitened residuals `ys` (per run); fills fits in candidate order.
+std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitened>& ws,
+                                 const std::vector<Eigen::VectorXd>& ys,
+                                 const Eigen::VectorXd& sigma, const CalibrationOptions& o,
+                                 bool with_parameters) {
+  const auto& r = cat.readout;
+  const size_t nr = cat.runs.size();
+  std::vector<EffectFit> fits(cat.candidates.size());
+  for (size_t ci = 0; ci < cat.candidates.size(); ++ci) {
+    const Candidate& c = cat.candidates[ci];
+    EffectFit& f = fits[ci];
+    f.candidate = static_cast<int>(ci);
+    f.kind = c.kind;
+    f.name = c.name;
+    const double p = static_cast<double>(c.columns.front().cols());
+    std::vector<Normal> normals(nr);
+    double total_s = 0;
+    for (size_t ri = 0; ri < nr; ++ri) {
+      const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sigma);
+      normals[ri] = {a.transpose() * a, a.transpose() * ys[ri], ys[ri].squaredNorm()};
+      total_s += normals[ri].s;
+    }
+    double heldout = 0, insample = 0;
+    if (c.fixed) {
+      const Eigen::VectorXd one = Eigen::VectorXd::Ones(1);
+      for (const auto& nm : normals) heldout += gain_of(nm, one);
+      insample = heldout;
+      f.heldout_gain = heldout;
+      f.score = heldout - o.penalty_per_parameter;
+      f.parameters = {c.time_constant};
+    } else if (c.per_run) {
+      for (size_t ri = 0; ri < nr; ++ri) {
+        // Fit on the run's temperatures, score on all of its channels.
+        std::vector<Eigen::Index> keep;
+        const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sigma);
+        for (size_t k = 0; k < ws[ri].rows.size(); ++k)
+          if (r.sensors == 0 || ws[ri].channel[k] < r.sensors)
+            keep.push_back(static_cast<Eigen::Index>(k));
+        Eigen::MatrixXd at(static_cast<Eigen::Index>(keep.size()), a.cols());
+        Eigen::VectorXd yt(static_cast<Eigen::Index>(keep.size()));
+        for (size_t k = 0; k < keep.size(); ++k) {
+          at.row(static_cast<Eigen::Index>(k)) = a.row(keep[k]);
+          yt(static_cast<Eigen::Index>(k)) = ys[ri](keep[k]);
+        }
+        const Eigen::VectorXd th =
+            solve_ridge(at.transpose() * at, at.transpose() * yt, std::max(o.ridge, 1e-6));
+        heldout += gain_of(normals[ri], th);
+        const Eigen::VectorXd full =
+            solve_ridge(normals[ri].g, normals[ri].b, std::max(o.ridge, 1e-6));
+        insample += gain_of(normals[ri], full);
+        if (with_parameters) f.run_parameters.emplace_back(th.data(), th.data() + th.size());
+      }
+      f.heldout_gain = heldout;
+      f.score = heldout - o.penalty_per_parameter * p * static_cast<double>(nr);
+    } else {
+      Normal sum{Eigen::MatrixXd::Zero(normals[0].g.rows(), normals[0].g.cols()),
+                 Eigen::VectorXd::Zero(normals[0].b.size()), 0};
+      for (const auto& nm : normals) {
+        sum.g += nm.g;
+        sum.b += nm.b;
+      }
+      for (size_t ri = 0; ri < nr; ++ri) {
+        const Eigen::VectorXd th =
+            solve_ridge(sum.g - normals[ri].g, sum.b - normals[ri].b, o.ridge);
+        heldout += gain_of(normals[ri], th);
+      }
+      const Eigen::VectorXd full = solve_ridge(sum.g, sum.b, o.ridge);
+      for (const auto& nm : normals) insample += gain_of(nm, full);
+      f.heldout_gain = heldout;
+      f.score = heldout - o.penalty_per_parameter * p;
+      if (with_parameters) f.parameters.assign(full.data(), full.data() + full.size());
+    }
+    f.explained_fraction = total_s > 0 ? insample / total_s : 0;
+  }
+  return fits;
+}
+
+}  // namespace
+
+Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
+  if (cat.runs.size() < 2)
+    throw core::DataError(
+        "calibration needs at least two training runs (got " + std::to_string(cat.runs.size()) +
+        "): effects are chosen by how much they explain on a run held out from the fit");
+  Selection sel;
+  const auto& r = cat.readout;
+  sel.sigma = noise_sigma(cat.runs, r.sensors, o);
+  std::vector<Whitened> ws;
+  std::vector<Eigen::VectorXd> ys;
+  for (const auto& rm : cat.runs) {
+    ws.push_back(whitened(rm, sel.sigma));
+    ys.push_back(ws.back().y);
+    sel.residual_ss += ys.back().squaredNorm();
+  }
+  // Noise alone: the best score over every candidate on white noise at the estimated level.
+  std::mt19937_64 rng = core::generator(o.seed, 7);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  sel.null_score = -1e300;
+  for (int trial = 0; trial < o.null_trials; ++trial) {
+    std::vector<Eigen::VectorXd> noise;
+    for (const auto& y : ys) {
+      Eigen::VectorXd e(y.size());
+      for (Eigen::Index i = 0; i < e.size(); ++i) e(i) = normal(rng);
+      noise.push_back(e);
+    }
+    for (const auto& f : score_all(cat, ws, noise, sel.sigma, o, false))
+      sel.null_score = std::max(sel.null_score, f.score);
+  }
+  // Model-form allowance per channel [whitened SS per sample].
+  Eigen::VectorXd allowance(r.channels());
+  for (int ch = 0; ch < r.channels(); ++ch) {
+    double tol = o.temperature_tolerance_K;
+    if (ch >= r.sensors) {
+      double ss = 0, cnt = 0;
+      for (const auto& rm : cat.runs) {
+        ss += rm.base.col(ch).squaredNorm();
+        cnt += static_cast<double>(rm.base.rows());
+      }
+      tol = o.displacement_tolerance_rel * std::sqrt(ss / cnt) + o.displacement_tolerance_m;
+    }
+    allowance(ch) = (tol / sel.sigma(ch)) * (tol / sel.sigma(ch));
+  }
+  std::vector<Eigen::VectorXd> current = ys;
+  const double total = sel.residual_ss;
+  for (int round = 0; round < o.max_effects; ++round) {
+    std::vector<EffectFit> fits = score_all(cat, ws, current, sel.sigma, o, true);
+    for (auto& f : fits) {
+      const Candidate& c = cat.candidates[f.candidate];
+      const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
+      f.floor = 0;
+      for (const auto& w : ws)
+        for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? allowance(ch) : 0.0;
+      // explained_fraction relative to the whole training residual, not what is left of it.
+      double left = 0;
+      for (const auto& y : current) left += y.squaredNorm();
+      f.explained_fraction *= total > 0 ? left / total : 0;
+    }
+    std::vector<int> order(fits.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return fits[a].score > fits[b].score; });
+    if (round == 0) {
+      std::set<std::string> places;
+      for (int i : order) {
+        const Candidate& c = cat.candidates[i];
+        const std::string key = kind_name(c.kind) + c.location.dump();
+        if (!places.insert(key).second) continue;
+        sel.ranking.push_back(fits[i]);
+        if (sel.ranking.size() >= 8) break;
+      }
+    }
+    const EffectFit& best = fits[order.front()];
+    if (!(best.score > sel.null_score && best.score > best.floor && best.score > 0)) break;
+    sel.claimed.push_back(best);
+    // Remove the claimed effect's in-sample fit before looking for the next one.
+    const Candidate& c = cat.candidates[best.candidate];
+    for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+      const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sel.sigma);
+      Eigen::VectorXd th;
+      if (c.fixed)
+        th = Eigen::VectorXd::Ones(1);
+      else if (c.per_run)
+        th = solve_ridge(a.transpose() * a, a.transpose() * current[ri], std::max(o.ridge, 1e-6));
+      else
+        th = Eigen::Map<const Eigen::VectorXd>(best.parameters.data(),
+                                               static_cast<Eigen::Index>(best.parameters.size()));
+      current[ri] -= a * th;
+    }
+  }
+  return sel;
+}
+
+}  // namespace tt::calibration

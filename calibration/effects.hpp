@@ -1,0 +1,138 @@
+// Candidate effects that the declared model may miss, each with the FEM response of every channel
+// to a unit of its parameters, and the choice among them: fitted by least squares across the
+// training runs, scored on runs held out from the fit, claimed only above what noise gives.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calibration/model.hpp"
+#include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::calibration {
+
+enum class EffectKind {
+  ambient_temperature,
+  heat_input,
+  speed_dependent_convection,
+  temperature_dependent_heat,
+  boundary_conductance,
+  material_parameter,
+  sensor_offset,
+  sensor_lag
+};
+std::string kind_name(EffectKind kind);
+
+struct CalibrationOptions {
+  double patch_spacing = 0.10;          /// grid of candidate heat-input patch centres [m]
+  double patch_half_size = 0.065;       /// half edge of a patch's box [m]
+  double ambient_knot_interval = 1800;  /// hat functions of the air temperature [s]
+  std::vector<double> lag_grid_s{30, 60, 120, 200, 300, 450, 700, 1000};
+  double ridge = 1e-8;                       /// relative to the normal matrix's mean diagonal
+  double penalty_per_parameter = 2;          /// complexity penalty [whitened sum of squares]
+  double temperature_tolerance_K = 0.025;    /// model-form error not to be explained by an effect
+  double displacement_tolerance_rel = 0.02;  /// ... relative to a probe's simulated RMS excursion
+  double displacement_tolerance_m = 0.1e-6;  /// ... plus this [m]
+  double noise_floor_K = 0.005, noise_floor_m = 0.01e-6;  /// least noise assumed per channel
+  int null_trials = 10;                                   /// fits to pure noise for the threshold
+  int max_effects = 2;
+  std::uint64_t seed = 20260107;
+};
+
+/// One run reduced to what the fit needs.
+struct RunModel {
+  std::string name;
+  core::CaseSpec spec;       /// the declared case under this run's inputs
+  Eigen::VectorXd times;     /// #samples [s]
+  Eigen::MatrixXd base;      /// #samples x #channels: declared model [K | m]
+  Eigen::MatrixXd measured;  /// #samples x #channels [K | m], NaN missing
+};
+
+/// A candidate effect: its identity, where it acts, and its channel responses per run.
+struct Candidate {
+  EffectKind kind = EffectKind::heat_input;
+  std::string name;
+  nlohmann::json location;
+  std::vector<std::string> parameters;  /// names with units
+  bool per_run = false;                 /// parameters fitted run by run (an unknown signal)
+  bool fixed = false;                   /// one column whose amplitude is 1 (a lag filter)
+  // What the augmented case needs.
+  int group = -1, material = -1, source = -1, sensor = -1;
+  std::string law, field;  /// heat-input law; material field
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  double area = 0, ref_speed_rpm = 0, time_constant = 0;
+  std::vector<double> knots;  /// ambient hat knots [s]
+  std::vector<int> entries;   /// ambient: convection entries whose sink moves
+  std::vector<Eigen::MatrixXd>
+      columns;  /// per run: (#samples #channels) x #parameters (column-major channels)
+};
+
+/// Channel histories of the declared model for each run and the catalogue of candidate effects
+/// with their responses (one march per run with every unit load as a column).
+struct Catalogue {
+  Readout readout;
+  std::vector<RunModel> runs;
+  std::vector<Candidate> candidates;
+};
+
+/// Heat-input patches: boxes on a grid over the exterior faces (centroid inside the box), one
+/// patch per boundary group the box covers.
+struct Patch {
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  /// area-weighted face centroid [m]
+  double area = 0;                                   /// [m^2]
+  std::vector<int> faces;
+  std::vector<int> groups;  /// boundary groups the faces belong to
+};
+std::vector<Patch> surface_patches(const mesh::TetMesh& mesh, double spacing, double half_size);
+/// #nodes integral of the shape functions over faces [m^2].
+Eigen::VectorXd face_load(const mesh::TetMesh& mesh, const std::vector<int>& faces);
+
+/// Builds the catalogue: `runs` carry the measured channels (order of `r`). `ambient_only`
+/// restricts the candidates to the air temperature (for runs held for testing).
+Catalogue catalogue(const mesh::TetMesh& mesh, const core::CaseSpec& declared, const Readout& r,
+                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& options,
+                    bool ambient_only = false);
+
+/// A candidate fitted to the training residual.
+struct EffectFit {
+  int candidate = -1;
+  EffectKind kind = EffectKind::heat_input;
+  std::string name;
+  std::vector<double> parameters;                   /// shared parameters
+  std::vector<std::vector<double>> run_parameters;  /// per run (per-run candidates)
+  double heldout_gain = 0;        /// whitened sum of squares removed on held-out runs
+  double score = 0;               /// heldout_gain - penalty
+  double explained_fraction = 0;  /// share of the training residual's whitened SS removed alone
+  double floor = 0;               /// model-form allowance for this candidate
+};
+
+struct Selection {
+  std::vector<EffectFit> claimed;  /// claimed effects, most important first
+  std::vector<EffectFit> ranking;  /// best candidate per (kind, place) of the first round
+  double null_score = 0;           /// best score over fits to pure noise
+  Eigen::VectorXd sigma;           /// per channel noise estimate [K | m]
+  double residual_ss = 0;          /// training residual, whitened
+};
+
+/// Per channel white-noise level from second differences of the residuals (robust, pooled).
+Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
+                            const CalibrationOptions& options);
+
+/// Chooses effects: leave-one-run-out gains, penalty, noise threshold, model-form floor; greedy
+/// over up to options.max_effects effects. Needs at least two runs.
+Selection select_effects(const Catalogue& cat, const CalibrationOptions& options);
+
+/// Fits a per-run candidate (the air temperature) to one run from its temperature channels.
+std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,
+                                       const Readout& r, const Eigen::VectorXd& sigma,
+                                       const CalibrationOptions& options);
+
+/// First-order lag of x sampled at `times` (exact for x linear between samples), y(0) = x(0).
+Eigen::VectorXd lagged(const Eigen::VectorXd& times, const Eigen::VectorXd& x, double tau);
+
+}  // namespace tt::calibration

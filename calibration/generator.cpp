@@ -1,0 +1,356 @@
+#include "calibration/generator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "calibration/calibrate.hpp"
+#include "core/errors.hpp"
+#include "core/rng.hpp"
+#include "solvers/elastic.hpp"
+#include "solvers/loads.hpp"
+#include "solvers/thermal.hpp"
+
+namespace tt::calibration {
+
+namespace {
+
+constexpr double kCelsius = 273.15;
+
+double uniform(std::mt19937_64& rng, double a, double b) {
+  return std::uniform_real_distribution<double>(a, b)(rng);
+}
+double log_uniform(std::mt19937_64& rng, double a, double b) {
+  return std::exp(uniform(rng, std::log(a), std::log(b)));
+}
+int pick(std::mt19937_64& rng, int n) {
+  return std::uniform_int_distribution<int>(0, n - 1)(rng);
+}
+double signed_factor(std::mt19937_64& rng, double lo, double hi) {
+  const double f = uniform(rng, lo, hi);
+  return pick(rng, 2) ? f : -f / (1 + f);  // +f or the matching decrease
+}
+
+int point_node(const mesh::TetMesh& m, const std::string& id) {
+  for (const auto& p : m.points)
+    if (p.id == id) return p.node;
+  throw core::DataError("generator: named point '" + id +
+                        "' is not in the mesh; expected one of the case's points");
+}
+
+}  // namespace
+
+core::CaseSpec generator_case(const core::CaseSpec& declared, const GeneratorOptions& o) {
+  core::CaseSpec s = declared;
+  for (auto& b : s.bodies) b.max_edge *= o.mesh_scale;
+  s.mesh.circle_segments = static_cast<int>(std::lround(s.mesh.circle_segments / o.mesh_scale));
+  s.thermal.step = o.step_s;
+  s.thermal.output_interval = o.step_s;
+  s.outputs.fields = false;
+  return s;
+}
+
+core::DutyCycle random_duty_cycle(double hours, std::mt19937_64& rng) {
+  core::DutyCycle d;
+  d.end = hours * 3600;
+  const double speeds[] = {1500, 2000, 3000, 4000};
+  double t = 0;
+  bool running = true;
+  while (t < d.end) {
+    d.segments.push_back({t, running ? speeds[pick(rng, 4)] : 0.0});
+    t += 300.0 * (1 + pick(rng, 6));
+    running = !running || pick(rng, 3) == 0;
+  }
+  return d;
+}
+
+InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
+                             const mesh::TetMesh& m, const std::vector<std::string>& sensors,
+                             std::mt19937_64& rng) {
+  InjectedEffect e;
+  e.present = true;
+  e.kind = kind;
+  e.seed = rng();
+  const auto& conv = declared.thermal.convection;
+  std::vector<int> unfixed;
+  for (size_t c = 0; c < conv.size(); ++c) {
+    const auto& f = declared.mechanical.fixed_groups;
+    if (std::find(f.begin(), f.end(), conv[c].group) == f.end())
+      unfixed.push_back(static_cast<int>(c));
+  }
+  switch (kind) {
+    case EffectKind::ambient_temperature:
+      e.magnitude = log_uniform(rng, 0.3, 2.5);
+      break;
+    case EffectKind::heat_input: {
+      // A box around a random point of the housing's unfixed exterior, sized at random.
+      std::vector<int> faces;
+      std::vector<double> cum;
+      double total = 0;
+      for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
+        const int g = core::index_of(m.face_group[f]);
+        if (m.face_other_tet[f] >= 0 || g < 0) continue;
+        const auto& fixed = declared.mechanical.fixed_groups;
+        if (std::find(fixed.begin(), fixed.end(), g) != fixed.end()) continue;
+        if (m.region_names[core::index_of(m.tet_region[m.face_tet[f]])] !=
+            declared.bodies.front().name)
+          continue;
+        const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), b = m.nodes.row(m.faces(f, 1)),
+                              c = m.nodes.row(m.faces(f, 2));
+        total += 0.5 * (b - a).cross(c - a).norm();
+        faces.push_back(static_cast<int>(f));
+        cum.push_back(total);
+      }
+      const double u = uniform(rng, 0, total);
+      const int f = faces[std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()];
+      const Eigen::Vector3d p =
+          (m.nodes.row(m.faces(f, 0)) + m.nodes.row(m.faces(f, 1)) + m.nodes.row(m.faces(f, 2))) /
+          3;
+      Eigen::Vector3d half(uniform(rng, 0.03, 0.06), uniform(rng, 0.03, 0.06),
+                           uniform(rng, 0.03, 0.06));
+      e.box_min = p - half;
+      e.box_max = p + half;
+      e.magnitude = log_uniform(rng, 4, 25);  // W
+      // The faces whose centroid is in the box (the case format's rule) give area and centre.
+      Eigen::Vector3d wc = Eigen::Vector3d::Zero();
+      for (int k : faces) {
+        const Eigen::Vector3d a = m.nodes.row(m.faces(k, 0)), b = m.nodes.row(m.faces(k, 1)),
+                              c = m.nodes.row(m.faces(k, 2));
+        const Eigen::Vector3d g = (a + b + c) / 3;
+        if ((g.array() < e.box_min.array()).any() || (g.array() > e.box_max.array()).any())
+          continue;
+        const double ar = 0.5 * (b - a).cross(c - a).norm();
+        const std::string gname = m.group_names[core::index_of(m.face_group[k])];
+        if (std::find(e.groups.begin(), e.groups.end(), gname) == e.groups.end())
+          e.groups.push_back(gname);
+        e.area += ar;
+        wc += ar * g;
+      }
+      e.centre = wc / e.area;
+      e.follows_speed = pick(rng, 2) == 1;
+      break;
+    }
+    case EffectKind::speed_dependent_convection: {
+      const int c = unfixed[static_cast<size_t>(pick(rng, static_cast<int>(unfixed.size())))];
+      e.target = declared.groups[conv[c].group].name;
+      e.magnitude = conv[c].h * log_uniform(rng, 1.5, 5);  // gain at 3000 rpm [W/(m2 K)]
+      break;
+    }
+    case EffectKind::temperature_dependent_heat: {
+      const int s = pick(rng, static_cast<int>(declared.thermal.sources.size()));
+      e.target = declared.thermal.sources[s].name;
+      e.magnitude = log_uniform(rng, 0.02, 0.08);
+      break;
+    }
+    case EffectKind::boundary_conductance: {
+      const int c = pick(rng, static_cast<int>(conv.size()));
+      e.target = declared.groups[conv[c].group].name;
+      e.magnitude = signed_factor(rng, 0.6, 2.0);
+      break;
+    }
+    case EffectKind::material_parameter: {
+      // The materials of the two largest bodies (housing, shaft), where a wrong value matters.
+      const char* fields[] = {"conductivity", "heat_capacity", "expansion"};
+      const int body = pick(rng, std::min(2, static_cast<int>(declared.bodies.size())));
+      const int mi = declared.bodies[body].material;
+      e.target = declared.materials[mi].name + "." + fields[pick(rng, 3)];
+      e.magnitude = signed_factor(rng, 0.25, 0.6);
+      break;
+    }
+    case EffectKind::sensor_offset:
+      e.target = sensors[static_cast<size_t>(pick(rng, static_cast<int>(sensors.size())))];
+      e.magnitude = (pick(rng, 2) ? 1 : -1) * log_uniform(rng, 0.15, 1.0);
+      break;
+    case EffectKind::sensor_lag:
+      e.target = sensors[static_cast<size_t>(pick(rng, static_cast<int>(sensors.size())))];
+      e.magnitude = uniform(rng, 120, 600);
+      break;
+  }
+  return e;
+}
+
+core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
+                          const core::DutyCycle& duty, int run_index) {
+  core::CaseSpec s = gen;
+  s.duty_cycle = duty;
+  if (!e.present) return s;
+  auto& conv = s.thermal.convection;
+  auto entry_of = [&](const std::string& group) -> core::Convection& {
+    for (auto& c : conv)
+      if (s.groups[c.group].name == group) return c;
+    throw core::DataError("generator: no convection on group '" + group + "'");
+  };
+  switch (e.kind) {
+    case EffectKind::ambient_temperature: {
+      // A smooth random air signal: a drift plus two slow waves, on every unfixed sink.
+      std::mt19937_64 rng = core::generator(e.seed, static_cast<std::uint64_t>(run_index));
+      const double drift = uniform(rng, -1, 1), ph1 = uniform(rng, 0, 6.3),
+                   ph2 = uniform(rng, 0, 6.3);
+      const double p1 = uniform(rng, 7200, 14400), p2 = uniform(rng, 2400, 5400);
+      core::TimeTable t;
+      for (double x = 0; x <= duty.end + 1e-9; x += 300) {
+        const double v =
+            drift * x / std::max(duty.end, 1.0) + 0.7 * std::sin(6.2832 * x / p1 + ph1) +
+            0.3 * std::sin(6.2832 * x / p2 + ph2) - (0.7 * std::sin(ph1) + 0.3 * std::sin(ph2));
+        t.time.push_back(x);
+        t.value.push_back(v * e.magnitude);
+      }
+      for (auto& c : conv) {
+        const auto& f = s.mechanical.fixed_groups;
+        if (std::find(f.begin(), f.end(), c.group) != f.end()) continue;
+        core::TimeTable own = t;
+        for (size_t k = 0; k < own.time.size(); ++k)
+          own.value[k] += solvers::table_value(c.sink, own.time[k]);
+        c.sink = own;
+      }
+      break;
+    }
+    case EffectKind::heat_input: {
+      // Every group the box covers gets its part (the case format's way to put heat on faces).
+      Candidate c;
+      c.kind = EffectKind::heat_input;
+      c.box_min = e.box_min;
+      c.box_max = e.box_max;
+      c.law = e.follows_speed ? "speed" : "constant";
+      c.ref_speed_rpm = 3000;
+      c.location = {{"groups", e.groups}};
+      AugmentedCase a{s, {}};
+      a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
+      s = a.spec;
+      break;
+    }
+    case EffectKind::speed_dependent_convection: {
+      auto& c = entry_of(e.target);
+      c.h_speed_gain = e.magnitude;
+      c.speed_ref_rpm = 3000;
+      c.speed_exponent = 0.8;
+      break;
+    }
+    case EffectKind::temperature_dependent_heat:
+      for (auto& src : s.thermal.sources)
+        if (src.name == e.target) src.temperature_coefficient = e.magnitude;
+      break;
+    case EffectKind::boundary_conductance:
+      entry_of(e.target).h *= 1 + e.magnitude;
+      break;
+    case EffectKind::material_parameter: {
+      const auto dot = e.target.find('.');
+      const std::string name = e.target.substr(0, dot), field = e.target.substr(dot + 1);
+      for (auto& mat : s.materials) {
+        if (mat.name != name) continue;
+        if (field == "conductivity")
+          mat.conductivity *= 1 + e.magnitude;
+        else if (field == "heat_capacity")
+          mat.specific_heat *= 1 + e.magnitude;
+        else
+          mat.expansion *= 1 + e.magnitude;
+      }
+      break;
+    }
+    case EffectKind::sensor_offset:
+    case EffectKind::sensor_lag:
+      break;  // applied to the readings
+  }
+  return s;
+}
+
+io::MeasuredRun clean_run(const mesh::TetMesh& m, const core::CaseSpec& truth,
+                          const InjectedEffect& e, const Instrumentation& inst,
+                          const GeneratorOptions& o, const std::string& name) {
+  const solvers::ThermalOperators ops = solvers::thermal_operators(m, truth);
+  const solvers::ThermalHistory th = solvers::thermal_history(m, truth, ops);
+  io::MeasuredRun run;
+  run.machine = truth.machine;
+  run.run = name;
+  run.inputs = {"speed_rpm"};
+  run.initial_temperature_c = truth.thermal.initial_temperature_c;
+  run.nominal_ambient_c =
+      truth.thermal.convection.empty() ? 20.0 : truth.thermal.convection.front().sink.value.front();
+  run.meta = {{"generator", "thermotwin calibration generator"}};
+  const Eigen::Index nt = static_cast<Eigen::Index>(th.times.size());
+  std::vector<Eigen::Index> at;  // history columns at the logger's samples
+  for (Eigen::Index k = 0; k < nt; ++k) {
+    const double q = th.times[k] / o.sample_interval_s;
+    if (std::abs(q - std::round(q)) < 1e-6) at.push_back(k);
+  }
+  const Eigen::Index ns = static_cast<Eigen::Index>(at.size());
+  run.time.resize(ns);
+  run.input_values.resize(ns, 1);
+  for (Eigen::Index i = 0; i < ns; ++i) {
+    run.time(i) = th.times[at[i]];
+    run.input_values(i, 0) = solvers::speed_at(truth.duty_cycle, run.time(i));
+  }
+  Eigen::VectorXd fine_t(nt);
+  for (Eigen::Index k = 0; k < nt; ++k) fine_t(k) = th.times[k];
+  run.temperature.resize(ns, static_cast<Eigen::Index>(inst.sensor_points.size()));
+  for (size_t s = 0; s < inst.sensor_points.size(); ++s) {
+    const int node = point_node(m, inst.sensor_points[s]);
+    run.sensors.push_back({inst.sensor_points[s], m.points[0].position});
+    for (const auto& p : m.points)
+      if (p.id == inst.sensor_points[s]) run.sensors.back().position = p.position;
+    Eigen::VectorXd x = th.temperature.row(node).transpose();
+    if (e.present && e.kind == EffectKind::sensor_lag && e.target == inst.sensor_points[s]) {
+      // The sensor's own first-order lag, integrated on the truth's fine time grid.
+      Eigen::VectorXd y(nt);
+      y(0) = x(0);
+      for (Eigen::Index k = 1; k < nt; ++k) {
+        const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
+        y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
+      }
+      x = y;
+    }
+    if (e.present && e.kind == EffectKind::sensor_offset && e.target == inst.sensor_points[s])
+      x.array() += e.magnitude;
+    for (Eigen::Index i = 0; i < ns; ++i)
+      run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
+  }
+  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
+    const int tcp = point_node(m, truth.mechanical.tcp_point);
+    const solvers::ElasticModel model(m, truth);
+    const char* ids[] = {"dx", "dy", "dz"};
+    run.displacement.resize(ns, 3);
+    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd a = model.influence(tcp, d);
+      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
+      const double u0 = a.dot(th.temperature.col(0));
+      for (Eigen::Index i = 0; i < ns; ++i)
+        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
+    }
+  } else {
+    run.displacement.resize(ns, 0);
+  }
+  return run;
+}
+
+io::MeasuredRun with_noise(const io::MeasuredRun& clean, const GeneratorOptions& o,
+                           std::mt19937_64& rng) {
+  io::MeasuredRun run = clean;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  auto quantise = [](double v, double q) { return q > 0 ? q * std::round(v / q) : v; };
+  for (Eigen::Index s = 0; s < run.temperature.cols(); ++s) {
+    double drift = 0;
+    for (Eigen::Index i = 0; i < run.time.size(); ++i) {
+      const double dt = i ? run.time(i) - run.time(i - 1) : 0.0;
+      const double a = std::exp(-dt / 600.0);
+      drift = a * drift + std::sqrt(1 - a * a) * o.drift_temperature_K * normal(rng);
+      run.temperature(i, s) =
+          quantise(run.temperature(i, s) - kCelsius + o.noise_temperature_K * normal(rng) + drift,
+                   o.quantum_temperature_K) +
+          kCelsius;
+    }
+  }
+  for (Eigen::Index p = 0; p < run.displacement.cols(); ++p)
+    for (Eigen::Index i = 0; i < run.time.size(); ++i)
+      run.displacement(i, p) = quantise(
+          run.displacement(i, p) + o.noise_displacement_m * normal(rng), o.quantum_displacement_m);
+  return run;
+}
+
+io::MeasuredRun synthetic_run(const mesh::TetMesh& m, const core::CaseSpec& truth,
+                              const InjectedEffect& e, const Instrumentation& inst,
+                              const GeneratorOptions& o, const std::string& name,
+                              std::mt19937_64& rng) {
+  return with_noise(clean_run(m, truth, e, inst, o, name), o, rng);
+}
+
+}  // namespace tt::calibration

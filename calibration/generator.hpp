@@ -1,0 +1,86 @@
+// Test data with an undeclared effect: the virtual machine with an extra effect switched on,
+// simulated on its own (finer) mesh and time step, read by noisy sensors, written in the
+// measured-data format. It shares none of the calibrator's choices: heat enters through a box of
+// random size and position (not a calibrator patch), the air temperature is a random smooth
+// signal (not hat functions), the convection gain follows speed with exponent 0.8, magnitudes
+// are drawn from ranges that reach down to the detection limit.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "calibration/effects.hpp"
+#include "core/case_spec.hpp"
+#include "io/measured_data.hpp"
+#include "mesh/tet_mesh.hpp"
+
+namespace tt::calibration {
+
+/// The effect switched on in the truth, with its drawn magnitude and place.
+struct InjectedEffect {
+  bool present = false;
+  EffectKind kind = EffectKind::heat_input;
+  double magnitude =
+      0;  /// kind's own unit: W (heat), K (air, offset), factor-1, 1/K, W/(m2K), s (lag)
+  std::string target;  /// group, material.field, source or sensor id
+  Eigen::Vector3d centre =
+      Eigen::Vector3d::Zero();  /// heat input: area-weighted centre of its faces [m]
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  std::vector<std::string> groups;  /// heat input: the boundary groups its box covers
+  double area = 0;  /// heat input: area of the faces in the box on the generator's mesh [m^2]
+  bool follows_speed = false;
+  std::uint64_t seed = 0;  /// for the run-specific parts (the air signal)
+};
+
+struct GeneratorOptions {
+  double mesh_scale = 0.8;                /// bodies' max_edge times this (finer than the case)
+  double step_s = 6;                      /// thermal step of the truth [s]
+  double sample_interval_s = 60;          /// the data logger's interval [s]
+  double noise_temperature_K = 0.03;      /// white noise per reading
+  double drift_temperature_K = 0.01;      /// slow correlated part (first-order, 600 s)
+  double noise_displacement_m = 0.08e-6;  /// white noise per reading
+  double quantum_temperature_K = 0.01, quantum_displacement_m = 0.01e-6;
+};
+
+/// A random effect of `kind` on `declared` (sizes drawn by `rng` from the ranges of
+/// docs/calibration.md). `mesh` is the generator's mesh (for the heat input's faces).
+InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
+                             const mesh::TetMesh& mesh, const std::vector<std::string>& sensor_ids,
+                             std::mt19937_64& rng);
+
+/// The generator's own case: the declared case meshed finer, with its own time step.
+core::CaseSpec generator_case(const core::CaseSpec& declared, const GeneratorOptions& options);
+
+/// `gen_case` (from generator_case) with `effect` switched on, under `duty` (run-specific air
+/// signal seeded by effect.seed + run_index).
+core::CaseSpec truth_case(const core::CaseSpec& gen_case, const InjectedEffect& effect,
+                          const core::DutyCycle& duty, int run_index);
+
+/// Sensors at named points of the case (by id) and displacement probes at the TCP in x, y, z.
+struct Instrumentation {
+  std::vector<std::string> sensor_points;  /// ids of named points
+  bool tcp_probes = true;
+};
+
+/// Simulates `truth` on `mesh`, samples it every options.sample_interval_s, applies sensor
+/// effects (offset, lag) and noise from `rng`, and returns the run (nominal conditions in meta).
+io::MeasuredRun synthetic_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
+                              const InjectedEffect& effect, const Instrumentation& inst,
+                              const GeneratorOptions& options, const std::string& name,
+                              std::mt19937_64& rng);
+
+/// The noiseless readings of synthetic_run (noise added separately so that many noise draws can
+/// share one simulation).
+io::MeasuredRun clean_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
+                          const InjectedEffect& effect, const Instrumentation& inst,
+                          const GeneratorOptions& options, const std::string& name);
+io::MeasuredRun with_noise(const io::MeasuredRun& clean, const GeneratorOptions& options,
+                           std::mt19937_64& rng);
+
+/// Random duty cycles of `hours`: segments of 5-30 min at 0, 1500, 2000, 3000 or 4000 rpm.
+core::DutyCycle random_duty_cycle(double hours, std::mt19937_64& rng);
+
+}  // namespace tt::calibration

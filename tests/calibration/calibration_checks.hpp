@@ -1,0 +1,55 @@
+// The per-kind check shared by the CI and the long variants.
+#pragma once
+
+#include <algorithm>
+#include <cstdio>
+
+#include "calibration_fixture.hpp"
+
+namespace tt::calibration::testing {
+
+/// One effect kind: generate, calibrate with it undeclared, check kind, place and RMS.
+inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
+  std::mt19937_64 rng = core::generator(seed, static_cast<std::uint64_t>(kind));
+  const InjectedEffect e = random_effect(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
+  const auto runs = testing::effect_runs(s, e, rng);
+  const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  const CalibrationResult res = calibrate(s.mesh, s.declared, cat, {runs[2]}, s.copt);
+  // RMS against the test run's noise-free truth: no model removes the sensors' noise.
+  const io::MeasuredRun truth =
+      clean_run(s.gen_mesh, truth_case(s.gen, e, s.duties[2], 2), e, s.inst, s.gopt, "truth");
+  const Eigen::MatrixXd clean = measured_channels(truth, s.train.readout);
+  const RmsFigures b = rms_figures({clean}, {res.tests[0].before}, s.train.readout.sensors);
+  const RmsFigures a = rms_figures({clean}, {res.tests[0].after}, s.train.readout.sensors);
+  const bool sensor_kind = kind == EffectKind::sensor_offset || kind == EffectKind::sensor_lag;
+  const double before = sensor_kind ? b.temperature_rms_K : b.displacement_rms_um;
+  const double after = sensor_kind ? a.temperature_rms_K : a.displacement_rms_um;
+  std::printf("[calibration] measured-data RMS: T %.4g -> %.4g K, u %.4g -> %.4g um; null %.1f\n",
+              res.before.temperature_rms_K, res.after.temperature_rms_K,
+              res.before.displacement_rms_um, res.after.displacement_rms_um,
+              res.selection.null_score);
+  for (size_t k = 0; k < std::min<size_t>(3, res.selection.ranking.size()); ++k)
+    std::printf("[calibration]   rank %zu: %s score %.1f floor %.1f explained %.3f\n", k,
+                res.selection.ranking[k].name.c_str(), res.selection.ranking[k].score,
+                res.selection.ranking[k].floor, res.selection.ranking[k].explained_fraction);
+  std::string first = res.effects.empty() ? "none" : res.effects[0]["kind"].get<std::string>();
+  std::printf(
+      "[calibration] %s magnitude %.4g target '%s': first %s, RMS before %.4g after %.4g (%s)\n",
+      kind_name(kind).c_str(), e.magnitude, e.target.c_str(), first.c_str(), before, after,
+      sensor_kind ? "K" : "um");
+  ASSERT_FALSE(res.effects.empty()) << "no effect claimed";
+  EXPECT_EQ(first, kind_name(kind)) << res.effects.dump(1);
+  if (kind == EffectKind::heat_input && first == "heat_input") {
+    const auto c = res.effects[0]["location"]["centre_m"];
+    const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+    const double err = (found - e.centre).norm();
+    std::printf(
+        "[calibration] heat input at (%.3f, %.3f, %.3f), found (%.3f, %.3f, %.3f): place error "
+        "%.3f m\n",
+        e.centre(0), e.centre(1), e.centre(2), found(0), found(1), found(2), err);
+    EXPECT_LT(err, 0.1);
+  }
+  EXPECT_LE(after, 0.3 * before);
+}
+
+}  // namespace tt::calibration::testing
