@@ -63,10 +63,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (n > 0 && !run.time.allFinite()) std::abort();
   } catch (const tt::core::Error&) {
     // a typed rejection is the expected answer to most inputs
-  } catch (const nlohmann::json::out_of_range& e) {
-    // Finding F2 (docs/reliability.md): a number beyond double in meta.json escapes as nlohmann's
-    // out_of_range 406 instead of a DataError. Let the fuzzer look past it until it is fixed.
-    if (e.id != 406) throw;
   }
   return 0;
 }

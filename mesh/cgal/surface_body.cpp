@@ -24,11 +24,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
+#include <iterator>
 #include <iostream>
 #include <limits>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "mesh/cgal/surface_file_check.hpp"
 
 namespace tt::mesh::cgal {
 namespace {
@@ -117,12 +120,26 @@ Eigen::Vector3d inside_point_of(const Mesh& m, double diagonal, const std::strin
   return best;
 }
 
-}  // namespace
+/// CGAL's OFF and PLY readers trust the file (docs/reliability.md, F4 to F7): what they would crash
+/// on or allocate without bound is refused here, naming the file and the line.
+void refuse_what_cgal_cannot_read(const std::filesystem::path& file, const std::string& prefix) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension != ".off" && extension != ".ply") return;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::GeometryError(prefix + "cannot open the file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto problem = extension == ".off" ? off_problem(text) : ply_header_problem(text);
+  if (problem)
+    throw core::GeometryError(prefix + *problem + ". Hint: export the surface again, as ASCII OFF, "
+                              "STL or a PLY with float coordinates.");
+}
 
-SurfaceSolid surface_solid(const std::filesystem::path& file, double scale,
-                           const std::string& what) {
-  const std::string prefix = file.string() + " (" + what + "): ";
+SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
+                             const std::string& prefix) {
   // 1. Read the polygon soup and make it a consistently oriented mesh.
+  refuse_what_cgal_cannot_read(file, prefix);
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
   std::ostringstream reader_said;  // CGAL's readers report format errors on std::cerr
@@ -144,7 +161,20 @@ SurfaceSolid surface_solid(const std::filesystem::path& file, double scale,
                               ". Hint: the file must be an ASCII or binary STL, an OFF or a PLY "
                               "surface.");
   }
+  if (const auto problem = soup_problem(polygons, points.size()))
+    throw core::GeometryError(prefix + *problem + ". Hint: check the exporter's settings.");
   for (auto& p : points) p = Point(scale * p.x(), scale * p.y(), scale * p.z());
+  // A machine part lies within kilometres of its origin; beyond that, a coordinate is a unit or
+  // export error, and CGAL's predicates are not made for it.
+  constexpr double kFarthest = 1e4;  // m
+  for (std::size_t v = 0; v < points.size(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!(std::abs(points[v][k]) <= kFarthest)) {
+        std::ostringstream msg;
+        msg << prefix << "vertex " << v << " has coordinate " << "xyz"[k] << " = " << points[v][k]
+            << " m, beyond " << kFarthest << " m. Hint: check the file and its length unit.";
+        throw core::GeometryError(msg.str());
+      }
   PMP::repair_polygon_soup(points, polygons);
   if (!PMP::orient_polygon_soup(points, polygons))
     throw core::GeometryError(prefix +
@@ -201,6 +231,22 @@ SurfaceSolid surface_solid(const std::filesystem::path& file, double scale,
   solid.inside_point = inside_point_of(m, diagonal, prefix);
   solid.surface = surface_of(m);
   return solid;
+}
+
+}  // namespace
+
+SurfaceSolid surface_solid(const std::filesystem::path& file, double scale,
+                           const std::string& what) {
+  const std::string prefix = file.string() + " (" + what + "): ";
+  try {
+    return solid_from_file(file, scale, prefix);
+  } catch (const CGAL::Failure_exception& e) {
+    // A precondition or assertion of CGAL's on a surface that passed every check before it.
+    throw core::GeometryError(prefix + "the geometry library refused the surface (" +
+                              e.expression() + " at " + e.filename() + ":" +
+                              std::to_string(e.line_number()) +
+                              "). Hint: check the file for degenerate or far-flung triangles.");
+  }
 }
 
 std::vector<PointLocation> locate_points(const TriangleSurface& surface,

@@ -195,7 +195,16 @@ TEST(SurfaceBody, TwoShellsAreRejected) {
 TEST(SurfaceBody, UnreadableFileIsRejected) {
   const std::string msg = surface_error("junk.ply", "this is not a PLY file\n");
   EXPECT_NE(msg.find("junk.ply"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("could not read"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("a PLY file starts with the line 'ply'"), std::string::npos) << msg;
+  const std::string stl = surface_error("junk.stl", "this is not an STL file\n");
+  EXPECT_NE(stl.find("could not read"), std::string::npos) << stl;
+}
+
+TEST(SurfaceBody, FarFlungVertexIsRejectedBeforeTheGeometryChecks) {
+  const std::string msg = surface_error(
+      "far.off", "OFF\n4 4 0\n0 0 0\n10 3.3e44 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
+  EXPECT_NE(msg.find("far.off"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("vertex 1 has coordinate y"), std::string::npos) << msg;
 }
 
 TEST(SurfaceBody, SurfaceMixedWithPrimitivesInOneBodyIsRejected) {
