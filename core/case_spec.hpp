@@ -184,6 +184,20 @@ struct OutputSpec {
   double fields_interval = 600;          /// time between field snapshots [s]
 };
 
+/// Where placement may put sensors ([placement] in the case file).
+struct PlacementSpec {
+  /// points: named points; surface: corner vertices of the mesh on chosen surfaces, plus the
+  /// named points listed in `points`.
+  enum class Candidates { points, surface };
+  Candidates candidates = Candidates::points;
+  /// points: the named points that are candidates; empty: every one but the TCP, the probe and
+  /// the axis points. surface: named points added to the surface vertices.
+  std::vector<std::string> points;
+  std::vector<int> bodies;  /// surface: exterior faces of these bodies' tets
+  std::vector<int> groups;  /// surface: faces of these boundary groups
+  int max_candidates = 0;   /// surface: > 0 thins the vertices to this many, spread out
+};
+
 struct CaseSpec {
   std::filesystem::path source;          /// the case file
   std::string name;
@@ -199,6 +213,7 @@ struct CaseSpec {
   ThermalSpec thermal;
   MechanicalSpec mechanical;
   OutputSpec outputs;
+  PlacementSpec placement;
 };
 
 }  // namespace tt::core

@@ -1119,10 +1119,64 @@ void read_outputs(const Tab& root, CaseSpec& spec) {
                                            Sign::positive, "time between field snapshots in s");
 }
 
+/// [placement]: which candidates the sensors are chosen from. Read after [mechanical], whose
+/// TCP, probe and axis points cannot be sensor positions.
+void read_placement(const Tab& root, CaseSpec& spec) {
+  using Candidates = core::PlacementSpec::Candidates;
+  const toml::node* n = root.get("placement");
+  if (!n) return;
+  const Tab p = as_tab(*root.ctx, *n, "placement");
+  const Ctx& c = *p.ctx;
+  p.allow({"candidates", "points", "bodies", "groups", "max_candidates"});
+  auto& pl = spec.placement;
+  pl.candidates =
+      choice_or<Candidates>(p, "candidates", pl.candidates,
+                            {{"points", Candidates::points}, {"surface", Candidates::surface}});
+  const bool surface = pl.candidates == Candidates::surface;
+  const auto& me = spec.mechanical;
+  if (const auto* a = p.get("points")) {
+    const auto idx = references(c, *a, p.at("points"), point_ids(spec), "point");
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+      const std::string& id = spec.points[idx[i]].id;
+      const auto listed = [&](const Names& ids) {
+        return std::find(ids.begin(), ids.end(), id) != ids.end();
+      };
+      const char* role = id == me.tcp_point        ? "the TCP"
+                         : listed(me.probe_points) ? "a probe point"
+                         : listed(me.axis_points)  ? "a feed-axis measurement point"
+                                                   : nullptr;
+      if (role)
+        fail_value(c, (*a->as_array())[i], p.at("points") + "[" + std::to_string(i) + "]",
+                   std::string("is ") + role + ", not a sensor position");
+      pl.points.push_back(id);
+    }
+  }
+  // Keys that only mean something for surface candidates.
+  for (const char* key : {"bodies", "groups", "max_candidates"})
+    if (!surface && p.get(key))
+      fail_value(c, *p.get(key), p.at(key), "only used with candidates = \"surface\"",
+                 "add candidates = \"surface\" or remove the key");
+  if (const auto* b = p.get("bodies"))
+    pl.bodies = references(c, *b, p.at("bodies"), names_of(spec.bodies), "body");
+  if (const auto* g = p.get("groups"))
+    pl.groups = references(c, *g, p.at("groups"), names_of(spec.groups), "boundary group");
+  if (surface && pl.bodies.empty() && pl.groups.empty())
+    fail_value(c, p.need("candidates", ""), p.at("candidates"),
+               "needs bodies = [body names] or groups = [boundary group names] in placement",
+               "the surface vertices of those bodies or groups become the candidates");
+  if (const auto* m = p.get("max_candidates")) {
+    const auto v = integer(c, *m, p.at("max_candidates"));
+    if (v < 0 || v > 10'000'000)
+      fail_value(c, *m, p.at("max_candidates"), "must lie in [0, 10000000]",
+                 "0 keeps every surface vertex");
+    pl.max_candidates = static_cast<int>(v);
+  }
+}
+
 CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file) {
   const Tab r{&ctx, &root, ""};
   r.allow({"case", "geometry", "materials", "bodies", "mesh", "boundary", "points", "duty_cycle",
-           "thermal", "mechanical", "outputs", "feed_axis"});
+           "thermal", "mechanical", "outputs", "feed_axis", "placement"});
   CaseSpec spec;
   spec.source = file;
   read_header(r, spec);
@@ -1141,6 +1195,7 @@ CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file)
   check_step(r, spec);
   read_mechanical(r, spec);
   read_outputs(r, spec);
+  read_placement(r, spec);
   return spec;
 }
 
@@ -1366,8 +1421,16 @@ std::string resolved_case_toml(const CaseSpec& spec) {
       << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
   o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
     << "\nfields = " << (spec.outputs.fields ? "true" : "false")
-    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval)
-    << "\n\n[points]\nlist = [\n";
+    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
+  const auto& pl = spec.placement;
+  o << "\n[placement]\ncandidates = "
+    << (pl.candidates == core::PlacementSpec::Candidates::surface ? "\"surface\"" : "\"points\"")
+    << "\npoints = " << strings_text(pl.points) << "\n";
+  if (pl.candidates == core::PlacementSpec::Candidates::surface)
+    o << "bodies = " << names_text(pl.bodies, bodies)
+      << "\ngroups = " << names_text(pl.groups, groups)
+      << "\nmax_candidates = " << pl.max_candidates << "\n";
+  o << "\n[points]\nlist = [\n";
   for (const auto& p : spec.points) {
     o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
     if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));

@@ -195,6 +195,11 @@ void expect_same(const CaseSpec& a, const CaseSpec& b, double tol = 0) {
   EXPECT_EQ(a.outputs.plot_points, b.outputs.plot_points);
   EXPECT_EQ(a.outputs.fields, b.outputs.fields);
   EXPECT_EQ(a.outputs.fields_interval, b.outputs.fields_interval);
+  EXPECT_EQ(a.placement.candidates, b.placement.candidates);
+  EXPECT_EQ(a.placement.points, b.placement.points);
+  EXPECT_EQ(a.placement.bodies, b.placement.bodies);
+  EXPECT_EQ(a.placement.groups, b.placement.groups);
+  EXPECT_EQ(a.placement.max_candidates, b.placement.max_candidates);
 }
 
 int index_of(const auto& items, const std::string& name) {
@@ -546,6 +551,10 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
   text +=
       "\n[mesh]\norder = 1\ncircle_segments = 24\nradius_edge_ratio = 2.0\n"
       "min_dihedral_deg = 15.0\n";
+  text +=
+      "\n[placement]\ncandidates = \"surface\"\nbodies = [\"pin\"]\ngroups = [\"joint\", "
+      "\"base\"]\n"
+      "max_candidates = 500\n";
 
   const CaseSpec s = read_case(write("full.toml", text));
   // Spot checks that the features landed in SI.
@@ -573,6 +582,10 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
   EXPECT_EQ(s.mechanical.point_supports[0].point, "P2");
   EXPECT_EQ(s.mechanical.point_supports[0].fixed, (std::array<bool, 3>{true, false, true}));
   EXPECT_EQ(s.mechanical.point_supports[1].fixed, (std::array<bool, 3>{true, true, true}));
+  EXPECT_EQ(s.placement.candidates, tt::core::PlacementSpec::Candidates::surface);
+  EXPECT_EQ(s.placement.bodies, std::vector<int>{1});
+  EXPECT_EQ(s.placement.groups, (std::vector<int>{2, 0}));
+  EXPECT_EQ(s.placement.max_candidates, 500);
 
   const std::string resolved = resolved_case_toml(s);
   fs::create_directories(dir_ / "elsewhere");  // the resolved file lives beside the results
@@ -772,6 +785,27 @@ const BadInput bad_inputs[] = {
      "plot_points = [\"P1\"]\nfields_interval_s = 0", "fields_interval_s",
      "outputs.fields_interval_s = 0", "must be > 0"},
     {"fixed_missing", "fixed = [\"base\"]\n", "", "[mechanical]", "mechanical.fixed", "missing"},
+    {"placement_unknown_key", "[points]",
+     "[placement]\ncandidates = \"surface\"\nbodies = [\"block\"]\nmax_candidate = 5\n\n[points]",
+     "max_candidate =", "placement.max_candidate = 5", "did you mean 'max_candidates'?"},
+    {"placement_unknown_kind", "[points]", "[placement]\ncandidates = \"surfaces\"\n\n[points]",
+     "surfaces", "placement.candidates = \"surfaces\"", "did you mean 'surface'?"},
+    {"placement_unknown_body", "[points]",
+     "[placement]\ncandidates = \"surface\"\nbodies = [\"blok\"]\n\n[points]", "blok",
+     "placement.bodies[0] = \"blok\"", "did you mean 'block'?"},
+    {"placement_unknown_group", "[points]",
+     "[placement]\ncandidates = \"surface\"\ngroups = [\"rest\", \"bse\"]\n\n[points]", "bse",
+     "placement.groups[1] = \"bse\"", "did you mean 'base'?"},
+    {"placement_surface_of_nothing", "[points]",
+     "[placement]\ncandidates = \"surface\"\n\n[points]",
+     "candidates =", "placement.candidates = \"surface\"", "needs bodies = [body names] or groups"},
+    {"placement_bodies_with_points", "[points]", "[placement]\nbodies = [\"block\"]\n\n[points]",
+     "bodies = [\"block\"]\n\n", "placement.bodies", "only used with candidates = \"surface\""},
+    {"placement_tcp_as_sensor", "[points]", "[placement]\npoints = [\"P1\"] # tcp\n\n[points]",
+     "# tcp", "placement.points[0] = \"P1\"", "is the TCP"},
+    {"placement_negative_max", "[points]",
+     "[placement]\ncandidates = \"surface\"\ngroups = [\"rest\"]\nmax_candidates = -3\n\n[points]",
+     "max_candidates", "placement.max_candidates = -3", "must lie in"},
 };
 
 INSTANTIATE_TEST_SUITE_P(CaseReader, BadCase, ::testing::ValuesIn(bad_inputs),
