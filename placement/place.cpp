@@ -83,6 +83,7 @@ struct TargetData {
   const PlacementInput& input;
   const PlacementOptions& options;
   std::size_t target_index;
+  const GreedyPath& greedy;  ///< Gaussian forward selection: the GA's fallback start
 };
 
 Selection selection(const TargetData& d, Method method, std::string search,
@@ -117,7 +118,18 @@ SearchResult searched(const TargetData& d, Method method, int m, const SetFitnes
   search = "ga";
   GaOptions ga = d.options.ga;
   ga.seed = core::derived_seed(d.options.seed, stream(d, method, 0));
-  return genetic_search(p, m, fitness, ga);
+  // The greedy set of m as pool positions (the pool is ascending).
+  std::vector<std::vector<int>> fallback;
+  if (static_cast<int>(d.greedy.order.size()) >= m) {
+    std::vector<int> positions;
+    for (int k = 0; k < m; ++k) {
+      const int column = d.greedy.order[static_cast<std::size_t>(k)];
+      positions.push_back(static_cast<int>(std::lower_bound(d.pool.begin(), d.pool.end(), column) -
+                                           d.pool.begin()));
+    }
+    fallback.push_back(std::move(positions));
+  }
+  return genetic_search(p, m, fitness, ga, fallback);
 }
 
 void histogram_selections(const TargetData& d, const Eigen::VectorXd& mi_bits,
@@ -288,7 +300,11 @@ PlacementResult place_all(const PlacementInput& input, const PlacementOptions& o
             : target.values_m;
     const auto linear = linear_problem(temperatures, y);
     const auto binned = binned_problem(temperatures, y, o.temperature_bins, o.error_bins);
-    const TargetData d{linear, binned, result.pool, input, o, t};
+    const bool searches =
+        wants(Method::kGaussianGreedy) || wants(Method::kGaussianGa) || wants(Method::kHistogramMi);
+    const GreedyPath greedy =
+        searches ? gaussian_greedy(linear, result.pool, o.m_max, o.collinearity) : GreedyPath{};
+    const TargetData d{linear, binned, result.pool, input, o, t, greedy};
 
     TargetResult tr;
     tr.target = target.name;
@@ -298,9 +314,7 @@ PlacementResult place_all(const PlacementInput& input, const PlacementOptions& o
 
     if (wants(Method::kHistogramMi)) histogram_selections(d, tr.mi_bits, out);
     if (wants(Method::kGaussianGreedy))
-      path_selections(d, Method::kGaussianGreedy,
-                      gaussian_greedy(linear, result.pool, o.m_max, o.collinearity),
-                      "gaussian_bits", out);
+      path_selections(d, Method::kGaussianGreedy, greedy, "gaussian_bits", out);
     if (wants(Method::kGaussianGa)) gaussian_ga_selections(d, out);
     if (wants(Method::kKsgGreedy) || wants(Method::kJmiKsg)) {
       tr.ksg_pool = ksg_pool_of(result.pool, linear, o.ksg_max_candidates);

@@ -90,7 +90,8 @@ SearchResult exhaustive_search(int pool_size, int m, const SetFitness& fitness) 
 }
 
 SearchResult genetic_search(int pool_size, int m, const SetFitness& fitness,
-                            const GaOptions& options) {
+                            const GaOptions& options,
+                            const std::vector<std::vector<int>>& fallback) {
   require_search(pool_size, m);
   if (options.population < 2 || options.elites < 0 || options.elites >= options.population ||
       options.tournament < 1)
@@ -130,6 +131,21 @@ SearchResult genetic_search(int pool_size, int m, const SetFitness& fitness,
     pop.push_back(std::move(c));
   }
   evaluate(pop);
+  const bool none_admissible = std::all_of(
+      pop.begin(), pop.end(), [&](const auto& c) { return !std::isfinite(seen.at(c)); });
+  if (none_admissible && !fallback.empty()) {
+    for (std::size_t i = 0; i < fallback.size() && i < pop.size(); ++i) {
+      auto c = fallback[i];
+      std::sort(c.begin(), c.end());
+      if (static_cast<int>(c.size()) != m || c.front() < 0 || c.back() >= pool_size ||
+          std::adjacent_find(c.begin(), c.end()) != c.end())
+        throw core::DataError("placement: GA fallback combination " + std::to_string(i) +
+                              ": expected " + std::to_string(m) + " distinct positions in [0, " +
+                              std::to_string(pool_size) + ")");
+      pop[i] = std::move(c);
+    }
+    evaluate(pop);
+  }
 
   auto fit = [&](const std::vector<int>& c) { return seen.at(c); };
   auto by_rank = [&](const std::vector<int>& a, const std::vector<int>& b) {

@@ -49,7 +49,13 @@ SearchResult exhaustive_search(int pool_size, int m, const SetFitness& fitness);
 /// The seeded genetic algorithm: random initial combinations, tournament selection, crossover
 /// that keeps the parents' shared genes and fills from the rest of their union, mutation that
 /// swaps one gene for a random outsider, elitism; every distinct combination evaluated once.
+/// `fallback`: admissible combinations (e.g. a greedy path's) that take the places of the first
+/// initial members when none of the random ones is admissible. Among thousands of smooth
+/// surface histories nearly every random m-set can hold a collinear pair, and a population
+/// with no finite fitness never moves; when one random member is admissible they are not used,
+/// so they cannot change a result the random start reaches on its own.
 SearchResult genetic_search(int pool_size, int m, const SetFitness& fitness,
-                            const GaOptions& options);
+                            const GaOptions& options,
+                            const std::vector<std::vector<int>>& fallback = {});
 
 }  // namespace tt::placement

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
+#include <random>
 
 #include "placement/baselines.hpp"
 #include "placement/gaussian.hpp"
@@ -92,6 +95,57 @@ TEST(Twins, MirrorPairsOfC54AndTheSearchPoolKeepTheLowerId) {
   EXPECT_EQ(pool[0], 0);
   EXPECT_EQ(pool[1], 1);
   EXPECT_EQ(pool[2], 3);
+}
+
+/// The definition, all pairs: for each i off the plane, the lowest j > i at its mirror image.
+static std::vector<std::pair<int, int>> all_pairs_twins(const Eigen::MatrixX3d& x, double plane,
+                                                        double tol) {
+  std::vector<std::pair<int, int>> pairs;
+  for (int i = 0; i < x.rows(); ++i) {
+    if (std::abs(x(i, 0) - plane) <= tol) continue;
+    Eigen::RowVector3d image = x.row(i);
+    image(0) = 2 * plane - image(0);
+    for (int j = i + 1; j < x.rows(); ++j)
+      if ((x.row(j) - image).cwiseAbs().maxCoeff() <= tol) {
+        pairs.emplace_back(i, j);
+        break;
+      }
+  }
+  return pairs;
+}
+
+TEST(Twins, ThousandsOfSurfaceVerticesGiveTheAllPairsAnswerFast) {
+  // 6000 candidates on a box surface: 2000 mirrored pairs about x = 0.01 in shuffled order, some
+  // images off by just more or just less than the tolerance, points on the plane, and a
+  // point duplicated (its image then matches the lowest of the copies).
+  std::mt19937_64 gen(5);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  const double plane = 0.01, tol = 1e-6;
+  std::vector<Eigen::RowVector3d> pts;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::RowVector3d a(plane + 0.001 + std::abs(u(gen)), u(gen),
+                               std::round(u(gen) * 50) / 50);
+    Eigen::RowVector3d b = a;
+    b(0) = 2 * plane - a(0);
+    if (k % 7 == 0) b(1) += (k % 2 ? 0.9 : 1.1) * tol;  // half within tolerance, half just outside
+    pts.push_back(a);
+    pts.push_back(b);
+  }
+  for (int k = 0; k < 1500; ++k) pts.emplace_back(u(gen), u(gen), u(gen));
+  for (int k = 0; k < 400; ++k) pts.emplace_back(plane + (k % 3 - 1) * 0.5 * tol, u(gen), u(gen));
+  for (int k = 0; k < 100; ++k) pts.push_back(pts[static_cast<std::size_t>(2 * k)]);
+  std::shuffle(pts.begin(), pts.end(), gen);
+  Eigen::MatrixX3d x(static_cast<Eigen::Index>(pts.size()), 3);
+  for (std::size_t i = 0; i < pts.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = pts[i];
+
+  const auto start = std::chrono::steady_clock::now();
+  const auto fast = mirror_twins(x, plane, tol);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto reference = all_pairs_twins(x, plane, tol);
+  EXPECT_EQ(fast, reference);
+  EXPECT_GT(fast.size(), 1900u);
+  EXPECT_LT(seconds, 0.5) << "6000 candidates took " << seconds << " s";
 }
 
 TEST(QrPod, PivotsPickOneCandidatePerIndependentPattern) {

@@ -104,3 +104,36 @@ TEST(Search, GeneticSearchIsReproducibleAndRespectsInadmissibleCombinations) {
   EXPECT_FALSE(a.best[0] == 0 && a.best[1] == 1);
   EXPECT_TRUE(std::isfinite(a.fitness));
 }
+
+TEST(Search, GeneticSearchStartsFromTheFallbackOnlyWhenNoRandomCombinationIsAdmissible) {
+  // 2000 candidates of which only the first 12 mix: a 6-set is admissible only inside them (as
+  // when almost every random set of smooth surface histories holds a collinear pair).
+  const SetFitness f = [](std::span<const int> s) {
+    double v = 0.0;
+    for (int i : s) {
+      if (i >= 12) return -std::numeric_limits<double>::infinity();
+      v += 1.0 / (1.0 + i);
+    }
+    return v;
+  };
+  GaOptions o;
+  o.seed = 4;
+  const auto alone = genetic_search(2000, 6, f, o);
+  EXPECT_FALSE(std::isfinite(alone.fitness)) << "the random start never finds an admissible set";
+  const auto seeded = genetic_search(2000, 6, f, o, {{11, 3, 5, 7, 9, 10}});
+  ASSERT_TRUE(std::isfinite(seeded.fitness));
+  EXPECT_GE(seeded.fitness, f(std::vector<int>{3, 5, 7, 9, 10, 11}));
+  for (int i : seeded.best) EXPECT_LT(i, 12);
+
+  // When the random start has admissible members the fallback is not used: the same result.
+  const SetFitness g = [](std::span<const int> s) {
+    double v = 0.0;
+    for (int i : s) v += std::sin(0.37 * i);
+    return v;
+  };
+  const auto plain = genetic_search(2000, 6, g, o);
+  const auto with_fallback = genetic_search(2000, 6, g, o, {{0, 1, 2, 3, 4, 5}});
+  EXPECT_EQ(plain.best, with_fallback.best);
+  EXPECT_EQ(plain.evaluations, with_fallback.evaluations);
+  EXPECT_THROW(genetic_search(2000, 6, f, o, {{1, 1, 2, 3, 4, 5}}), tt::core::DataError);
+}
