@@ -1,7 +1,10 @@
 // thermotwin place: where to put temperature sensors.
-//   thermotwin place CASE --out DIR          simulate the case, then place sensors on its candidates
-//   thermotwin place --from RUNDIR --out DIR place sensors on a finished run's histories
+//   thermotwin place CASE --out DIR          simulate the case, then place sensors on its
+//   candidates thermotwin place --from RUNDIR --out DIR place sensors on a finished run's histories
+// The candidates are the case's named points, or with [placement] candidates = "surface" the
+// vertices of the chosen surfaces (docs/placement.md).
 // Writes placement.json, mi_ranking.csv, candidates_mi.vtp and mi_bars_<target>.png.
+#include <chrono>
 #include <iostream>
 
 #include "app/commands.hpp"
@@ -19,11 +22,16 @@ namespace tt::app {
 
 Histories simulated_histories(const core::CaseSpec& spec, bool quiet) {
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  const CandidateSet candidates = candidate_set(spec, mesh);
   const std::vector<solvers::CampaignRun> runs{{"case", "the case's duty cycle", spec}};
-  const auto results = solvers::simulate_campaign(mesh, spec, runs, [&](double t, double end) {
-    if (!quiet) report_progress("thermal", t, end);
-  });
-  return histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
+  const auto results = solvers::simulate_campaign(
+      mesh, spec, runs,
+      [&](double t, double end) {
+        if (!quiet) report_progress("thermal", t, end);
+      },
+      candidates.nodes);
+  return histories_from_nodes(spec, candidates, results[0].times, results[0].node_temperature,
+                              results[0].error);
 }
 
 placement::PlacementInput placement_input(const Histories& h) {
@@ -55,17 +63,23 @@ int place_command(const PlaceArgs& args) {
   options.error_bins = args.bins;
   options.m_max = args.m_max;
   options.seed = spec.seed;
+  const auto t_place = std::chrono::steady_clock::now();
   const placement::PlacementResult result = placement::place_all(placement_input(h), options);
+  const double place_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_place).count();
 
   // 3. Outputs, all or nothing.
   io::OutputDir out(args.out);
   const auto& dir = out.path();
   nlohmann::json doc = io::placement_json(result);
   doc["candidates"] = nlohmann::json::array();
-  for (size_t c = 0; c < h.names.size(); ++c)
-    doc["candidates"].push_back({{"id", c + 1},
-                                 {"name", h.names[c]},
-                                 {"position_m", {h.positions(c, 0), h.positions(c, 1), h.positions(c, 2)}}});
+  for (size_t c = 0; c < h.names.size(); ++c) {
+    nlohmann::json entry{{"id", c + 1},
+                         {"name", h.names[c]},
+                         {"position_m", {h.positions(c, 0), h.positions(c, 1), h.positions(c, 2)}}};
+    if (h.nodes[c] >= 0) entry["node"] = h.nodes[c];
+    doc["candidates"].push_back(std::move(entry));
+  }
   io::write_json(dir / "placement.json", doc);
   io::write_mi_ranking_csv(dir / "mi_ranking.csv", result);
   std::vector<io::NamedField> fields;
@@ -76,12 +90,27 @@ int place_command(const PlaceArgs& args) {
     fields.push_back({"mi_rank_" + t.target, 1, rank});
   }
   io::write_point_cloud_vtp(dir / "candidates_mi.vtp", h.names, h.positions, fields);
-  for (const auto& t : result.targets)
-    plot({"bars", (dir / "mi_ranking.csv").string(), (dir / ("mi_bars_" + t.target + ".png")).string(),
-          "--label", "id", "--value", "mi_bits_" + t.target, "--title",
-          "single-sensor mutual information with " + t.target + " (formula 1)"});
+  // Thousands of surface candidates make an unreadable bar chart: then the best 50.
+  const bool many = h.names.size() > 60;
+  for (const auto& t : result.targets) {
+    std::vector<std::string> bars{"bars",
+                                  (dir / "mi_ranking.csv").string(),
+                                  (dir / ("mi_bars_" + t.target + ".png")).string(),
+                                  "--label",
+                                  "id",
+                                  "--value",
+                                  "mi_bits_" + t.target,
+                                  "--title",
+                                  std::string(many ? "best 50 candidates: " : "") +
+                                      "single-sensor mutual information with " + t.target +
+                                      " (formula 1)"};
+    if (many) bars.insert(bars.end(), {"--sort", "--top", "50"});
+    plot(bars);
+  }
   out.commit();
-  std::cerr << "thermotwin: place: " << h.names.size() << " candidates -> " << args.out.string() << "\n";
+  std::cerr << "thermotwin: place: " << h.names.size() << " candidates x "
+            << result.sample_times_s.size() << " samples, placement " << place_s << " s -> "
+            << args.out.string() << "\n";
   return 0;
 }
 

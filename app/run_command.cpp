@@ -7,8 +7,10 @@
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/study.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/axis_out.hpp"
+#include "io/candidates_csv.hpp"
 #include "io/case_reader.hpp"
 #include "io/checkpoint.hpp"
 #include "io/csv_out.hpp"
@@ -44,6 +46,21 @@ void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory
       rows(t, i + 1) = th.temperature(mesh.points[i].node, t) - solvers::kCelsiusOffset;
   }
   io::write_csv(path, header, rows);
+}
+
+/// candidates.csv and candidate_temperatures.csv (time_s, then <id>_degC per candidate): the
+/// histories `place --from` chooses sensors from when the case asks for surface candidates.
+void write_candidates(const CandidateSet& set, const solvers::ThermalHistory& th,
+                      const std::filesystem::path& dir) {
+  io::write_candidates_csv(dir / kCandidatesCsv, {set.names, set.nodes, set.positions});
+  std::vector<std::string> header{"time_s"};
+  for (const auto& id : set.names) header.push_back(id + "_degC");
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(th.times.size()),
+                       static_cast<Eigen::Index>(header.size()));
+  rows.col(0) = Eigen::Map<const Eigen::VectorXd>(th.times.data(), rows.rows());
+  rows.rightCols(rows.cols() - 1) =
+      solvers::nodal_history(th, set.nodes).array() - solvers::kCelsiusOffset;
+  io::write_csv(dir / kCandidateTemperaturesCsv, header, rows);
 }
 
 /// thermal_error.csv: the TCP and probe columns, then the feed axis's points when there are any.
@@ -145,6 +162,10 @@ int run_command(const RunArgs& args) {
   if (!args.quiet)
     std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets ("
               << mesh_s << " s)\n";
+  // Surface vertices that are candidate sensors: their histories go to candidate_temperatures.csv.
+  std::optional<CandidateSet> candidates;
+  if (spec.placement.candidates == core::PlacementSpec::Candidates::surface)
+    candidates = candidate_set(spec, mesh);
   // 3. Simulate: heat transfer, then thermo-elasticity. The time loop saves its state beside
   //    DIR (DIR.checkpoint) so that --resume continues a run that was killed.
   const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
@@ -176,6 +197,7 @@ int run_command(const RunArgs& args) {
   const auto t_write = Clock::now();
   write_mesh_files(mesh, spec, dir);
   write_temperatures(mesh, run.thermal, dir / "temperatures.csv");
+  if (candidates) write_candidates(*candidates, run.thermal, dir);
   // The feed axis's error at its measurement points, and its compensation polynomial.
   std::optional<solvers::AxisError> axis;
   std::optional<solvers::AxisPolynomial> axis_poly;

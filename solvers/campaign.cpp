@@ -107,7 +107,9 @@ std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
 }
 
 std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,
-                                              const std::vector<CampaignRun>& runs, const Progress& progress) {
+                                              const std::vector<CampaignRun>& runs,
+                                              const Progress& progress,
+                                              const std::vector<int>& sampled_nodes) {
   const ThermalOperators ops = thermal_operators(mesh, base);
   const ElasticModel elastic(mesh, base);
   const auto nodes = error_nodes(mesh, base);
@@ -125,10 +127,11 @@ std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const c
       if (progress) progress(done + t, total);
     });
     done += r.spec.duty_cycle.end;
-    CampaignResult c{r.name, r.shape, th.times, {}, {}};
-    c.point_temperature.resize(static_cast<Eigen::Index>(th.times.size()), static_cast<Eigen::Index>(mesh.points.size()));
-    for (size_t i = 0; i < mesh.points.size(); ++i)
-      c.point_temperature.col(static_cast<Eigen::Index>(i)) = th.temperature.row(mesh.points[i].node).transpose();
+    CampaignResult c{r.name, r.shape, th.times, {}, {}, {}};
+    std::vector<int> point_nodes;
+    for (const auto& p : mesh.points) point_nodes.push_back(p.node);
+    c.point_temperature = nodal_history(th, point_nodes);
+    c.node_temperature = nodal_history(th, sampled_nodes);
     const Eigen::MatrixXd u = influence * (th.temperature.array() - elastic.reference_temperature_k()).matrix();
     c.error = thermal_error_of(u, distance).values;
     results.push_back(std::move(c));

@@ -31,13 +31,17 @@ struct CampaignResult {
   std::string name, shape;
   std::vector<double> times;           /// [s], t = 0 first
   Eigen::MatrixXd point_temperature;   /// #times x #named points [K]
+  Eigen::MatrixXd node_temperature;    /// #times x #sampled nodes [K] (candidate sensors)
   Eigen::MatrixXd error;               /// #times x 9: thermal_error.csv's columns [m, rad]
 };
 
 /// Simulates every run on `mesh` (built from `base`; runs may differ from it only in duty cycle,
 /// initial temperature and sinks). The thermal error comes from adjoint influence vectors.
+/// Besides the named points, each run records the history at `sampled_nodes` (e.g. the surface
+/// vertices that are candidate sensors).
 std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,
                                               const std::vector<CampaignRun>& runs,
-                                              const Progress& progress = {});
+                                              const Progress& progress = {},
+                                              const std::vector<int>& sampled_nodes = {});
 
 }  // namespace tt::solvers

@@ -385,6 +385,19 @@ ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
                          : integrate<10>(mesh, spec, ops, progress, checkpointing);
 }
 
+Eigen::MatrixXd nodal_history(const ThermalHistory& history, const std::vector<int>& nodes) {
+  const Eigen::MatrixXd& t = history.temperature;
+  Eigen::MatrixXd out(t.cols(), static_cast<Eigen::Index>(nodes.size()));
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i] < 0 || nodes[i] >= t.rows())
+      throw core::SolverError("node " + std::to_string(nodes[i]) +
+                              " asked for a history: the mesh has " + std::to_string(t.rows()) +
+                              " nodes");
+    out.col(static_cast<Eigen::Index>(i)) = t.row(nodes[i]).transpose();
+  }
+  return out;
+}
+
 Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet) {
   Eigen::Matrix<double, 3, Eigen::Dynamic> x(3, mesh.nodes_per_tet());
   for (int a = 0; a < mesh.nodes_per_tet(); ++a) x.col(a) = mesh.nodes.row(mesh.tets(tet, a)).transpose();

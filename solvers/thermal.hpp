@@ -83,6 +83,10 @@ ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
                                const ThermalOperators& ops, const Progress& progress = {},
                                const Checkpointing& checkpointing = {});
 
+/// The history at some nodes, as a sensor there would record it: #times x nodes.size() [K].
+/// Throws SolverError for a node the history does not have.
+Eigen::MatrixXd nodal_history(const ThermalHistory& history, const std::vector<int>& nodes);
+
 /// Element coordinates gathered from the mesh: 3 x nodes-per-element [m].
 Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet);
 

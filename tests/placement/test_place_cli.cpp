@@ -1,0 +1,98 @@
+// End to end through the CLI on the coarse SB-1 (order 1): `run` with the housing's surface
+// vertices as candidates records their histories (candidates.csv, candidate_temperatures.csv),
+// and `place --from` the run chooses among them with every method, for dy and dz, m = 1..6.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kThermotwin = fs::path(TT_BINARY_DIR) / "thermotwin";
+const fs::path kCoarse = fs::path(TT_SOURCE_DIR) / "cases" / "sb1_coarse.toml";
+
+std::string text_of(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Runs thermotwin with `args`, output into `log`; its exit status.
+int thermotwin(const std::string& args, const fs::path& log) {
+  const std::string cmd = kThermotwin.string() + " " + args + " > '" + log.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+int data_lines(const fs::path& csv) {
+  std::ifstream in(csv);
+  int n = 0;
+  for (std::string line; std::getline(in, line);) n += !line.empty();
+  return n - 1;  // without the header
+}
+
+TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
+  const fs::path dir = fs::path(TT_BINARY_DIR) / "place_cli_scratch";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // The coarse case, without field files (not needed here), choosing among the housing's surface.
+  std::string text = text_of(kCoarse);
+  const auto outputs = text.find("[outputs]\n");
+  ASSERT_NE(outputs, std::string::npos);
+  text.insert(outputs + 10, "fields = false\n");
+  text += "\n[placement]\ncandidates = \"surface\"\nbodies = [\"housing\"]\n";
+  std::ofstream(dir / "case.toml") << text;
+
+  ASSERT_EQ(thermotwin("run '" + (dir / "case.toml").string() + "' --out '" +
+                           (dir / "run").string() + "' --quiet",
+                       dir / "run.log"),
+            0)
+      << text_of(dir / "run.log");
+  const int n = data_lines(dir / "run" / "candidates.csv");
+  EXPECT_GT(n, 1000) << "the housing of the coarse mesh has some 2000 surface vertices";
+  EXPECT_EQ(data_lines(dir / "run" / "candidate_temperatures.csv"),
+            data_lines(dir / "run" / "temperatures.csv"));
+
+  ASSERT_EQ(thermotwin("place --from '" + (dir / "run").string() + "' --out '" +
+                           (dir / "place").string() + "' --quiet",
+                       dir / "place.log"),
+            0)
+      << text_of(dir / "place.log");
+  const auto doc = nlohmann::json::parse(text_of(dir / "place" / "placement.json"));
+  ASSERT_EQ(doc["candidates"].size(), static_cast<size_t>(n));
+  for (const auto& c : doc["candidates"]) {
+    const std::string name = c["name"];
+    EXPECT_EQ(name, "v" + std::to_string(c["node"].get<int>()));
+  }
+  EXPECT_EQ(doc["samples"], 100);
+  const std::set<std::string> methods{"histogram_mi", "gaussian_greedy", "gaussian_ga",
+                                      "ksg_greedy",   "jmi_ksg",         "qr_pod",
+                                      "correlation",  "grey_relational"};
+  for (const std::string target : {"dy", "dz"}) {
+    ASSERT_TRUE(doc["targets"].contains(target)) << target;
+    const auto& by_method = doc["targets"][target]["methods"];
+    for (const auto& method : methods) {
+      ASSERT_TRUE(by_method.contains(method)) << target << " " << method;
+      std::set<int> ms;
+      for (const auto& s : by_method[method]) {
+        ms.insert(s["m"].get<int>());
+        EXPECT_EQ(s["ids"].size(), s["m"].get<size_t>());
+        for (const auto& id : s["ids"]) EXPECT_TRUE(id.get<int>() >= 1 && id.get<int>() <= n);
+      }
+      EXPECT_EQ(ms, (std::set<int>{1, 2, 3, 4, 5, 6})) << target << " " << method;
+    }
+  }
+  EXPECT_TRUE(fs::exists(dir / "place" / "candidates_mi.vtp"));
+  if (!HasFailure()) fs::remove_all(dir);  // kept for a look when something failed
+}
+
+}  // namespace
