@@ -90,11 +90,11 @@ std::string line_no(std::size_t index) {
 }  // namespace
 
 std::optional<std::string> ply_header_problem(std::string_view text) {
-  // Only the header is split into lines: the body of a binary file is no text.
+  // The header ends at the first line whose first word is exactly "end_header" (a word that only
+  // begins so, "end_header0...", does not end it); only the first megabyte is split into lines,
+  // since the body of a binary file is no text.
   constexpr std::size_t kLongestHeader = 1 << 20;
-  const std::size_t header_end = text.find("end_header");
-  const auto lines = lines_of(text.substr(
-      0, header_end == std::string_view::npos ? kLongestHeader : header_end + 10));
+  const auto lines = lines_of(text.substr(0, kLongestHeader));
   if (lines.empty() || words_of(lines[0]) != std::vector<std::string_view>{"ply"})
     return "a PLY file starts with the line 'ply'";
   std::string_view element;

@@ -52,6 +52,10 @@ TEST(PlyHeader, WhatCgalCrashesOnIsRefused) {
                                    "element face 4\nproperty list uchar float vertex_indices\n")),
             std::nullopt);
   EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex), std::nullopt);
+  // A word that only begins with end_header does not end the header (found by the fuzzer).
+  EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex + kPlainFace +
+                               "end_header0binary\n" + kPlyBody),
+            std::nullopt);
   EXPECT_NE(ply_header_problem("solid x\n"), std::nullopt);
 }
 
