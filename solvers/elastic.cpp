@@ -1,5 +1,6 @@
 #include "solvers/elastic.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -31,7 +32,8 @@ k::ElasticMaterial elastic_material(const mesh::TetMesh& m, const core::CaseSpec
   return k::ElasticMaterial{mat.youngs_modulus, mat.poisson_ratio, mat.expansion};
 }
 
-/// Stiffness K (3n x 3n) and thermal coupling G (3n x n): f_thermal = G (T - T_ref).
+/// Stiffness K (3n x 3n, upper triangle only: K is symmetric and CHOLMOD reads no more) and
+/// thermal coupling G (3n x n): f_thermal = G (T - T_ref).
 template <int N>
 std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(const mesh::TetMesh& m,
                                                                              const core::CaseSpec& spec) {
@@ -44,7 +46,7 @@ std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(con
   auto parts = core::parallel_chunks<std::pair<Triplets, Triplets>>(
       m.tets.rows(), 2048, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
         std::pair<Triplets, Triplets> out;
-        out.first.reserve((e - b) * 9 * N * N);
+        out.first.reserve((e - b) * 3 * N * (3 * N + 1) / 2);
         out.second.reserve((e - b) * 3 * N * N);
         for (auto t = b; t < e; ++t) {
           const int ti = static_cast<int>(t);
@@ -52,8 +54,10 @@ std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(con
           const auto mat = elastic_material(m, spec, ti);
           const auto ke = k::stiffness_matrix(x, mat, ti);
           for (int i = 0; i < 3 * N; ++i)
-            for (int j = 0; j < 3 * N; ++j)
-              out.first.emplace_back(3 * m.tets(ti, i / 3) + i % 3, 3 * m.tets(ti, j / 3) + j % 3, ke(i, j));
+            for (int j = 0; j < 3 * N; ++j) {
+              const int row = 3 * m.tets(ti, i / 3) + i % 3, col = 3 * m.tets(ti, j / 3) + j % 3;
+              if (row <= col) out.first.emplace_back(row, col, ke(i, j));
+            }
           const auto g = k::thermal_coupling_matrix(x, mat, ti);
           for (int j = 0; j < N; ++j)
             for (int i = 0; i < 3 * N; ++i)
@@ -61,10 +65,17 @@ std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(con
         }
         return out;
       });
+  // Gathered chunk by chunk, each chunk freed once copied, so that the triplets are held about
+  // once rather than twice.
+  std::size_t kn = 0, gn = 0;
+  for (const auto& p : parts) kn += p.first.size(), gn += p.second.size();
   Triplets kt, gt;
+  kt.reserve(kn);
+  gt.reserve(gn);
   for (auto& p : parts) {
     kt.insert(kt.end(), p.first.begin(), p.first.end());
     gt.insert(gt.end(), p.second.begin(), p.second.end());
+    p = {};
   }
   Eigen::SparseMatrix<double> kk(3 * n, 3 * n), g(3 * n, n);
   kk.setFromTriplets(kt.begin(), kt.end());
@@ -149,28 +160,39 @@ struct ElasticModel::Impl {
 ElasticModel::ElasticModel(const mesh::TetMesh& m, const core::CaseSpec& spec) : impl_(std::make_unique<Impl>()) {
   const auto t0 = Clock::now();
   const std::vector<char> fixed = constrained_dofs(m, spec);
-  auto [kk, g] = m.order == 1 ? assemble<4>(m, spec) : assemble<10>(m, spec);
-  const int ndof = static_cast<int>(kk.rows());
-  impl_->free_index.assign(ndof, -1);
-  int nf = 0;
-  for (int i = 0; i < ndof; ++i)
-    if (!fixed[i]) impl_->free_index[i] = nf++;
-  Triplets ft;
-  ft.reserve(kk.nonZeros());
-  for (int col = 0; col < kk.outerSize(); ++col)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(kk, col); it; ++it)
-      if (impl_->free_index[it.row()] >= 0 && impl_->free_index[col] >= 0)
-        ft.emplace_back(impl_->free_index[it.row()], impl_->free_index[col], it.value());
-  Eigen::SparseMatrix<double> kf(nf, nf);
-  kf.setFromTriplets(ft.begin(), ft.end());
-  kf.makeCompressed();
-  impl_->coupling = std::move(g);
-  impl_->free_dofs = nf;
+  // The free-dof stiffness, upper triangle only (all CHOLMOD reads), built in a scope of its own
+  // so that the full stiffness and the triplets are freed before the factor takes its memory; the
+  // matrix itself is freed once factored. On the refined SB-1 mesh (1.1 M dofs) the factor alone
+  // is about 15 GB, so what lives beside it decides whether the run fits.
+  Eigen::SparseMatrix<double> kf;
+  int ndof = 0;
+  {
+    auto [kk, g] = m.order == 1 ? assemble<4>(m, spec) : assemble<10>(m, spec);
+    ndof = static_cast<int>(kk.rows());
+    impl_->free_index.assign(ndof, -1);
+    int nf = 0;
+    for (int i = 0; i < ndof; ++i)
+      if (!fixed[i]) impl_->free_index[i] = nf++;
+    Triplets ft;
+    for (int col = 0; col < kk.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(kk, col); it; ++it) {
+        // Free indices keep the global order, so the upper triangle stays upper.
+        const int r = impl_->free_index[it.row()], c = impl_->free_index[col];
+        if (r >= 0 && c >= 0) ft.emplace_back(r, c, it.value());
+      }
+    kk = Eigen::SparseMatrix<double>();
+    kf.resize(nf, nf);
+    kf.setFromTriplets(ft.begin(), ft.end());
+    kf.makeCompressed();
+    impl_->coupling = std::move(g);
+    impl_->free_dofs = nf;
+  }
   timings_.assemble_s = std::chrono::duration<double>(Clock::now() - t0).count();
   timings_.dofs = ndof;
-  timings_.free_dofs = nf;
+  timings_.free_dofs = impl_->free_dofs;
   const auto t1 = Clock::now();
   impl_->factor = std::make_unique<cholmod::Factor>(kf, "elastic stiffness");
+  kf = Eigen::SparseMatrix<double>();
   timings_.factor_s = std::chrono::duration<double>(Clock::now() - t1).count();
   reference_k_ = spec.mechanical.reference_temperature_c + kCelsiusOffset;
 }
@@ -183,15 +205,23 @@ Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) 
     throw core::SolverError("temperature fields have " + std::to_string(temperature.rows()) +
                             " rows, expected one per mesh node (" + std::to_string(impl_->coupling.cols()) +
                             "). Hint: on a 10-node mesh give mid-edge nodes too.");
-  const Eigen::MatrixXd load = impl_->coupling * (temperature.array() - reference_k_).matrix();
-  const int ndof = static_cast<int>(load.rows());
-  Eigen::MatrixXd rhs(impl_->free_dofs, load.cols());
-  for (int i = 0; i < ndof; ++i)
-    if (impl_->free_index[i] >= 0) rhs.row(impl_->free_index[i]) = load.row(i);
-  const Eigen::MatrixXd uf = impl_->factor->solve(rhs);
-  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(ndof, load.cols());
-  for (int i = 0; i < ndof; ++i)
-    if (impl_->free_index[i] >= 0) u.row(i) = uf.row(impl_->free_index[i]);
+  // The output times go through the factor as multi-right-hand-side blocks of a bounded width:
+  // one block for all times would hold five dense copies of #dofs x #times beside the factor.
+  constexpr Eigen::Index kBlock = 16;
+  const int ndof = static_cast<int>(impl_->coupling.rows());
+  const Eigen::Index times = temperature.cols();
+  Eigen::MatrixXd u = Eigen::MatrixXd::Zero(ndof, times);
+  for (Eigen::Index first = 0; first < times; first += kBlock) {
+    const Eigen::Index width = std::min(kBlock, times - first);
+    const Eigen::MatrixXd load =
+        impl_->coupling * (temperature.middleCols(first, width).array() - reference_k_).matrix();
+    Eigen::MatrixXd rhs(impl_->free_dofs, width);
+    for (int i = 0; i < ndof; ++i)
+      if (impl_->free_index[i] >= 0) rhs.row(impl_->free_index[i]) = load.row(i);
+    const Eigen::MatrixXd uf = impl_->factor->solve(rhs);
+    for (int i = 0; i < ndof; ++i)
+      if (impl_->free_index[i] >= 0) u.block(i, first, 1, width) = uf.row(impl_->free_index[i]);
+  }
   return u;
 }
 
