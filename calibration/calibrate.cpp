@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
@@ -99,10 +100,18 @@ AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
         ng.name = unique_group_name(s, "heat_input_" + gname.get<std::string>());
         ng.rest = s.groups[g].rest;
         for (core::FaceSelector sel : s.groups[g].select) {
+          // Only the patch's body: the bore's group also holds the shaft's faces across the gap.
+          if (c.body >= 0) {
+            if (!sel.bodies.empty() &&
+                std::find(sel.bodies.begin(), sel.bodies.end(), c.body) == sel.bodies.end())
+              continue;
+            sel.bodies = {c.body};
+          }
           sel.within_min = sel.within_min ? sel.within_min->cwiseMax(c.box_min) : c.box_min;
           sel.within_max = sel.within_max ? sel.within_max->cwiseMin(c.box_max) : c.box_max;
           ng.select.push_back(sel);
         }
+        if (ng.select.empty()) continue;
         insert_group(s, g, ng);  // the covered group is now at g + 1
         const int covered = g + 1;
         std::vector<core::Convection> copies;
@@ -217,11 +226,24 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
                             const CalibrationOptions& o) {
   CalibrationResult res;
   res.selection = select_effects(train, o);
-  const Readout& r = train.readout;
+  // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
+  // grids around the best ones, and the choice made again with those candidates, so that the
+  // noise rule and the ranking see them too.
+  std::optional<Catalogue> refined;
+  if (!res.selection.claimed.empty()) {
+    const Candidate& first = train.candidates[res.selection.claimed.front().candidate];
+    if (first.kind == EffectKind::heat_input && o.heat_refine_levels > 0)
+      refined = with_refined_heat_inputs(mesh, train, o);
+    else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
+      refined = with_refined_lag(train, first.sensor, first.time_constant, o);
+    if (refined) res.selection = select_effects(*refined, o);
+  }
+  const Catalogue& cat = refined ? *refined : train;
+  const Readout& r = cat.readout;
   // Per-run effects need their own fit on each test run (the air temperature is a signal of the
   // run, not of the machine): the ambient columns for the test runs.
   bool per_run = false;
-  for (const auto& f : res.selection.claimed) per_run |= train.candidates[f.candidate].per_run;
+  for (const auto& f : res.selection.claimed) per_run |= cat.candidates[f.candidate].per_run;
   Catalogue test_cat;
   if (per_run && !test.empty()) test_cat = catalogue(mesh, declared, r, test, o, true);
 
@@ -241,7 +263,7 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
     tr.before = simulated_channels(mesh, spec, rt, run.time);
     AugmentedCase aug{spec, {}};
     for (const auto& f : res.selection.claimed) {
-      const Candidate& c = train.candidates[f.candidate];
+      const Candidate& c = cat.candidates[f.candidate];
       std::vector<double> p = f.parameters;
       if (c.per_run) {
         const auto it = std::find_if(test_cat.candidates.begin(), test_cat.candidates.end(),
@@ -273,7 +295,7 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
   res.after = rms_figures(meas, after, r.sensors);
 
   auto describe = [&](const EffectFit& f, bool claimed) {
-    const Candidate& c = train.candidates[f.candidate];
+    const Candidate& c = cat.candidates[f.candidate];
     nlohmann::json j;
     j["kind"] = kind_name(c.kind);
     j["name"] = c.name;
@@ -282,7 +304,7 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
       nlohmann::json runs = nlohmann::json::array();
       for (size_t k = 0; k < f.run_parameters.size(); ++k)
         runs.push_back(
-            {{"run", train.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
+            {{"run", cat.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
       j["parameters"] = {{"per_training_run", runs}};
       if (claimed) {
         nlohmann::json tests = nlohmann::json::array();

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <set>
@@ -134,52 +135,138 @@ Eigen::VectorXd face_load(const mesh::TetMesh& m, const std::vector<int>& faces)
   return b;
 }
 
-std::vector<Patch> surface_patches(const mesh::TetMesh& m, double spacing, double half) {
-  std::vector<int> ext;
+namespace {
+
+/// Exterior faces that belong to a boundary group, with centroid and area.
+struct ExteriorFaces {
+  std::vector<int> face;
   std::vector<Eigen::Vector3d> centroid;
   std::vector<double> area;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = Eigen::Vector3d::Constant(-1e300);
+};
+
+ExteriorFaces exterior_faces(const mesh::TetMesh& m) {
+  ExteriorFaces x;
   for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
     if (m.face_other_tet[f] >= 0 || core::index_of(m.face_group[f]) < 0) continue;
     const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), p = m.nodes.row(m.faces(f, 1)),
                           q = m.nodes.row(m.faces(f, 2));
-    ext.push_back(static_cast<int>(f));
-    centroid.push_back((a + p + q) / 3);
-    area.push_back(0.5 * (p - a).cross(q - a).norm());
-    lo = lo.cwiseMin(centroid.back());
-    hi = hi.cwiseMax(centroid.back());
+    x.face.push_back(static_cast<int>(f));
+    x.centroid.push_back((a + p + q) / 3);
+    x.area.push_back(0.5 * (p - a).cross(q - a).norm());
+    x.lo = x.lo.cwiseMin(x.centroid.back());
+    x.hi = x.hi.cwiseMax(x.centroid.back());
   }
+  return x;
+}
+
+std::vector<Patch> box_patches(const mesh::TetMesh& m, const ExteriorFaces& ext,
+                               const std::vector<Eigen::Vector3d>& centres, double half) {
   std::vector<Patch> out;
   std::set<std::vector<int>> seen;
-  const Eigen::Vector3i count = (((hi - lo) / spacing).array().floor().cast<int>() + 1).matrix();
+  for (const Eigen::Vector3d& c : centres) {
+    // One patch per boundary group and body in the box: heat through the bore is not heat through
+    // the housing's outside, nor heat into the shaft across the gap, and a patch mixing them would
+    // sit at neither.
+    std::map<std::pair<int, int>, Patch> by_place;
+    for (size_t e = 0; e < ext.face.size(); ++e) {
+      if ((ext.centroid[e].array() < (c.array() - half)).any() ||
+          (ext.centroid[e].array() > (c.array() + half)).any())
+        continue;
+      const int f = ext.face[e];
+      const int body = core::index_of(m.tet_region[static_cast<size_t>(m.face_tet[f])]);
+      Patch& p = by_place[{core::index_of(m.face_group[f]), body}];
+      p.faces.push_back(f);
+      p.area += ext.area[e];
+      p.centre += ext.area[e] * ext.centroid[e];
+    }
+    for (auto& [place, p] : by_place) {
+      if (p.area < 0.15 * (2 * half) * (2 * half) || !seen.insert(p.faces).second) continue;
+      p.box_min = c.array() - half;
+      p.box_max = c.array() + half;
+      p.centre /= p.area;
+      p.groups = {place.first};
+      p.body = place.second;
+      out.push_back(std::move(p));
+    }
+  }
+  return out;
+}
+
+/// A heat-input candidate on patch `p` under `law` ("speed" or "constant"), without columns.
+Candidate heat_candidate(const Patch& p, const std::string& law, double ref_speed,
+                         const core::CaseSpec& spec) {
+  Candidate c;
+  c.kind = EffectKind::heat_input;
+  c.law = law;
+  c.box_min = p.box_min;
+  c.box_max = p.box_max;
+  c.area = p.area;
+  c.body = p.body;
+  c.ref_speed_rpm = ref_speed;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "heat input at (%.3f, %.3f, %.3f) m, %s", p.centre(0), p.centre(1),
+                p.centre(2), law.c_str());
+  c.name = buf;
+  nlohmann::json groups = nlohmann::json::array();
+  for (int g : p.groups) groups.push_back(spec.groups[g].name);
+  c.location = {{"centre_m", {p.centre(0), p.centre(1), p.centre(2)}},
+                {"box_min_m", {p.box_min(0), p.box_min(1), p.box_min(2)}},
+                {"box_max_m", {p.box_max(0), p.box_max(1), p.box_max(2)}},
+                {"area_m2", p.area},
+                {"groups", groups}};
+  if (p.body >= 0) c.location["body"] = spec.bodies[p.body].name;
+  c.parameters = {law == "speed" ? "flux_W_m2 at " + std::to_string(ref_speed) + " rpm"
+                                 : "flux_W_m2"};
+  return c;
+}
+
+SeparableColumn heat_column(const mesh::TetMesh& m, const Patch& p, const Candidate& c) {
+  SeparableColumn col;
+  col.name = c.name;
+  col.shape = face_load(m, p.faces);
+  const double ref_speed = c.ref_speed_rpm;
+  if (c.law == "speed")
+    col.law = [ref_speed](double, double speed) { return speed > 0 ? speed / ref_speed : 0.0; };
+  else
+    col.law = [](double, double) { return 1.0; };
+  return col;
+}
+
+/// The lag candidate of sensor `s` with time constant `tau` [s]: one fixed column per run.
+Candidate lag_candidate(const std::vector<RunModel>& runs, const Readout& r, int s, double tau) {
+  Candidate l;
+  l.kind = EffectKind::sensor_lag;
+  l.sensor = s;
+  l.fixed = true;
+  l.time_constant = tau;
+  l.name = "lag of sensor " + r.ids[s] + " (" + std::to_string(static_cast<int>(std::lround(tau))) +
+           " s)";
+  l.location = {{"sensor", r.ids[s]}};
+  l.parameters = {"time_constant_s"};
+  for (const auto& rm : runs) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
+    const Eigen::VectorXd x = rm.base.col(s);
+    a.block(s * rm.times.size(), 0, rm.times.size(), 1) = lagged(rm.times, x, tau) - x;
+    l.columns.push_back(a);
+  }
+  return l;
+}
+
+}  // namespace
+
+std::vector<Patch> surface_patches(const mesh::TetMesh& m, double spacing, double half) {
+  const ExteriorFaces ext = exterior_faces(m);
+  const Eigen::Vector3i count =
+      (((ext.hi - ext.lo) / spacing).array().floor().cast<int>() + 1).matrix();
   const Eigen::Vector3d start =
-      0.5 * (lo + hi) - 0.5 * spacing * (count.cast<double>() - Eigen::Vector3d::Ones());
+      0.5 * (ext.lo + ext.hi) - 0.5 * spacing * (count.cast<double>() - Eigen::Vector3d::Ones());
+  std::vector<Eigen::Vector3d> centres;
   for (int i = 0; i < count(0); ++i)
     for (int j = 0; j < count(1); ++j)
-      for (int k = 0; k < count(2); ++k) {
-        const Eigen::Vector3d c = start + spacing * Eigen::Vector3d(i, j, k);
-        // One patch per boundary group in the box: heat through the bore is not heat through the
-        // housing's outside, and a patch mixing them would sit at neither.
-        std::map<int, Patch> by_group;
-        for (size_t e = 0; e < ext.size(); ++e) {
-          if ((centroid[e].array() < (c.array() - half)).any() ||
-              (centroid[e].array() > (c.array() + half)).any())
-            continue;
-          Patch& p = by_group[core::index_of(m.face_group[ext[e]])];
-          p.faces.push_back(ext[e]);
-          p.area += area[e];
-          p.centre += area[e] * centroid[e];
-        }
-        for (auto& [g, p] : by_group) {
-          if (p.area < 0.15 * (2 * half) * (2 * half) || !seen.insert(p.faces).second) continue;
-          p.box_min = c.array() - half;
-          p.box_max = c.array() + half;
-          p.centre /= p.area;
-          p.groups = {g};
-          out.push_back(std::move(p));
-        }
-      }
-  return out;
+      for (int k = 0; k < count(2); ++k)
+        centres.push_back(start + spacing * Eigen::Vector3d(i, j, k));
+  return box_patches(m, ext, centres, half);
 }
 
 Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
@@ -289,39 +376,10 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
   if (!ambient_only) {
     // Heat entering through an undeclared surface patch, under each law.
     for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
-      const Eigen::VectorXd shape = face_load(m, p.faces);
       for (const std::string law : {"speed", "constant"}) {
-        Candidate c;
-        c.kind = EffectKind::heat_input;
-        c.law = law;
-        c.box_min = p.box_min;
-        c.box_max = p.box_max;
-        c.area = p.area;
-        c.ref_speed_rpm = ref_speed;
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "heat input at (%.3f, %.3f, %.3f) m, %s", p.centre(0),
-                      p.centre(1), p.centre(2), law.c_str());
-        c.name = buf;
-        nlohmann::json groups = nlohmann::json::array();
-        for (int g : p.groups) groups.push_back(declared.groups[g].name);
-        c.location = {{"centre_m", {p.centre(0), p.centre(1), p.centre(2)}},
-                      {"box_min_m", {p.box_min(0), p.box_min(1), p.box_min(2)}},
-                      {"box_max_m", {p.box_max(0), p.box_max(1), p.box_max(2)}},
-                      {"area_m2", p.area},
-                      {"groups", groups}};
-        c.parameters = {law == "speed" ? "flux_W_m2 at " + std::to_string(ref_speed) + " rpm"
-                                       : "flux_W_m2"};
-        SeparableColumn col;
-        col.name = c.name;
-        col.shape = shape;
-        if (law == "speed")
-          col.law = [ref_speed](double, double speed) {
-            return speed > 0 ? speed / ref_speed : 0.0;
-          };
-        else
-          col.law = [](double, double) { return 1.0; };
+        Candidate c = heat_candidate(p, law, ref_speed, declared);
         sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
-        sep.push_back(std::move(col));
+        sep.push_back(heat_column(m, p, c));
         cands.push_back(std::move(c));
       }
     }
@@ -466,23 +524,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
         c.columns.push_back(a);
       }
       cands.push_back(std::move(c));
-      for (double tau : o.lag_grid_s) {
-        Candidate l;
-        l.kind = EffectKind::sensor_lag;
-        l.sensor = s;
-        l.fixed = true;
-        l.time_constant = tau;
-        l.name = "lag of sensor " + r.ids[s] + " (" + std::to_string(static_cast<int>(tau)) + " s)";
-        l.location = {{"sensor", r.ids[s]}};
-        l.parameters = {"time_constant_s"};
-        for (const auto& rm : cat.runs) {
-          Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
-          const Eigen::VectorXd x = rm.base.col(s);
-          a.block(s * rm.times.size(), 0, rm.times.size(), 1) = lagged(rm.times, x, tau) - x;
-          l.columns.push_back(a);
-        }
-        cands.push_back(std::move(l));
-      }
+      for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(cat.runs, r, s, tau));
     }
   }
   cat.candidates = std::move(cands);
@@ -515,13 +557,15 @@ namespace {
 std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitened>& ws,
                                  const std::vector<Eigen::VectorXd>& ys,
                                  const Eigen::VectorXd& sigma, const CalibrationOptions& o,
-                                 bool with_parameters) {
+                                 bool with_parameters, const std::vector<int>& subset = {}) {
   const auto& r = cat.readout;
   const size_t nr = cat.runs.size();
-  std::vector<EffectFit> fits(cat.candidates.size());
-  for (size_t ci = 0; ci < cat.candidates.size(); ++ci) {
+  const size_t count = subset.empty() ? cat.candidates.size() : subset.size();
+  std::vector<EffectFit> fits(count);
+  for (size_t fi = 0; fi < count; ++fi) {
+    const size_t ci = subset.empty() ? fi : static_cast<size_t>(subset[fi]);
     const Candidate& c = cat.candidates[ci];
-    EffectFit& f = fits[ci];
+    EffectFit& f = fits[fi];
     f.candidate = static_cast<int>(ci);
     f.kind = c.kind;
     f.name = c.name;
@@ -589,6 +633,89 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
 }
 
 }  // namespace
+
+Catalogue with_refined_heat_inputs(const mesh::TetMesh& m, const Catalogue& cat,
+                                   const CalibrationOptions& o) {
+  Catalogue out = cat;
+  if (out.runs.empty()) return out;
+  const core::CaseSpec& spec = out.runs.front().spec;
+  const Eigen::VectorXd sigma = noise_sigma(out.runs, out.readout.sensors, o);
+  std::vector<Whitened> ws;
+  std::vector<Eigen::VectorXd> ys;
+  for (const auto& rm : out.runs) {
+    ws.push_back(whitened(rm, sigma));
+    ys.push_back(ws.back().y);
+  }
+  const ExteriorFaces ext = exterior_faces(m);
+  const double half = o.patch_half_size * o.heat_refine_half_scale;
+  std::set<std::pair<std::string, std::vector<int>>> seen;
+  double spacing = o.patch_spacing;
+  for (int level = 0; level < o.heat_refine_levels; ++level) {
+    spacing /= 3;
+    std::vector<int> heat;
+    for (size_t ci = 0; ci < out.candidates.size(); ++ci)
+      if (out.candidates[ci].kind == EffectKind::heat_input) heat.push_back(static_cast<int>(ci));
+    if (heat.empty()) return out;
+    const std::vector<EffectFit> fits = score_all(out, ws, ys, sigma, o, false, heat);
+    std::vector<size_t> order(fits.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return fits[a].score > fits[b].score; });
+    // The best places (a box scored under both laws counts once), each with its best law.
+    std::vector<const Candidate*> parents;
+    for (size_t i : order) {
+      const Candidate& c = out.candidates[static_cast<size_t>(fits[i].candidate)];
+      const Eigen::Vector3d centre = 0.5 * (c.box_min + c.box_max);
+      const bool again = std::any_of(parents.begin(), parents.end(), [&](const Candidate* p) {
+        return (0.5 * (p->box_min + p->box_max) - centre).norm() < 1e-9;
+      });
+      if (!again) parents.push_back(&c);
+      if (static_cast<int>(parents.size()) >= o.heat_refine_parents) break;
+    }
+    std::vector<Candidate> added;
+    std::vector<SeparableColumn> sep;
+    for (const Candidate* parent : parents) {
+      const Eigen::Vector3d centre = 0.5 * (parent->box_min + parent->box_max);
+      std::vector<Eigen::Vector3d> centres;
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j)
+          for (int k = -1; k <= 1; ++k)
+            centres.push_back(centre + spacing * Eigen::Vector3d(i, j, k));
+      for (const Patch& p : box_patches(m, ext, centres, half)) {
+        if (!seen.insert({parent->law, p.faces}).second) continue;
+        Candidate c = heat_candidate(p, parent->law, parent->ref_speed_rpm, spec);
+        sep.push_back(heat_column(m, p, c));
+        added.push_back(std::move(c));
+      }
+    }
+    if (added.empty()) break;
+    // One march per run with the new patches as columns, as in the catalogue.
+    for (const auto& rm : out.runs) {
+      const Responses rs = march(m, rm.spec, out.readout, rm.times, sep, {});
+      for (size_t k = 0; k < added.size(); ++k)
+        added[k].columns.push_back(
+            Eigen::Map<const Eigen::VectorXd>(rs.columns[k].data(), rs.columns[k].size()));
+    }
+    for (auto& c : added) out.candidates.push_back(std::move(c));
+  }
+  return out;
+}
+
+Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
+                           const CalibrationOptions& o) {
+  Catalogue out = cat;
+  double lo = tau / 2, hi = tau * 2;
+  for (double g : o.lag_grid_s) {
+    if (g < tau) lo = std::max(lo, g);
+    if (g > tau) hi = std::min(hi, g);
+  }
+  for (int k = 1; k < o.lag_refine_steps; ++k) {
+    const double t = lo * std::pow(hi / lo, static_cast<double>(k) / o.lag_refine_steps);
+    if (std::abs(t - tau) > 1e-9 * tau)
+      out.candidates.push_back(lag_candidate(out.runs, out.readout, sensor, t));
+  }
+  return out;
+}
 
 Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
   if (cat.runs.size() < 2)

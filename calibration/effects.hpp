@@ -28,11 +28,17 @@ enum class EffectKind {
 std::string kind_name(EffectKind kind);
 
 struct CalibrationOptions {
-  double patch_spacing = 0.10;          /// grid of candidate heat-input patch centres [m]
-  double patch_half_size = 0.065;       /// half edge of a patch's box [m]
+  double patch_spacing = 0.10;     /// grid of candidate heat-input patch centres [m]
+  double patch_half_size = 0.065;  /// half edge of a patch's box [m]
+  /// Place of a heat input refined after the grid: `heat_refine_levels` grids, each a third of
+  /// the previous spacing, of boxes `heat_refine_half_scale` x patch_half_size around the best
+  /// `heat_refine_parents` places found so far.
+  int heat_refine_levels = 2, heat_refine_parents = 1;
+  double heat_refine_half_scale = 0.6;
   double ambient_knot_interval = 1800;  /// hat functions of the air temperature [s]
   std::vector<double> lag_grid_s{30, 60, 120, 200, 300, 450, 700, 1000};
-  double ridge = 1e-8;                       /// relative to the normal matrix's mean diagonal
+  int lag_refine_steps = 16;  /// geometric steps between the grid neighbours of a claimed lag
+  double ridge = 1e-8;        /// relative to the normal matrix's mean diagonal
   double penalty_per_parameter = 2;          /// complexity penalty [whitened sum of squares]
   double temperature_tolerance_K = 0.025;    /// model-form error not to be explained by an effect
   double displacement_tolerance_rel = 0.02;  /// ... relative to a probe's simulated RMS excursion
@@ -62,6 +68,7 @@ struct Candidate {
   bool fixed = false;                   /// one column whose amplitude is 1 (a lag filter)
   // What the augmented case needs.
   int group = -1, material = -1, source = -1, sensor = -1;
+  int body = -1;           /// heat input: the body whose faces take the heat
   std::string law, field;  /// heat-input law; material field
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
   double area = 0, ref_speed_rpm = 0, time_constant = 0;
@@ -80,13 +87,15 @@ struct Catalogue {
 };
 
 /// Heat-input patches: boxes on a grid over the exterior faces (centroid inside the box), one
-/// patch per boundary group the box covers.
+/// patch per boundary group and body the box covers (heat into the bore wall is not heat into the
+/// shaft across the gap).
 struct Patch {
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  /// area-weighted face centroid [m]
   double area = 0;                                   /// [m^2]
   std::vector<int> faces;
   std::vector<int> groups;  /// boundary groups the faces belong to
+  int body = -1;            /// the body the faces bound
 };
 std::vector<Patch> surface_patches(const mesh::TetMesh& mesh, double spacing, double half_size);
 /// #nodes integral of the shape functions over faces [m^2].
@@ -97,6 +106,18 @@ Eigen::VectorXd face_load(const mesh::TetMesh& mesh, const std::vector<int>& fac
 Catalogue catalogue(const mesh::TetMesh& mesh, const core::CaseSpec& declared, const Readout& r,
                     const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& options,
                     bool ambient_only = false);
+
+/// `cat` with heat-input candidates added on finer grids around its best heat-input places (scored
+/// on the training residual as select_effects scores them), marched like the catalogue's own: the
+/// grid's spacing bounds how well a place can be found, and a finer grid everywhere costs too much.
+Catalogue with_refined_heat_inputs(const mesh::TetMesh& mesh, const Catalogue& cat,
+                                   const CalibrationOptions& options);
+
+/// `cat` with lag candidates of `sensor` at `lag_refine_steps` time constants spaced
+/// geometrically between the grid values either side of `tau` [s]: the grid's step (up to 1.7x)
+/// leaves much of a lag's signal unexplained.
+Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
+                           const CalibrationOptions& options);
 
 /// A candidate fitted to the training residual.
 struct EffectFit {
