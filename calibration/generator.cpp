@@ -6,6 +6,7 @@
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "mesh/mesher.hpp"
 #include "solvers/elastic.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
@@ -212,6 +213,7 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
       c.box_max = e.box_max;
       c.law = e.follows_speed ? "speed" : "constant";
       c.ref_speed_rpm = 3000;
+      c.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
       c.location = {{"groups", e.groups}};
       AugmentedCase a{s, {}};
       a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
@@ -253,9 +255,17 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
   return s;
 }
 
-io::MeasuredRun clean_run(const mesh::TetMesh& m, const core::CaseSpec& truth,
+io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffect& e, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {
+  // A heat input adds boundary groups: the faces must carry the truth's own group labels, or its
+  // flux and convection land on whatever group had that index before (same nodes: groups do not
+  // change TetGen's input).
+  std::vector<std::string> names;
+  for (const auto& g : truth.groups) names.push_back(g.name);
+  const bool relabel = names != mesh_in.group_names;
+  const mesh::TetMesh own = relabel ? mesh::mesh_case(truth) : mesh::TetMesh{};
+  const mesh::TetMesh& m = relabel ? own : mesh_in;
   const solvers::ThermalOperators ops = solvers::thermal_operators(m, truth);
   const solvers::ThermalHistory th = solvers::thermal_history(m, truth, ops);
   io::MeasuredRun run;

@@ -65,7 +65,8 @@ struct Instrumentation {
   bool tcp_probes = true;
 };
 
-/// Simulates `truth` on `mesh`, samples it every options.sample_interval_s, applies sensor
+/// Simulates `truth` on `mesh` (re-meshed when `truth` has other boundary groups, as a heat input
+/// adds), samples it every options.sample_interval_s, applies sensor
 /// effects (offset, lag) and noise from `rng`, and returns the run (nominal conditions in meta).
 io::MeasuredRun synthetic_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
                               const InjectedEffect& effect, const Instrumentation& inst,
