@@ -75,14 +75,18 @@ inline std::unique_ptr<Study> make_study(const Scale& sc) {
   return s;
 }
 
-/// Runs (train, train, test) of the truth with `effect`, noise from `rng`.
+/// Runs (train, train, test) of the truth with `effect`, noise from `rng`; `clean` gets the same
+/// runs without noise (the test run's is the truth the RMS figures are measured against).
 inline std::vector<io::MeasuredRun> effect_runs(const Study& s, const InjectedEffect& effect,
-                                                std::mt19937_64& rng) {
+                                                std::mt19937_64& rng,
+                                                std::vector<io::MeasuredRun>* clean = nullptr) {
   std::vector<io::MeasuredRun> out;
   for (int k = 0; k < 3; ++k) {
     const core::CaseSpec t = truth_case(s.gen, effect, s.duties[k], k);
-    out.push_back(synthetic_run(s.gen_mesh, t, effect, s.inst, s.gopt,
-                                (k < 2 ? "train " : "test ") + std::to_string(k), rng));
+    io::MeasuredRun c = clean_run(s.gen_mesh, t, effect, s.inst, s.gopt,
+                                  (k < 2 ? "train " : "test ") + std::to_string(k));
+    out.push_back(with_noise(c, s.gopt, rng));
+    if (clean) clean->push_back(std::move(c));
   }
   return out;
 }

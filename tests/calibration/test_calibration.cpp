@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "calibration_checks.hpp"
 #include "core/errors.hpp"
@@ -28,6 +29,44 @@ TEST(Lag, ExactForARampAfterTheTransient) {
   // y = 0.01 (t - tau (1 - exp(-t / tau))) for x = 0.01 t, y(0) = 0.
   for (Eigen::Index k = 0; k < t.size(); ++k)
     EXPECT_NEAR(y(k), 0.01 * (t(k) - 100 * (1 - std::exp(-t(k) / 100))), 1e-12);
+}
+
+// A lag between two grid values is found by the refinement: the grid alone would leave most of the
+// signal of a 269 s lag to the 300 s candidate.
+TEST(Lag, RefinedBetweenGridValues) {
+  Catalogue cat;
+  cat.readout.ids = {"T1"};
+  cat.readout.sensors = 1;
+  CalibrationOptions o;
+  for (int k = 0; k < 2; ++k) {
+    RunModel rm;
+    rm.name = "run " + std::to_string(k);
+    rm.times = Eigen::VectorXd::LinSpaced(241, 0, 14400);
+    rm.base.resize(rm.times.size(), 1);
+    for (Eigen::Index i = 0; i < rm.times.size(); ++i)  // warm-up with steps and a slow wave
+      rm.base(i, 0) = 293 + 3 * (1 - std::exp(-rm.times(i) / 2000)) +
+                      ((static_cast<int>(rm.times(i) / (900 + 600 * k)) % 2) ? 0.8 : 0.0) +
+                      0.5 * std::sin(rm.times(i) / 1500);
+    rm.measured = rm.base;
+    rm.measured.col(0) = lagged(rm.times, rm.base.col(0), 269);
+    std::mt19937_64 rng = core::generator(5, static_cast<std::uint64_t>(k));
+    std::normal_distribution<double> noise(0, 0.01);
+    for (Eigen::Index i = 0; i < rm.times.size(); ++i) rm.measured(i, 0) += noise(rng);
+    cat.runs.push_back(rm);
+  }
+  const Catalogue grid = with_refined_lag(cat, 0, 300, [] {
+    CalibrationOptions none;
+    none.lag_refine_steps = 1;
+    return none;
+  }());
+  const Catalogue fine = with_refined_lag(cat, 0, 300, o);
+  EXPECT_EQ(grid.candidates.size(), 0u);
+  // Every step but the one at the grid value itself (300 s is the geometric middle of 200, 450).
+  ASSERT_EQ(fine.candidates.size(), static_cast<size_t>(o.lag_refine_steps - 2));
+  const Selection sel = select_effects(fine, o);
+  ASSERT_FALSE(sel.claimed.empty());
+  const double tau = fine.candidates[static_cast<size_t>(sel.claimed[0].candidate)].time_constant;
+  EXPECT_NEAR(tau, 269, 0.05 * 269);
 }
 
 TEST(CaseForRun, SpeedColumnBecomesSegments) {
@@ -79,13 +118,21 @@ TEST(Augment, HeatInputCaseReadsBackAndMeshesWithTheNewGroup) {
 TEST(Kinds, AmbientTemperature) {
   check_kind(study(), EffectKind::ambient_temperature, 11);
 }
-// Disabled: kind and RMS pass (4.25 -> 0.29 um) but the place misses (0.27 m: a patch of the bore
-// is preferred to the rear face near the bore with 16 top/side sensors). See docs/calibration.md.
+// Kind and place (within 0.1 m) are checked; the RMS bound is not: this draw (4.7 W) moves the tool
+// by 0.10 um, and the after RMS cannot go below the calibration model's own discretisation error
+// against the generator (0.043 um on a clean run), 44 % of before. Draws above about 8 W pass it.
+// See docs/calibration.md, "Limits".
+TEST(Kinds, HeatInputKindAndPlace) {
+  check_kind(study(), EffectKind::heat_input, 12, /*check_rms=*/false);
+}
+// The full check of the same draw (fails the RMS bound as said above).
 TEST(Kinds, DISABLED_HeatInput) {
   check_kind(study(), EffectKind::heat_input, 12);
 }
 // Disabled: right kind first, but the drawn gain moves the tool by 0.07 um and the after RMS
-// (0.040 um) stays at the coarse-vs-fine mesh discrepancy: 55 % of before, not 30 %.
+// (0.040 um) stays at the calibration model's discretisation error against the generator (0.043 um
+// on a clean run; the calibrator's exponent 1 against the truth's 0.8 changes it by 0.001 um): 55 %
+// of before, not 30 %.
 TEST(Kinds, DISABLED_SpeedDependentConvection) {
   check_kind(study(), EffectKind::speed_dependent_convection, 13);
 }
@@ -101,8 +148,9 @@ TEST(Kinds, MaterialParameter) {
 TEST(Kinds, SensorOffset) {
   check_kind(study(), EffectKind::sensor_offset, 17);
 }
-// Disabled: right kind and time constant class, but over 16 sensors the truth-based temperature
-// RMS goes 0.018 -> 0.008 K (45 %): the mesh discrepancy of the other sensors remains.
+// Disabled: right kind and time constant (refined: 269 s drawn), but over 16 sensors the
+// truth-based temperature RMS cannot go below the calibration model's discretisation error on the
+// other 15 sensors (0.0080 K on a clean run), 44 % of this draw's 0.018 K.
 TEST(Kinds, DISABLED_SensorLag) {
   check_kind(study(), EffectKind::sensor_lag, 18);
 }
