@@ -120,41 +120,52 @@ Eigen::Vector3d inside_point_of(const Mesh& m, double diagonal, const std::strin
   return best;
 }
 
-/// CGAL's OFF and PLY readers trust the file (docs/reliability.md, F4 to F7): what they would crash
-/// on or allocate without bound is refused here, naming the file and the line.
-void refuse_what_cgal_cannot_read(const std::filesystem::path& file, const std::string& prefix) {
+/// The file's polygon soup. CGAL 5.5's OFF and PLY readers trust the file (docs/reliability.md,
+/// F3 to F11): OFF is read by our own strict reader, and a PLY header is checked before CGAL reads
+/// the file. False when CGAL's reader fails; `reader_said` holds what it printed.
+bool read_soup(const std::filesystem::path& file, const std::string& prefix, std::vector<Point>& points,
+               std::vector<std::vector<std::size_t>>& polygons, std::string& reader_said) {
   std::string extension = file.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (extension != ".off" && extension != ".ply") return;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw core::GeometryError(prefix + "cannot open the file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto problem = extension == ".off" ? off_problem(text) : ply_header_problem(text);
-  if (problem)
-    throw core::GeometryError(prefix + *problem + ". Hint: export the surface again, as ASCII OFF, "
-                              "STL or a PLY with float coordinates.");
+  const auto refuse = [&](const std::string& problem) {
+    return core::GeometryError(prefix + problem + ". Hint: export the surface again, as ASCII OFF, "
+                               "STL or a PLY with float coordinates.");
+  };
+  if (extension == ".off" || extension == ".ply") {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw core::GeometryError(prefix + "cannot open the file");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (extension == ".off") {
+      OffReading off = read_off(text);
+      if (!off.problem.empty()) throw refuse(off.problem);
+      for (const auto& p : off.soup.points) points.emplace_back(p[0], p[1], p[2]);
+      polygons = std::move(off.soup.polygons);
+      return true;
+    }
+    if (const auto problem = ply_header_problem(text)) throw refuse(*problem);
+  }
+  std::ostringstream said;  // CGAL's readers report format errors on std::cerr
+  bool read = false;
+  std::streambuf* cerr_buffer = std::cerr.rdbuf(said.rdbuf());
+  try {
+    read = CGAL::IO::read_polygon_soup(file.string(), points, polygons);
+  } catch (...) {
+    read = false;
+  }
+  std::cerr.rdbuf(cerr_buffer);
+  reader_said = said.str();
+  return read;
 }
 
 SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
                              const std::string& prefix) {
   // 1. Read the polygon soup and make it a consistently oriented mesh.
-  refuse_what_cgal_cannot_read(file, prefix);
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
-  std::ostringstream reader_said;  // CGAL's readers report format errors on std::cerr
-  bool read = false;
-  {
-    std::streambuf* cerr_buffer = std::cerr.rdbuf(reader_said.rdbuf());
-    try {
-      read = CGAL::IO::read_polygon_soup(file.string(), points, polygons);
-    } catch (...) {
-      read = false;
-    }
-    std::cerr.rdbuf(cerr_buffer);
-  }
+  std::string said;
+  const bool read = read_soup(file, prefix, points, polygons, said);
   if (!read || polygons.empty()) {
-    std::string said = reader_said.str();
     while (!said.empty() && std::isspace(static_cast<unsigned char>(said.back()))) said.pop_back();
     throw core::GeometryError(prefix + "could not read any polygon" +
                               (said.empty() ? "" : " (the reader said: " + said + ")") +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <initializer_list>
 #include <limits>
 
@@ -54,25 +55,6 @@ std::optional<unsigned long long> plain_count(std::string_view word) {
   const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
   if (error != std::errc() || end != word.data() + word.size()) return std::nullopt;
   return value;
-}
-
-/// The numbers at the start of a line, read as a stream of doubles reads them (CGAL reads OFF
-/// face lines so): one after the other, the next starting where the last ended ("0-10" is 0 and
-/// -10), up to the first text that is no number.
-std::vector<double> leading_numbers(std::string_view line) {
-  std::vector<double> numbers;
-  const char* at = line.data();
-  const char* const end = line.data() + line.size();
-  while (true) {
-    while (at < end && (*at == ' ' || *at == '\t' || *at == '\r' || *at == '\v' || *at == '\f')) ++at;
-    if (at < end && *at == '+') ++at;
-    double value = 0;
-    const auto [stop, error] = std::from_chars(at, end, value);
-    if (error == std::errc::invalid_argument) break;
-    numbers.push_back(error == std::errc() ? value : std::numeric_limits<double>::quiet_NaN());
-    at = stop;
-  }
-  return numbers;
 }
 
 std::string quoted(std::string_view word) {
@@ -140,65 +122,114 @@ std::optional<std::string> ply_header_problem(std::string_view text) {
   return "the header has no 'end_header' line";
 }
 
-std::optional<std::string> off_problem(std::string_view text) {
-  const auto lines = lines_of(text);
-  // Words of each line with comments cut off; blank lines and comment lines skipped.
-  struct Line {
-    std::size_t index;
-    std::string_view text;
-    std::vector<std::string_view> words;
+namespace {
+
+/// Words of the OFF text after the keyword, each with its line, '#' comments left out, and the
+/// records (rest of a line from a word) that the vertices and faces are read from.
+struct OffCursor {
+  std::string_view text;
+  std::size_t at = 0;
+  std::size_t line = 0;
+
+  static bool blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n'; }
+
+  /// Skips blanks, line ends and comments; false at the end of the text.
+  bool skip() {
+    while (at < text.size()) {
+      if (text[at] == '\n') {
+        ++line, ++at;
+      } else if (blank(text[at])) {
+        ++at;
+      } else if (text[at] == '#') {
+        while (at < text.size() && text[at] != '\n') ++at;
+      } else {
+        return true;
+      }
+    }
+    return false;
+  }
+  std::string_view word() {
+    if (!skip()) return {};
+    const std::size_t start = at;
+    while (at < text.size() && !blank(text[at]) && text[at] != '#') ++at;
+    return text.substr(start, at - start);
+  }
+  /// The words from here to the end of the line (comment cut off).
+  std::vector<std::string_view> record() {
+    if (!skip()) return {};
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view rest = text.substr(at, end - at);
+    at = end;
+    return words_of(rest.substr(0, rest.find('#')));
+  }
+};
+
+std::optional<double> finite_number(std::string_view word) {
+  if (!word.empty() && word.front() == '+') word.remove_prefix(1);
+  double value = 0;
+  const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
+  if (error != std::errc() || end != word.data() + word.size() || !std::isfinite(value))
+    return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+OffReading read_off(std::string_view text) {
+  OffReading r;
+  OffCursor in{text};
+  const auto fail = [&](const std::string& why) {
+    r.soup = {};
+    r.problem = line_no(in.line) + ": " + why;
+    return r;
   };
-  std::vector<Line> content;
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::string_view text = lines[i].substr(0, lines[i].find('#'));
-    auto w = words_of(text);
-    if (!w.empty()) content.push_back({i, text, std::move(w)});
-  }
-  if (content.empty()) return "the file is empty";
-  const std::string_view keyword = content[0].words[0];
-  const auto ends_with_off = keyword.size() >= 3 && keyword.substr(keyword.size() - 3) == "OFF";
-  if (!ends_with_off) return "an OFF file starts with the keyword OFF (found " + quoted(keyword) + ")";
-  const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
-  if (prefix.find_first_not_of("STCN") != std::string_view::npos)
-    return "only 3-D OFF files are read (keyword " + quoted(keyword) + ")";
-  // The three counts follow the keyword, on its line or the next ones.
-  std::vector<std::string_view> header;
-  std::size_t row = 0, word = 1;
-  if (content[0].words.size() > 1 && content[0].words[1] == "BINARY")
-    return "binary OFF is not read; export ASCII OFF, STL or PLY";
-  while (header.size() < 3 && row < content.size()) {
-    const auto& w = content[row].words;
-    while (header.size() < 3 && word < w.size()) header.push_back(w[word++]);
-    if (header.size() < 3) ++row, word = 0;
-  }
-  if (header.size() < 3) return "the header lacks its three counts (vertices, faces, edges)";
+  const std::string_view keyword = in.word();
+  if (keyword.empty()) return fail("the file is empty");
+  if (!is_one_of(keyword, {"OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF"}))
+    return fail("an OFF file starts with the keyword OFF (or COFF, NOFF, STOFF...), found " +
+                quoted(keyword) + "; binary, homogeneous and n-dimensional OFF are not read");
   std::array<unsigned long long, 3> counts{};
-  for (std::size_t k = 0; k < 3; ++k) {
-    const auto c = plain_count(header[k]);
+  for (auto& count : counts) {
+    const std::string_view w = in.word();
+    if (w == "BINARY") return fail("binary OFF is not read; export ASCII OFF, STL or PLY");
+    const auto c = plain_count(w);
     if (!c || *c > text.size())
-      return line_no(content[row].index) + ": count " + quoted(header[k]) +
-             " is not a count this file can hold";
-    counts[k] = *c;
+      return fail("count " + quoted(w) + " is not a count this file can hold (vertices, faces, edges)");
+    count = *c;
   }
-  // One vertex per line, then one face per line. CGAL reads a face line as numbers and casts the
-  // first to the count of indices and the next ones to indices: the count must be a number from 0
-  // to what the file can hold (each index takes at least two bytes), each index one of a vertex.
-  const std::size_t first_face = row + 1 + counts[0];
-  for (std::size_t f = 0; f < counts[1] && first_face + f < content.size(); ++f) {
-    const auto& [line, text_of_line, w] = content[first_face + f];
-    const std::vector<double> numbers = leading_numbers(text_of_line);
-    if (numbers.empty()) continue;  // no number at all: CGAL refuses the line
-    const double count = numbers[0];
-    if (!(count >= 0 && count <= static_cast<double>(text.size() / 2)))
-      return line_no(line) + ": a face of " + quoted(w[0]) +
-             " vertices; a count from 0 to what this file can hold is expected";
-    const auto indices = std::min(numbers.size() - 1, static_cast<std::size_t>(count));
-    for (std::size_t i = 1; i <= indices; ++i)
-      if (!(numbers[i] >= 0 && numbers[i] < static_cast<double>(counts[0])))
-        return line_no(line) + ": a face names vertex " + std::to_string(numbers[i]) +
-               "; the file has " + std::to_string(counts[0]) + " vertices";
+  const auto vertices = static_cast<std::size_t>(counts[0]), faces = static_cast<std::size_t>(counts[1]);
+  r.soup.points.reserve(vertices);
+  for (std::size_t v = 0; v < vertices; ++v) {
+    const auto w = in.record();
+    if (w.size() < 3) return fail("vertex " + std::to_string(v) + " of " + std::to_string(vertices) + " lacks x, y, z");
+    std::array<double, 3> p{};
+    for (int k = 0; k < 3; ++k) {
+      const auto x = finite_number(w[k]);
+      if (!x) return fail("vertex " + std::to_string(v) + ": coordinate " + quoted(w[k]) + " is not a finite number");
+      p[k] = *x;
+    }
+    r.soup.points.push_back(p);
   }
-  return std::nullopt;
+  r.soup.polygons.reserve(faces);
+  for (std::size_t f = 0; f < faces; ++f) {
+    const auto w = in.record();
+    const auto k = w.empty() ? std::nullopt : plain_count(w[0]);
+    if (!k || *k < 3 || *k >= w.size())
+      return fail("face " + std::to_string(f) + " of " + std::to_string(faces) +
+                  ": expected a count of at least 3 and that many vertex indices, found " +
+                  (w.empty() ? std::string("nothing") : quoted(w[0])));
+    std::vector<std::size_t> polygon;
+    polygon.reserve(*k);
+    for (std::size_t i = 1; i <= *k; ++i) {
+      const auto index = plain_count(w[i]);
+      if (!index || *index >= vertices)
+        return fail("face " + std::to_string(f) + ": vertex index " + quoted(w[i]) + ", the file has " +
+                    std::to_string(vertices) + " vertices");
+      polygon.push_back(static_cast<std::size_t>(*index));
+    }
+    r.soup.polygons.push_back(std::move(polygon));
+  }
+  return r;
 }
 
 std::optional<std::string> soup_problem(const std::vector<std::vector<std::size_t>>& polygons,

@@ -18,10 +18,25 @@ namespace tt::mesh::cgal {
 /// `end_header`, each count no larger than the file can hold.
 std::optional<std::string> ply_header_problem(std::string_view text);
 
-/// Why an ASCII OFF file is refused, or nothing: its header counts and the leading count of every
-/// face line must be plain integers that the file's size can hold. Binary OFF and the n-dimensional
-/// variants are refused: only the 3-D ASCII forms are read.
-std::optional<std::string> off_problem(std::string_view text);
+/// A surface as a soup: points and polygons of point indices.
+struct PolygonSoup {
+  std::vector<std::array<double, 3>> points;
+  std::vector<std::vector<std::size_t>> polygons;
+};
+
+/// An ASCII OFF file read into a soup, or why it cannot be: CGAL 5.5's OFF scanner casts counts
+/// and indices read as doubles to integers (undefined behaviour on negative or huge values) and
+/// sizes vectors by them, so OFF is read here instead, strictly. The keyword (OFF with the
+/// optional ST, C, N prefixes; binary and n-dimensional variants are refused), then the vertex,
+/// face and edge counts, then one vertex per record (x y z, then anything such as colours), then
+/// one face per record (k, then k vertex indices, then anything). A record is the rest of a line
+/// from its first non-blank character, '#' starting a comment; every count and index must be a
+/// plain integer in range, every coordinate a finite number.
+struct OffReading {
+  PolygonSoup soup;
+  std::string problem;  /// empty when read
+};
+OffReading read_off(std::string_view text);
 
 /// Why a polygon soup is refused, or nothing: every polygon has at least 3 indices, each below
 /// `point_count`.
