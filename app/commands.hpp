@@ -29,6 +29,7 @@ struct ProbesArgs {
 struct PlaceArgs {
   std::filesystem::path case_file, from_run, out;
   int samples = 100, bins = 20, m_max = 6;
+  bool sensor_noise = false;  /// place on readings with the campaign's sensor noise
   bool quiet = false;
 };
 

@@ -57,6 +57,9 @@ int main(int argc, char** argv) {
   place->add_option("--samples", place_args.samples, "S, samples the histories are resampled to (patent: 100)");
   place->add_option("--bins", place_args.bins, "N = M, histogram bins (patent: 20 to 40)");
   place->add_option("--m-max", place_args.m_max, "largest number of sensors");
+  place->add_flag("--sensor-noise", place_args.sensor_noise,
+                  "place on readings as real sensors give them: the campaign's noise (0.05 K, "
+                  "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
 
   FitArgs fit_args;

@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "app/study.hpp"
+#include "fitting/noise.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/placement_out.hpp"
@@ -34,6 +35,27 @@ Histories simulated_histories(const core::CaseSpec& spec, bool quiet) {
                               results[0].error);
 }
 
+namespace {
+
+/// The histories as the campaign's sensors would read them (fitting::SensorNoise defaults),
+/// reproducible from the case's seed.
+Histories with_sensor_noise(Histories h, std::uint64_t seed) {
+  fitting::Group g;
+  g.name = "place";
+  g.time = h.times;
+  g.temperature = h.temperature;
+  g.error = h.targets;
+  g.sensor_names = h.names;
+  g.target_names = h.target_names;
+  constexpr std::uint64_t kPlaceStream = 0x706c616365;  // "place"
+  const fitting::Group noisy = fitting::noisy_group(g, fitting::SensorNoise{}, seed, kPlaceStream);
+  h.temperature = noisy.temperature;
+  h.targets = noisy.error;
+  return h;
+}
+
+}  // namespace
+
 placement::PlacementInput placement_input(const Histories& h) {
   placement::PlacementInput in;
   for (size_t c = 0; c < h.names.size(); ++c) in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
@@ -56,6 +78,10 @@ int place_command(const PlaceArgs& args) {
     spec = io::read_case(args.case_file);
     h = simulated_histories(spec, args.quiet);
   }
+  // Simulated histories are exact, and a thermal field driven by a few sources lies in a
+  // subspace of few dimensions: beyond its rank no further sensor is admissible. Real readings
+  // carry noise; --sensor-noise places on such readings.
+  if (args.sensor_noise) h = with_sensor_noise(std::move(h), spec.seed);
   // 2. Every placement method, for each target and m = 1..m_max.
   placement::PlacementOptions options;
   options.samples = args.samples;
@@ -72,6 +98,7 @@ int place_command(const PlaceArgs& args) {
   io::OutputDir out(args.out);
   const auto& dir = out.path();
   nlohmann::json doc = io::placement_json(result);
+  doc["sensor_noise"] = args.sensor_noise;
   doc["candidates"] = nlohmann::json::array();
   for (size_t c = 0; c < h.names.size(); ++c) {
     nlohmann::json entry{{"id", c + 1},

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <vector>
 #include <sstream>
 #include <string>
 
@@ -92,6 +93,27 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
     }
   }
   EXPECT_TRUE(fs::exists(dir / "place" / "candidates_mi.vtp"));
+  EXPECT_EQ(doc["sensor_noise"], false);
+
+  // On readings with the campaign's sensor noise: every set again, and the same sets from the
+  // same seed.
+  std::vector<nlohmann::json> noisy;
+  for (const char* out : {"place_noisy_1", "place_noisy_2"}) {
+    ASSERT_EQ(thermotwin("place --from '" + (dir / "run").string() + "' --out '" +
+                             (dir / out).string() + "' --sensor-noise --quiet",
+                         dir / "place.log"),
+              0)
+        << text_of(dir / "place.log");
+    noisy.push_back(nlohmann::json::parse(text_of(dir / out / "placement.json")));
+  }
+  EXPECT_EQ(noisy[0]["sensor_noise"], true);
+  for (const std::string target : {"dy", "dz"})
+    for (const auto& method : methods) {
+      const auto& a = noisy[0]["targets"][target]["methods"][method];
+      const auto& b = noisy[1]["targets"][target]["methods"][method];
+      ASSERT_EQ(a.size(), 6u) << target << " " << method;
+      for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k]["ids"], b[k]["ids"]) << target << " " << method;
+    }
   if (!HasFailure()) fs::remove_all(dir);  // kept for a look when something failed
 }
 
