@@ -132,12 +132,20 @@ int fit_command(const FitArgs& args) {
   std::vector<fitting::SensorCountTable> tables;
   nlohmann::json summary = nlohmann::json::object();
   for (int target = 0; target < static_cast<int>(groups[0].target_names.size()); ++target) {
+    // The standard's own choice (7.1: |r| of the increments, pooled over the fitting groups) is
+    // named apart from the placement module's correlation ranking (which leaves twins out), so
+    // that the two never share a column of sensor_count_<target>.csv.
+    const auto standard_sets = [&](int count) {
+      auto sets = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, count);
+      for (auto& s : sets) s.method = "db3401_correlation";
+      return sets;
+    };
     std::vector<fitting::SensorSet> at_most_4 = sensor_sets(placed, target, 4);
-    const auto corr = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, 4);
+    const auto corr = standard_sets(4);
     at_most_4.insert(at_most_4.end(), corr.begin(), corr.end());
     evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
-    const auto corr6 = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, 6);
+    const auto corr6 = standard_sets(6);
     all.insert(all.end(), corr6.begin(), corr6.end());
     tables.push_back(fitting::sensor_count_table(groups, split, target, all, specs, args.required_sm_um * 1e-6));
     const auto& e = evals.back();
