@@ -106,6 +106,11 @@ std::optional<std::string> ply_header_problem(std::string_view text) {
       if (!is_integer_type(w[2]) || !(is_integer_type(w[3]) || (!indices && is_real_type(w[3]))))
         return line_no(i) + ": list property " + quoted(w[4]) + " has types " + quoted(w[2]) + " " +
                quoted(w[3]) + "; counts and indices must be integers";
+      // CGAL sizes a list by its count before reading it: a 32-bit count of 4e9 asks for 16 GB.
+      // An 8-bit count (what exporters write) bounds a list to 255 entries.
+      if (!is_one_of(w[2], {"char", "uchar", "int8", "uint8"}))
+        return line_no(i) + ": list property " + quoted(w[4]) + " has a count of type " +
+               quoted(w[2]) + "; only 8-bit counts (uchar) are read";
       continue;
     }
     if (w.size() != 3) return line_no(i) + ": 'property' takes a type and a name";

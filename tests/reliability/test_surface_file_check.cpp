@@ -52,6 +52,11 @@ TEST(PlyHeader, WhatCgalCrashesOnIsRefused) {
                                    "element face 4\nproperty list uchar float vertex_indices\n")),
             std::nullopt);
   EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex), std::nullopt);
+  // A list count wider than 8 bits: CGAL would size the list by a count of up to 4e9 (found by
+  // the fuzzer: a 17 GB allocation).
+  EXPECT_NE(ply_header_problem(ply(kPlainVertex +
+                                   "element face 4\nproperty list uint32 int vertex_indices\n")),
+            std::nullopt);
   // A word that only begins with end_header does not end the header (found by the fuzzer).
   EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex + kPlainFace +
                                "end_header0binary\n" + kPlyBody),
