@@ -102,6 +102,9 @@ std::optional<std::string> ply_header_problem(std::string_view text) {
     if (element.empty()) return line_no(i) + ": a property before any element";
     if (w.size() >= 2 && w[1] == "list") {
       if (w.size() != 5) return line_no(i) + ": 'property list' takes two types and a name";
+      // CGAL reads vertex x, y, z as scalars: a list of that name leaves its reader null.
+      if (element == "vertex" && is_one_of(w[4], {"x", "y", "z"}))
+        return line_no(i) + ": vertex coordinate " + quoted(w[4]) + " declared as a list";
       const bool indices = is_one_of(w[4], {"vertex_indices", "vertex_index"});
       if (!is_integer_type(w[2]) || !(is_integer_type(w[3]) || (!indices && is_real_type(w[3]))))
         return line_no(i) + ": list property " + quoted(w[4]) + " has types " + quoted(w[2]) + " " +

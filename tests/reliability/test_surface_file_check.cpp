@@ -57,6 +57,9 @@ TEST(PlyHeader, WhatCgalCrashesOnIsRefused) {
   EXPECT_NE(ply_header_problem(ply(kPlainVertex +
                                    "element face 4\nproperty list uint32 int vertex_indices\n")),
             std::nullopt);
+  // A vertex coordinate declared as a list (found by the fuzzer: a null call in CGAL).
+  EXPECT_NE(ply_header_problem(ply(kPlainVertex + "property list uchar float x\n" + kPlainFace)),
+            std::nullopt);
   // A word that only begins with end_header does not end the header (found by the fuzzer).
   EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex + kPlainFace +
                                "end_header0binary\n" + kPlyBody),
