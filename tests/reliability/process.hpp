@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstring>
@@ -18,6 +19,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "core/errors.hpp"
 
 extern char** environ;
 
@@ -122,6 +125,31 @@ inline std::vector<Dumped> read_dump(const fs::path& file) {
     out.push_back(std::move(d));
   }
   return out;
+}
+
+/// The inputs that made a fuzz target fail, kept in fuzz/regressions/<reader>/, in name order.
+inline std::vector<fs::path> fuzz_regressions(const std::string& reader) {
+  const fs::path dir = fs::path(TT_SOURCE_DIR) / "fuzz" / "regressions" / reader;
+  std::vector<fs::path> files;
+  if (fs::is_directory(dir))
+    for (const auto& e : fs::directory_iterator(dir))
+      if (e.is_regular_file()) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// "" when `read` ends in success or a project error, else what escaped.
+template <class Read>
+std::string escaped(Read&& read) {
+  try {
+    read();
+  } catch (const core::Error&) {
+  } catch (const std::exception& e) {
+    return std::string("std::exception: ") + e.what();
+  } catch (...) {
+    return "a non-standard exception";
+  }
+  return "";
 }
 
 }  // namespace tt::reliability_test

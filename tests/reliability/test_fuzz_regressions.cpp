@@ -14,33 +14,8 @@
 namespace tt::reliability_test {
 namespace {
 
-const fs::path kRegressions = fs::path(TT_SOURCE_DIR) / "fuzz" / "regressions";
-
-std::vector<fs::path> inputs(const std::string& reader) {
-  std::vector<fs::path> files;
-  if (fs::is_directory(kRegressions / reader))
-    for (const auto& e : fs::directory_iterator(kRegressions / reader))
-      if (e.is_regular_file()) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
-/// "" when `read` ends in success or a project error, else what escaped.
-template <class Read>
-std::string escaped(Read&& read) {
-  try {
-    read();
-  } catch (const core::Error&) {
-  } catch (const std::exception& e) {
-    return std::string("std::exception: ") + e.what();
-  } catch (...) {
-    return "a non-standard exception";
-  }
-  return "";
-}
-
 TEST(FuzzRegressions, CaseReader) {
-  const auto files = inputs("case");
+  const auto files = fuzz_regressions("case");
   EXPECT_FALSE(files.empty());
   for (const auto& f : files)
     EXPECT_EQ(escaped([&] { io::case_from_toml(read_text(f), "/nonexistent-tt-fuzz/case.toml"); }),
@@ -51,7 +26,7 @@ TEST(FuzzRegressions, CaseReader) {
 #ifdef TT_HAVE_CGAL_SURFACE
 TEST(FuzzRegressions, SurfaceReader) {
   const fs::path dir = scratch("fuzz_surface");
-  for (const auto& f : inputs("surface")) {
+  for (const auto& f : fuzz_regressions("surface")) {
     const std::string input = read_text(f);
     if (input.empty()) continue;
     static const char* const extensions[] = {".stl", ".off", ".ply"};

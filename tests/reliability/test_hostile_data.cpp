@@ -124,29 +124,8 @@ TEST(HostileData, CsvBeyondTheRowLimitIsRefusedAtThatRow) {
   EXPECT_EQ(io::read_measured_run(f.dir, limits).time.size(), 2000);
 }
 
-/// "" when `read` ends in success or a project error, else what escaped.
-template <class Read>
-std::string escaped(Read&& read) {
-  try {
-    read();
-  } catch (const core::Error&) {
-  } catch (const std::exception& e) {
-    return std::string("std::exception: ") + e.what();
-  }
-  return "";
-}
-
-std::vector<fs::path> regression_inputs() {
-  const fs::path dir = fs::path(TT_SOURCE_DIR) / "fuzz" / "regressions" / "measured";
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file()) files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
 TEST(FuzzRegressions, MeasuredDataReader) {
-  const auto files = regression_inputs();
+  const auto files = fuzz_regressions("measured");
   EXPECT_FALSE(files.empty());
   const fs::path dir = scratch("fuzz_measured");
   for (const auto& f : files) {
