@@ -17,10 +17,10 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cctype>
@@ -186,6 +186,16 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
             << " m, beyond " << kFarthest << " m. Hint: check the file and its length unit.";
         throw core::GeometryError(msg.str());
       }
+  {
+    std::vector<std::array<double, 3>> xyz;
+    xyz.reserve(points.size());
+    for (const auto& p : points) xyz.push_back({p.x(), p.y(), p.z()});
+    Triangulation split = fan_triangulated(xyz, polygons);
+    if (!split.problem.empty())
+      throw core::GeometryError(prefix + split.problem +
+                                ". Hint: export triangles (most exporters have a setting).");
+    polygons = std::move(split.triangles);
+  }
   PMP::repair_polygon_soup(points, polygons);
   if (!PMP::orient_polygon_soup(points, polygons))
     throw core::GeometryError(prefix +
@@ -198,7 +208,8 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
                               "watertight solid per file.");
   Mesh m;
   PMP::polygon_soup_to_polygon_mesh(points, polygons, m);
-  if (!CGAL::is_triangle_mesh(m)) PMP::triangulate_faces(m);
+  if (!CGAL::is_triangle_mesh(m))  // the soup was split into triangles above
+    throw core::GeometryError(prefix + "internal: the surface is not all triangles after splitting");
   m.collect_garbage();
   const CGAL::Bbox_3 box = PMP::bbox(m);
   const double diagonal =

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <limits>
+#include <optional>
 
 namespace tt::mesh::cgal {
 namespace {
@@ -253,6 +254,80 @@ std::optional<std::string> soup_problem(const std::vector<std::vector<std::size_
                " but the file has " + std::to_string(point_count) + " vertices";
   }
   return std::nullopt;
+}
+
+namespace {
+
+using Vec = std::array<double, 3>;
+Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec cross(const Vec& a, const Vec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/// Why the polygon (indices valid, at least 4) cannot be split as a fan, or nothing.
+std::optional<std::string> fan_problem(const std::vector<Vec>& corner) {
+  const std::size_t n = corner.size();
+  Vec normal{0, 0, 0};  // Newell's normal: twice the area vector
+  double size = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec& a = corner[i];
+    const Vec& b = corner[(i + 1) % n];
+    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    const Vec e = minus(b, a);
+    size = std::max(size, std::sqrt(dot(e, e)));
+  }
+  const double twice_area = std::sqrt(dot(normal, normal));
+  if (!(size > 0) || !(twice_area > 1e-12 * size * size)) return std::string("has no area");
+  const Vec unit{normal[0] / twice_area, normal[1] / twice_area, normal[2] / twice_area};
+  for (std::size_t i = 1; i < n; ++i)
+    if (std::abs(dot(minus(corner[i], corner[0]), unit)) > 1e-6 * size)
+      return "is not flat (vertex " + std::to_string(i) + " lies off the plane of the others)";
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec turn = cross(minus(corner[(i + 1) % n], corner[i]),
+                           minus(corner[(i + 2) % n], corner[(i + 1) % n]));
+    if (!(dot(turn, unit) > 1e-9 * size * size))
+      return "is not strictly convex (corner " + std::to_string((i + 1) % n) +
+             " is straight or turns back)";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Triangulation fan_triangulated(const std::vector<std::array<double, 3>>& points,
+                               const std::vector<std::vector<std::size_t>>& polygons) {
+  Triangulation out;
+  out.triangles.reserve(polygons.size());
+  for (std::size_t p = 0; p < polygons.size(); ++p) {
+    const auto& polygon = polygons[p];
+    if (polygon.size() == 3) {
+      out.triangles.push_back(polygon);
+      continue;
+    }
+    auto sorted = polygon;
+    std::sort(sorted.begin(), sorted.end());
+    std::optional<std::string> problem;
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      problem = "names a vertex twice";
+    } else {
+      std::vector<Vec> corner;
+      for (const std::size_t v : polygon) corner.push_back(points[v]);
+      problem = fan_problem(corner);
+    }
+    if (problem) {
+      out.triangles.clear();
+      out.problem = "polygon " + std::to_string(p) + " (" + std::to_string(polygon.size()) +
+                    " vertices) " + *problem + "; only flat convex polygons are split into " +
+                    "triangles here";
+      return out;
+    }
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
+      out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+  }
+  return out;
 }
 
 }  // namespace tt::mesh::cgal

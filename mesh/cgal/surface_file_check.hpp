@@ -43,4 +43,16 @@ OffReading read_off(std::string_view text);
 std::optional<std::string> soup_problem(const std::vector<std::vector<std::size_t>>& polygons,
                                         std::size_t point_count);
 
+/// The soup's polygons as triangles, or why they cannot be split here. A triangle stays as it is;
+/// a polygon of more vertices must be flat and strictly convex (no repeated vertex, no reflex or
+/// straight corner, every vertex within 1e-6 of its size from its plane) and is split as a fan
+/// from its first vertex. CGAL 5.5's own triangulation of polygon faces dereferences a null face
+/// on degenerate polygons (docs/reliability.md, F15), so it is never called.
+struct Triangulation {
+  std::vector<std::vector<std::size_t>> triangles;
+  std::string problem;  /// empty when split
+};
+Triangulation fan_triangulated(const std::vector<std::array<double, 3>>& points,
+                               const std::vector<std::vector<std::size_t>>& polygons);
+
 }  // namespace tt::mesh::cgal

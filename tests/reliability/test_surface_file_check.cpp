@@ -137,5 +137,37 @@ TEST(PolygonSoup, IndicesMustNameReadVertices) {
   EXPECT_NE(soup_problem({{0, 1, 2}}, 0), std::nullopt);
 }
 
+// F15: CGAL's triangulation of polygon faces dereferenced a null face on a degenerate polygon; the
+// soup is now split here, and only flat convex polygons are split.
+TEST(PolygonSoup, FlatConvexPolygonsAreSplitAsFans) {
+  const std::vector<std::array<double, 3>> square{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const Triangulation t = fan_triangulated(square, {{0, 1, 2, 3}, {0, 1, 2}});
+  ASSERT_EQ(t.problem, "");
+  const std::vector<std::vector<std::size_t>> expected{{0, 1, 2}, {0, 2, 3}, {0, 1, 2}};
+  EXPECT_EQ(t.triangles, expected);
+}
+
+TEST(PolygonSoup, DegenerateOrConcaveOrWarpedPolygonsAreRefused) {
+  auto problem = [](const std::vector<std::array<double, 3>>& points,
+                    const std::vector<std::size_t>& polygon) {
+    const Triangulation t = fan_triangulated(points, {{0, 1, 2}, polygon});
+    EXPECT_TRUE(t.triangles.empty());
+    return t.problem;
+  };
+  const std::vector<std::array<double, 3>> square{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  EXPECT_NE(problem(square, {0, 1, 2, 0}).find("polygon 1 (4 vertices) names a vertex twice"),
+            std::string::npos);
+  const std::vector<std::array<double, 3>> line{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+  EXPECT_NE(problem(line, {0, 1, 2, 3}).find("has no area"), std::string::npos);
+  const std::vector<std::array<double, 3>> dart{{0, 0, 0}, {2, 0, 0}, {1, 0.5, 0}, {1, 2, 0}};
+  EXPECT_NE(problem(dart, {0, 1, 2, 3}).find("not strictly convex"), std::string::npos);
+  const std::vector<std::array<double, 3>> straight{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {1, 1, 0}};
+  EXPECT_NE(problem(straight, {0, 1, 2, 3}).find("corner 1 is straight"), std::string::npos);
+  const std::vector<std::array<double, 3>> warped{{0, 0, 0}, {1, 0, 0}, {1, 1, 0.1}, {0, 1, 0}};
+  EXPECT_NE(problem(warped, {0, 1, 2, 3}).find("is not flat"), std::string::npos);
+  // The F15 input's shape: a polygon that returns to its first vertex.
+  EXPECT_NE(problem(square, {0, 1, 2, 3, 0}).find("names a vertex twice"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace tt::mesh::cgal
