@@ -33,7 +33,7 @@ struct CalibrationOptions {
   /// Place of a heat input refined after the grid: `heat_refine_levels` grids, each a third of
   /// the previous spacing, of boxes `heat_refine_half_scale` x patch_half_size around the best
   /// `heat_refine_parents` places found so far.
-  int heat_refine_levels = 2, heat_refine_parents = 1;
+  int heat_refine_levels = 2, heat_refine_parents = 3;
   double heat_refine_half_scale = 0.6;
   double ambient_knot_interval = 1800;  /// hat functions of the air temperature [s]
   std::vector<double> lag_grid_s{30, 60, 120, 200, 300, 450, 700, 1000};

@@ -8,9 +8,9 @@
 
 namespace tt::calibration::testing {
 
-/// One effect kind: generate, calibrate with it undeclared, check kind, place and (when
-/// `check_rms`) the test-run RMS after against before.
-inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed, bool check_rms = true) {
+/// One effect kind: generate, calibrate with it undeclared, check kind, place and the test-run RMS
+/// after against before.
+inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
   std::mt19937_64 rng = core::generator(seed, static_cast<std::uint64_t>(kind));
   const InjectedEffect e = random_effect(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
   std::vector<io::MeasuredRun> noiseless;
@@ -53,9 +53,7 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed, bool
         e.centre(0), e.centre(1), e.centre(2), found(0), found(1), found(2), err);
     EXPECT_LT(err, 0.1);
   }
-  if (check_rms) {
-    EXPECT_LE(after, 0.3 * before);
-  }
+  EXPECT_LE(after, 0.3 * before);
 }
 
 }  // namespace tt::calibration::testing
