@@ -97,12 +97,18 @@ TEST(HostileData, TenThousandSensorsReadInBoundedMemory) {
       << "peak RSS grew by " << after.ru_maxrss - before.ru_maxrss << " kB";
 }
 
-TEST(HostileData, CsvBeyondTheByteLimitIsRefusedBeforeReading) {
-  Folder f("data_bytes");
+/// A run of one sensor and `rows` rows, written into a new folder `name`.
+Folder one_sensor_run(const std::string& name, int rows) {
+  Folder f(name);
   f.write("meta.json", meta_with_sensors(1));
   std::string csv = "time_s,speed_rpm,T0\n";
-  for (int r = 0; r < 2000; ++r) csv += std::to_string(r) + ",0,20\n";
+  for (int r = 0; r < rows; ++r) csv += std::to_string(r) + ",0,20\n";
   f.write("data.csv", csv);
+  return f;
+}
+
+TEST(HostileData, CsvBeyondTheByteLimitIsRefusedBeforeReading) {
+  const Folder f = one_sensor_run("data_bytes", 2000);
   io::MeasuredReadLimits limits;
   limits.max_bytes = 4096;
   const std::string msg = data_error(f, limits);
@@ -110,11 +116,7 @@ TEST(HostileData, CsvBeyondTheByteLimitIsRefusedBeforeReading) {
 }
 
 TEST(HostileData, CsvBeyondTheRowLimitIsRefusedAtThatRow) {
-  Folder f("data_rows");
-  f.write("meta.json", meta_with_sensors(1));
-  std::string csv = "time_s,speed_rpm,T0\n";
-  for (int r = 0; r < 2000; ++r) csv += std::to_string(r) + ",0,20\n";
-  f.write("data.csv", csv);
+  const Folder f = one_sensor_run("data_rows", 2000);
   io::MeasuredReadLimits limits;
   limits.max_rows = 100;
   const std::string msg = data_error(f, limits);
