@@ -6,40 +6,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tests/common/case_toml.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace tt::reliability_test {
 namespace {
 
 // A heated steel bar on a fixed base: order 1, max_edge small enough for > 50 000 tets, ten steps.
-const char* kBarCase = R"(
-[case]
-name = "determinism bar"
-seed = 7
-
-[geometry]
-length_unit = "m"
-
-[materials.steel]
-density_kg_m3 = 7850.0
-specific_heat_J_kgK = 460.0
-conductivity_W_mK = 42.0
-youngs_modulus_Pa = 2.1e11
-poisson_ratio = 0.3
-expansion_per_K = 1.2e-5
-
-[[bodies]]
-name = "bar"
-material = "steel"
-max_edge = 0.009
-add = [ { box = { min = [0.0, 0.0, 0.0], max = [0.24, 0.1, 0.1] } } ]
-
-[[bodies]]
-name = "heater"
-material = "steel"
-max_edge = 0.009
-add = [ { box = { min = [0.24, 0.0, 0.0], max = [0.28, 0.1, 0.1] } } ]
-
+const std::string kBarCase = test_toml::header("determinism bar", "seed = 7\n") +
+                             test_toml::steel() +
+                             test_toml::box_body("bar", "steel", "0.009", "[0.0, 0.0, 0.0]",
+                                                 "[0.24, 0.1, 0.1]") +
+                             test_toml::box_body("heater", "steel", "0.009", "[0.24, 0.0, 0.0]",
+                                                 "[0.28, 0.1, 0.1]") +
+                             R"(
 [mesh]
 order = 1
 

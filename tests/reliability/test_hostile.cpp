@@ -14,6 +14,7 @@
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/thermal.hpp"
+#include "tests/common/case_toml.hpp"
 
 namespace tt::reliability_test {
 namespace {
@@ -108,28 +109,12 @@ TEST(HostileCase, ZeroConductivityIsRefused) {
 TEST(HostileCase, HeatSourceOnARegionWithoutElementsIsRefused) {
   // Two boxes, the source on the second; then every tet is given to the first, as a mesh that
   // lost a thin body would be.
-  const std::string text = R"(
-[case]
-name = "empty region"
-[geometry]
-length_unit = "m"
-[materials.steel]
-density_kg_m3 = 7850.0
-specific_heat_J_kgK = 460.0
-conductivity_W_mK = 42.0
-youngs_modulus_Pa = 2.1e11
-poisson_ratio = 0.3
-expansion_per_K = 1.2e-5
-[[bodies]]
-name = "block"
-material = "steel"
-max_edge = 0.05
-add = [ { box = { min = [0.0, 0.0, 0.0], max = [0.1, 0.1, 0.1] } } ]
-[[bodies]]
-name = "pad"
-material = "steel"
-max_edge = 0.05
-add = [ { box = { min = [0.1, 0.0, 0.0], max = [0.15, 0.1, 0.1] } } ]
+  const std::string text = test_toml::header("empty region") + test_toml::steel() +
+                           test_toml::box_body("block", "steel", "0.05", "[0.0, 0.0, 0.0]",
+                                               "[0.1, 0.1, 0.1]") +
+                           test_toml::box_body("pad", "steel", "0.05", "[0.1, 0.0, 0.0]",
+                                               "[0.15, 0.1, 0.1]") +
+                           R"(
 [[boundary]]
 name = "all"
 rest = true

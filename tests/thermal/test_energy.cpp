@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "tests/thermal/thermal_fixtures.hpp"
+#include "tests/common/case_toml.hpp"
 
 namespace tt::thermal_test {
 namespace {
@@ -32,14 +33,12 @@ struct EnergyCase {
       "{ start_s = 500.0, speed_rpm = 1500.0 } ]";
 
   std::string toml() const {
-    std::string t = "[case]\nname = \"energy\"\n[geometry]\nlength_unit = \"m\"\n";
+    std::string t = test_toml::header("energy");
     t += "[materials.iron]\ndensity_kg_m3 = 7250.0\nspecific_heat_J_kgK = 510.0\n"
          "conductivity_W_mK = 46.0\nyoungs_modulus_Pa = 1.2e11\npoisson_ratio = 0.26\n"
          "expansion_per_K = 1.1e-5\n";
-    t += "[[bodies]]\nname = \"block\"\nmaterial = \"iron\"\nmax_edge = 0.02\n"
-         "add = [ { box = { min = [0.0, 0.0, 0.0], max = [0.1, 0.05, 0.04] } } ]\n";
-    t += "[[bodies]]\nname = \"pad\"\nmaterial = \"iron\"\nmax_edge = 0.015\n"
-         "add = [ { box = { min = [0.1, 0.0, 0.0], max = [0.13, 0.05, 0.04] } } ]\n";
+    t += test_toml::box_body("block", "iron", "0.02", "[0.0, 0.0, 0.0]", "[0.1, 0.05, 0.04]");
+    t += test_toml::box_body("pad", "iron", "0.015", "[0.1, 0.0, 0.0]", "[0.13, 0.05, 0.04]");
     t += "[mesh]\norder = " + std::to_string(order) + "\n[mechanical]\nenabled = false\n";
     t += "[[boundary]]\nname = \"top\"\nselect = [ { bodies = [\"block\", \"pad\"], plane = { "
          "normal = [0.0, 1.0, 0.0], offset = 0.05 } } ]\n";

@@ -20,6 +20,7 @@
 #include "mesh/mesher.hpp"
 #include "solvers/campaign.hpp"
 #include "solvers/thermal.hpp"
+#include "tests/common/case_toml.hpp"
 
 namespace tt::candidates_test {
 namespace {
@@ -31,14 +32,9 @@ namespace fs = std::filesystem;
 constexpr double kX = 0.1, kY = 0.08, kZ = 0.06, kTop = 0.09;
 
 std::string two_box_case(int order, const std::string& placement) {
-  std::string t = "[case]\nname = \"two boxes\"\n[geometry]\nlength_unit = \"m\"\n";
-  t += "[materials.steel]\ndensity_kg_m3 = 7850.0\nspecific_heat_J_kgK = 460.0\nconductivity_W_mK "
-       "= 42.0\n"
-       "youngs_modulus_Pa = 2.1e11\npoisson_ratio = 0.3\nexpansion_per_K = 1.2e-5\n";
-  t += "[[bodies]]\nname = \"block\"\nmaterial = \"steel\"\nmax_edge = 0.03\n"
-       "add = [ { box = { min = [0.0, 0.0, 0.0], max = [0.1, 0.08, 0.06] } } ]\n";
-  t += "[[bodies]]\nname = \"cap\"\nmaterial = \"steel\"\nmax_edge = 0.03\n"
-       "add = [ { box = { min = [0.0, 0.0, 0.06], max = [0.1, 0.08, 0.09] } } ]\n";
+  std::string t = test_toml::header("two boxes") + test_toml::steel();
+  t += test_toml::box_body("block", "steel", "0.03", "[0.0, 0.0, 0.0]", "[0.1, 0.08, 0.06]");
+  t += test_toml::box_body("cap", "steel", "0.03", "[0.0, 0.0, 0.06]", "[0.1, 0.08, 0.09]");
   t += "[mesh]\norder = " + std::to_string(order) + "\n";
   t += "[[boundary]]\nname = \"base\"\nselect = [ { bodies = [\"block\"], plane = { normal = [0.0, "
        "0.0, 1.0], "
