@@ -32,7 +32,7 @@ struct Primitive {
   double radius = 0;        /// cylinder radius, annulus outer radius [m]
   double inner_radius = 0;  /// annulus inner radius [m]
   double z_min = 0, z_max = 0;  /// axial extent [m]
-  std::filesystem::path file;   /// closed STL/OFF/PLY surface (polygons flat, convex), case length unit
+  std::filesystem::path file;   /// closed STL/OFF/PLY surface (flat convex polygons), case unit
   double file_scale = 1.0;      /// factor from the file's length unit to m
   std::string where;            /// where it was declared, for messages: "bodies[0].add[1]"
 };
