@@ -75,7 +75,9 @@ TEST(Selection, NeverTouchesTestGroups) {
   const double best_sm =
       honest.selection.candidates[static_cast<std::size_t>(honest.selection.best)].validation.sm;
   for (const auto& c : honest.selection.candidates) {
-    if (c.model) EXPECT_GE(c.validation.sm, best_sm);
+    if (c.model) {
+      EXPECT_GE(c.validation.sm, best_sm);
+    }
   }
   EXPECT_EQ(honest.test_groups, (std::vector<std::string>{"run4", "run5"}));
 }
