@@ -1,5 +1,6 @@
 #include "mesh/cgal/surface_file_check.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -258,37 +259,30 @@ std::optional<std::string> soup_problem(const std::vector<std::vector<std::size_
 
 namespace {
 
-using Vec = std::array<double, 3>;
-Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using Vec = Eigen::Vector3d;
 
 /// Why the polygon (indices valid, at least 4) cannot be split as a fan, or nothing.
 std::optional<std::string> fan_problem(const std::vector<Vec>& corner) {
   const std::size_t n = corner.size();
-  Vec normal{0, 0, 0};  // Newell's normal: twice the area vector
+  Vec normal = Vec::Zero();  // Newell's normal: twice the area vector
   double size = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Vec& a = corner[i];
     const Vec& b = corner[(i + 1) % n];
-    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
-    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
-    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    const Vec e = minus(b, a);
-    size = std::max(size, std::sqrt(dot(e, e)));
+    normal += Vec((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
+                  (a.x() - b.x()) * (a.y() + b.y()));
+    size = std::max(size, (b - a).norm());
   }
-  const double twice_area = std::sqrt(dot(normal, normal));
+  const double twice_area = normal.norm();
   if (!(size > 0) || !(twice_area > 1e-12 * size * size)) return std::string("has no area");
-  const Vec unit{normal[0] / twice_area, normal[1] / twice_area, normal[2] / twice_area};
+  const Vec unit = normal / twice_area;
   for (std::size_t i = 1; i < n; ++i)
-    if (std::abs(dot(minus(corner[i], corner[0]), unit)) > 1e-6 * size)
+    if (std::abs((corner[i] - corner[0]).dot(unit)) > 1e-6 * size)
       return "is not flat (vertex " + std::to_string(i) + " lies off the plane of the others)";
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec turn = cross(minus(corner[(i + 1) % n], corner[i]),
-                           minus(corner[(i + 2) % n], corner[(i + 1) % n]));
-    if (!(dot(turn, unit) > 1e-9 * size * size))
+    const Vec turn =
+        (corner[(i + 1) % n] - corner[i]).cross(corner[(i + 2) % n] - corner[(i + 1) % n]);
+    if (!(turn.dot(unit) > 1e-9 * size * size))
       return "is not strictly convex (corner " + std::to_string((i + 1) % n) +
              " is straight or turns back)";
   }
@@ -314,7 +308,7 @@ Triangulation fan_triangulated(const std::vector<std::array<double, 3>>& points,
       problem = "names a vertex twice";
     } else {
       std::vector<Vec> corner;
-      for (const std::size_t v : polygon) corner.push_back(points[v]);
+      for (const std::size_t v : polygon) corner.push_back(Vec(points[v].data()));
       problem = fan_problem(corner);
     }
     if (problem) {

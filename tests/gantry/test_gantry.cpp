@@ -16,6 +16,7 @@
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
+#include "tests/common/case_toml.hpp"
 
 namespace tt::gantry_test {
 namespace {
@@ -23,14 +24,9 @@ namespace {
 /// A steel bar 1 m along x on [0, 1] with a moving source in it (window 0.2 m) and a fixed
 /// feed-speed source in a pad; the axis reciprocates over [0.2, 0.8] at 6 m/min, then stands.
 std::string bar_case(int order, const std::string& scheme = "backward_euler") {
-  std::string t = "[case]\nname = \"bar\"\n[geometry]\nlength_unit = \"m\"\n";
-  t += "[materials.steel]\ndensity_kg_m3 = 7850.0\nspecific_heat_J_kgK = 460.0\nconductivity_W_mK "
-       "= 42.0\n"
-       "youngs_modulus_Pa = 2.1e11\npoisson_ratio = 0.3\nexpansion_per_K = 1.2e-5\n";
-  t += "[[bodies]]\nname = \"bar\"\nmaterial = \"steel\"\nmax_edge = 0.04\n"
-       "add = [ { box = { min = [0.0, 0.0, 0.0], max = [1.0, 0.05, 0.05] } } ]\n";
-  t += "[[bodies]]\nname = \"pad\"\nmaterial = \"steel\"\nmax_edge = 0.04\n"
-       "add = [ { box = { min = [-0.05, 0.0, 0.0], max = [0.0, 0.05, 0.05] } } ]\n";
+  std::string t = test_toml::header("bar") + test_toml::steel();
+  t += test_toml::box_body("bar", "steel", "0.04", "[0.0, 0.0, 0.0]", "[1.0, 0.05, 0.05]");
+  t += test_toml::box_body("pad", "steel", "0.04", "[-0.05, 0.0, 0.0]", "[0.0, 0.05, 0.05]");
   t += "[mesh]\norder = " + std::to_string(order) + "\n";
   t += "[[boundary]]\nname = \"all\"\nrest = true\nselect = [ {} ]\n";
   t += "[thermal]\nscheme = \"" + scheme + "\"\nstep_s = 10.0\noutput_interval_s = 60.0\n";

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/common/case_toml.hpp"
+
 namespace tt::mesh::test {
 
 namespace fs = std::filesystem;
@@ -171,9 +173,7 @@ inline std::string small_case(const std::string& bodies, const std::string& poin
                               const std::string& unit = "m", const std::string& mesh = "") {
   std::ostringstream o;
   o << "[case]\nname = \"mesh test\"\n\n[geometry]\nlength_unit = \"" << unit << "\"\n\n"
-    << "[materials.steel]\ndensity_kg_m3 = 7850.0\nspecific_heat_J_kgK = 460.0\n"
-    << "conductivity_W_mK = 42.0\nyoungs_modulus_Pa = 2.1e11\npoisson_ratio = 0.3\n"
-    << "expansion_per_K = 1.2e-5\n\n"
+    << test_toml::steel() << "\n"
     << bodies << "\n\n[mesh]\norder = 1\n"
     << mesh << "\n"
     << "[[boundary]]\nname = \"outside\"\nselect = [ {} ]\n\n";
