@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/limits.hpp"
+
 namespace tt::core {
 
 struct Material {
@@ -81,6 +83,11 @@ struct MeshOptions {
   int circle_segments = 48;         /// facets around every cylinder
   double radius_edge_ratio = 1.5;   /// TetGen quality bound
   double min_dihedral_deg = 12.0;   /// TetGen quality bound asked for
+  /// Bounds on meshing (core/limits.hpp has the defaults): tetrahedra estimated before TetGen
+  /// starts, TetGen's wall time [s] and the memory it may add [GB, 10^9 bytes].
+  double max_tets = limits::kDefaultMaxTets;
+  double time_limit_s = limits::kDefaultMeshTimeLimitS;
+  double memory_limit_GB = limits::kDefaultMeshMemoryLimitGB;
 };
 
 /// Spindle speed over time: piecewise constant segments.

@@ -4,8 +4,23 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/finite.hpp"
 
 namespace tt::fitting {
+
+namespace {
+
+/// A fit whose numbers overflowed is refused, never written as a model.
+LinearFit checked(LinearFit fit) {
+  const std::string origin =
+      "the regressors or errors it was fitted on hold a NaN, an infinity or numbers beyond a "
+      "double's range";
+  core::require_finite(fit.intercept, "a fitted intercept", origin);
+  core::require_finite(fit.coefficients, "a fitted coefficient (row: regressor)", origin);
+  return fit;
+}
+
+}  // namespace
 
 LinearFit linear_fit(const Eigen::MatrixXd& phi, const Eigen::VectorXd& y, double lambda) {
   if (!(lambda >= 0.0))
@@ -27,7 +42,7 @@ LinearFit linear_fit(const Eigen::MatrixXd& phi, const Eigen::VectorXd& y, doubl
     const Eigen::VectorXd beta = a.completeOrthogonalDecomposition().solve(y);
     fit.intercept = beta(0);
     fit.coefficients = beta.tail(p);
-    return fit;
+    return checked(fit);
   }
   const Eigen::RowVectorXd mean = phi.colwise().mean();
   const Eigen::MatrixXd centred = phi.rowwise() - mean;
@@ -43,7 +58,7 @@ LinearFit linear_fit(const Eigen::MatrixXd& phi, const Eigen::VectorXd& y, doubl
   const Eigen::VectorXd b = normal.ldlt().solve(z.transpose() * (y.array() - y_mean).matrix());
   fit.coefficients = b.cwiseQuotient(scale);
   fit.intercept = y_mean - mean.dot(fit.coefficients);
-  return fit;
+  return checked(fit);
 }
 
 Eigen::VectorXd linear_prediction(const LinearFit& fit, const Eigen::MatrixXd& phi) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 
 namespace tt::io {
 
@@ -267,6 +268,20 @@ double number_or(const Tab& t, std::string_view key, double fallback, Sign sign 
 double length(const Tab& t, std::string_view key, Sign sign = Sign::positive,
               const std::string& hint = "a length in [geometry] length_unit") {
   return number(t, key, sign, hint) / t.ctx->length_divisor;
+}
+
+/// A temperature in degC: finite and not below absolute zero.
+double temperature_c(const Ctx& c, const toml::node& n, const std::string& path) {
+  const double v = as_number(c, n, path);
+  if (v < core::limits::kAbsoluteZeroDegC)
+    fail_value(c, n, path, "must be >= -273.15 degC (absolute zero)",
+               "temperatures in the case are in degC, not K");
+  return v;
+}
+
+double temperature_or(const Tab& t, std::string_view key, double fallback) {
+  const toml::node* n = t.get(key);
+  return n ? temperature_c(*t.ctx, *n, t.at(key)) : fallback;
 }
 
 std::int64_t integer(const Ctx& c, const toml::node& n, const std::string& path) {
@@ -563,11 +578,18 @@ void read_bodies(const Tab& root, CaseSpec& spec) {
   if (spec.bodies.empty()) fail(*root.ctx, line_of(*root.get("bodies")), "bodies: none declared");
 }
 
+constexpr std::int64_t kMinCircleSegments = 8, kMaxCircleSegments = 100000;
+/// TetGen 1.5's -q refinement stalls above about 18 deg (its manual); the adapter refuses more.
+constexpr double kMaxMinDihedralDeg = 18;
+/// Below about 1.1 TetGen's -q refinement may not terminate (its manual).
+constexpr double kMinRadiusEdgeRatio = 1.1;
+
 void read_mesh(const Tab& root, CaseSpec& spec) {
   const toml::node* n = root.get("mesh");
   if (!n) return;
   const Tab m = as_tab(*root.ctx, *n, "mesh");
-  m.allow({"order", "circle_segments", "radius_edge_ratio", "min_dihedral_deg"});
+  m.allow({"order", "circle_segments", "radius_edge_ratio", "min_dihedral_deg", "max_tets",
+           "time_limit_s", "memory_limit_GB"});
   if (const auto* o = m.get("order")) {
     const auto v = integer(*m.ctx, *o, m.at("order"));
     if (v != 1 && v != 2)
@@ -577,23 +599,32 @@ void read_mesh(const Tab& root, CaseSpec& spec) {
   }
   if (const auto* s = m.get("circle_segments")) {
     const auto v = integer(*m.ctx, *s, m.at("circle_segments"));
-    if (v < 8 || v > 100000)
-      fail_value(*m.ctx, *s, m.at("circle_segments"), "must be at least 8",
+    if (v < kMinCircleSegments || v > kMaxCircleSegments)
+      fail_value(*m.ctx, *s, m.at("circle_segments"),
+                 "must lie in [" + std::to_string(kMinCircleSegments) + ", " +
+                     std::to_string(kMaxCircleSegments) + "]",
                  "facets around each cylinder; 48 keeps the radius within 0.2 %");
     spec.mesh.circle_segments = static_cast<int>(v);
   }
   if (const auto* r = m.get("radius_edge_ratio")) {
     spec.mesh.radius_edge_ratio = as_number(*m.ctx, *r, m.at("radius_edge_ratio"));
-    if (!(spec.mesh.radius_edge_ratio > 1.0))
-      fail_value(*m.ctx, *r, m.at("radius_edge_ratio"), "must be > 1",
-                 "TetGen may not terminate below about 1.1; 1.5 is a good default");
+    if (!(spec.mesh.radius_edge_ratio >= kMinRadiusEdgeRatio))
+      fail_value(*m.ctx, *r, m.at("radius_edge_ratio"), "must be >= 1.1",
+                 "TetGen's refinement may not terminate below about 1.1; 1.5 is a good default");
   }
   if (const auto* d = m.get("min_dihedral_deg")) {
     spec.mesh.min_dihedral_deg = as_number(*m.ctx, *d, m.at("min_dihedral_deg"));
-    if (!(spec.mesh.min_dihedral_deg >= 0 && spec.mesh.min_dihedral_deg < 70))
-      fail_value(*m.ctx, *d, m.at("min_dihedral_deg"), "must lie in [0, 70)",
-                 "a regular tetrahedron has 70.5 deg; TetGen manages about 12-18");
+    if (!(spec.mesh.min_dihedral_deg >= 0 && spec.mesh.min_dihedral_deg <= kMaxMinDihedralDeg))
+      fail_value(*m.ctx, *d, m.at("min_dihedral_deg"), "must lie in [0, 18]",
+                 "TetGen's quality meshing manages at most about 18 deg; 12 is a good default");
   }
+  auto& mesh = spec.mesh;
+  mesh.max_tets = number_or(m, "max_tets", mesh.max_tets, Sign::positive,
+                            "tetrahedra estimated before meshing; raise it for a finer mesh");
+  mesh.time_limit_s = number_or(m, "time_limit_s", mesh.time_limit_s, Sign::positive,
+                                "wall time TetGen may take, in s");
+  mesh.memory_limit_GB = number_or(m, "memory_limit_GB", mesh.memory_limit_GB, Sign::positive,
+                                   "memory TetGen may take, in GB");
 }
 
 core::FaceSelector read_selector(const Tab& s, const Names& bodies) {
@@ -687,12 +718,24 @@ Names point_ids(const CaseSpec& spec) {
 /// Segments from a CSV "time_s,speed_rpm" with a header; errors point into the CSV.
 std::vector<core::DutyCycle::Segment> csv_segments(const Ctx& c, const toml::node& n,
                                                    const std::string& path) {
-  const std::string rel = as_string(c, n, path);
+  std::string rel = as_string(c, n, path);
   const fs::path file = c.dir / rel;
-  std::ifstream in(file);
-  if (rel.empty() || !in)
+  using core::limits::kDutyCycleFileBytes;
+  std::optional<std::string> bytes;
+  try {
+    if (!rel.empty()) bytes = core::limits::file_text_up_to(file, kDutyCycleFileBytes);
+  } catch (const core::IoError&) {
+    rel.clear();
+  }
+  if (rel.empty())
     fail_value(c, n, path, "cannot read " + file.string(),
                "paths are relative to the case file's folder");
+  if (!bytes)
+    fail_value(c, n, path,
+               file.string() + " holds more than " + core::limits::bytes_text(kDutyCycleFileBytes) +
+                   ", the limit for a duty-cycle CSV",
+               "a row per speed change is enough");
+  std::istringstream in(*bytes);
   const std::string where = " (" + path + " of " + c.file + ")";
   auto csv_fail = [&](int line, const std::string& msg) -> void {
     throw CaseError(core::located(file.string(), line, msg + where));
@@ -799,6 +842,7 @@ core::TimeTable sink_table(const Ctx& c, const toml::node& n, const std::string&
   for (std::size_t i = 0; i < a.size(); ++i) {
     const std::string p = path + "[" + std::to_string(i) + "]";
     const Eigen::VectorXd row = numbers(c, a[i], p, 2, "[t_s, degC]");
+    temperature_c(c, (*a[i].as_array())[1], p + "[1]");
     if (!table.time.empty() && !(row[0] > table.time.back()))
       fail_value(c, a[i], p,
                  "time must exceed the previous row's " + number_text(table.time.back()),
@@ -817,7 +861,8 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
   t.allow({"initial_temperature_degC", "scheme", "step_s", "output_interval_s", "lumped_mass",
            "convection", "heat_sources", "surface_flux"});
   auto& th = spec.thermal;
-  th.initial_temperature_c = number_or(t, "initial_temperature_degC", th.initial_temperature_c);
+  th.initial_temperature_c =
+      temperature_or(t, "initial_temperature_degC", th.initial_temperature_c);
   th.scheme = choice_or<core::TimeScheme>(t, "scheme", th.scheme,
                                           {{"backward_euler", core::TimeScheme::backward_euler},
                                            {"crank_nicolson", core::TimeScheme::crank_nicolson},
@@ -854,7 +899,7 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
       fail_value(c, *st, cv.at("sink_table"), "give either sink_degC or sink_table, not both");
     if (sd) {
       conv.sink.time = {0.0};
-      conv.sink.value = {as_number(c, *sd, cv.at("sink_degC"))};
+      conv.sink.value = {temperature_c(c, *sd, cv.at("sink_degC"))};
     } else if (st) {
       conv.sink = sink_table(c, *st, cv.at("sink_table"));
     } else {
@@ -966,6 +1011,32 @@ void check_step(const Tab& root, const CaseSpec& spec) {
            "; set step_s in [thermal]");
 }
 
+/// The node of `key` in [thermal] when the case gives it, else the [thermal] table or the root.
+const toml::node* thermal_key(const Tab& root, std::string_view key) {
+  const toml::node* th = root.get("thermal");
+  return th && th->is_table() ? th->as_table()->get(key) : nullptr;
+}
+
+/// duty_cycle.end_s / `interval` must not exceed `limit` (time steps, output times): every one
+/// of them is allocated or solved.
+void check_count(const Tab& root, const CaseSpec& spec, std::string_view key, double interval,
+                 std::int64_t limit, const std::string& counted) {
+  const double count = spec.duty_cycle.end / interval;
+  if (count <= static_cast<double>(limit)) return;
+  const std::string expected = "duty_cycle.end_s = " + number_text(spec.duty_cycle.end) +
+                               " would need " + number_text(std::ceil(count)) + " " + counted +
+                               ", more than the limit of " + std::to_string(limit);
+  const std::string hint = "lengthen " + std::string(key) + " or shorten the run";
+  const std::string path = "thermal." + std::string(key);
+  if (const toml::node* n = thermal_key(root, key)) fail_value(*root.ctx, *n, path, expected, hint);
+  const toml::node* end = root.get("duty_cycle")->as_table()->get("end_s");
+  fail_value(*root.ctx, *end, "duty_cycle.end_s",
+             "would need " + number_text(std::ceil(count)) + " " + counted + " of " + path +
+                 " = " + number_text(interval) + " s (the default), more than the limit of " +
+                 std::to_string(limit),
+             "shorten the run or set " + std::string(key) + " in [thermal]");
+}
+
 /// [feed_axis]: segments = [{ start_s, from, to, feed_m_min } | { start_s, position }, ...].
 void read_feed_axis(const Tab& root, CaseSpec& spec) {
   const toml::node* n = root.get("feed_axis");
@@ -1060,7 +1131,7 @@ void read_mechanical(const Tab& root, CaseSpec& spec) {
            "targets", "axis_points", "axis_polynomial_degree"});
   me.enabled = flag_or(m, "enabled", me.enabled);
   me.reference_temperature_c =
-      number_or(m, "reference_temperature_degC", me.reference_temperature_c);
+      temperature_or(m, "reference_temperature_degC", me.reference_temperature_c);
   if (const auto* f = m.get("fixed"))
     me.fixed_groups = references(c, *f, m.at("fixed"), names_of(spec.groups), "boundary group");
   const Names ids = point_ids(spec);
@@ -1193,6 +1264,9 @@ CaseSpec case_from_root(const toml::table& root, Ctx& ctx, const fs::path& file)
   read_feed_axis(r, spec);
   read_thermal(r, spec);
   check_step(r, spec);
+  check_count(r, spec, "step_s", spec.thermal.step, core::limits::kTimeSteps, "time steps");
+  check_count(r, spec, "output_interval_s", spec.thermal.output_interval,
+              core::limits::kOutputTimes, "output times");
   read_mechanical(r, spec);
   read_outputs(r, spec);
   read_placement(r, spec);
@@ -1289,12 +1363,17 @@ CaseSpec case_from_toml(std::string_view text, const fs::path& file) {
 }
 
 CaseSpec read_case(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw core::IoError(file.string() + ": cannot open the case file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw core::IoError(file.string() + ": cannot read the case file");
-  return case_from_toml(text.str(), file);
+  using core::limits::kCaseFileBytes;
+  std::optional<std::string> text;
+  try {
+    text = core::limits::file_text_up_to(file, kCaseFileBytes);
+  } catch (const core::IoError&) {
+    throw core::IoError(file.string() + ": cannot open or read the case file");
+  }
+  if (!text)
+    throw CaseError(file.string() + ": holds more than " + core::limits::bytes_text(kCaseFileBytes) +
+                    ", the limit for a case file; is it the case file (a TOML text)?");
+  return case_from_toml(*text, file);
 }
 
 std::string resolved_case_toml(const CaseSpec& spec) {
@@ -1324,7 +1403,10 @@ std::string resolved_case_toml(const CaseSpec& spec) {
   o << "\n[mesh]\norder = " << spec.mesh.order
     << "\ncircle_segments = " << spec.mesh.circle_segments
     << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
-    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg) << "\n";
+    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg)
+    << "\nmax_tets = " << number_text(spec.mesh.max_tets)
+    << "\ntime_limit_s = " << number_text(spec.mesh.time_limit_s)
+    << "\nmemory_limit_GB = " << number_text(spec.mesh.memory_limit_GB) << "\n";
   for (const auto& g : spec.groups) {
     o << "\n[[boundary]]\nname = " << toml_string(g.name)
       << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 #include "io/atomic_dir.hpp"
 
 namespace tt::io {
@@ -72,6 +73,15 @@ std::optional<double> optional_number(const fs::path& file, const json& meta,
   if (!it->is_number() || !std::isfinite(it->get<double>()))
     meta_error(file, key, json_text(*it) + ": expected a finite number or null");
   return it->get<double>();
+}
+
+/// A temperature in degC, not below absolute zero, or nothing for null.
+std::optional<double> optional_temperature(const fs::path& file, const json& meta,
+                                           const std::string& key) {
+  const auto t = optional_number(file, meta, key);
+  if (t && *t < core::limits::kAbsoluteZeroDegC)
+    meta_error(file, key, json_text(meta[key]) + ": below absolute zero (-273.15 degC)");
+  return t;
 }
 
 /// A [x, y, z] triple, or nothing for null.
@@ -159,8 +169,8 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   require_unit(file, meta, "time_unit", "s");
   require_unit(file, meta, "temperature_unit", "degC");
   require_unit(file, meta, "displacement_unit", "um");
-  run.initial_temperature_c = optional_number(file, meta, "initial_temperature_degC");
-  run.nominal_ambient_c = optional_number(file, meta, "nominal_ambient_degC");
+  run.initial_temperature_c = optional_temperature(file, meta, "initial_temperature_degC");
+  run.nominal_ambient_c = optional_temperature(file, meta, "nominal_ambient_degC");
 
   std::set<std::string> ids;
   const auto unique = [&](const std::string& id, const std::string& path) {
@@ -380,6 +390,11 @@ void read_samples(const fs::path& file, const MeasuredReadLimits& limits, Measur
                             where + ": '" + cell_text(cell) +
                                 "' is not a finite number; leave the cell empty for a missing "
                                 "reading"));
+        if (slots[column].role == ColumnRole::sensor && value < core::limits::kAbsoluteZeroDegC)
+          throw core::DataError(core::located(
+              file.string(), number,
+              where + ": " + cell_text(cell) +
+                  " degC is below absolute zero (-273.15 degC); temperatures are in degC"));
       } else if (column == 0) {
         throw core::DataError(
             core::located(file.string(), number, where + ": empty time; every row needs one"));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <Eigen/Geometry>
 #include <map>
 #include <sstream>
@@ -85,7 +86,93 @@ bool selector_matches(const core::FaceSelector& s, const TetMesh& m, int f, cons
   return true;
 }
 
+/// Volume of a primitive [m^3]; a surface file's from its closed surface.
+double primitive_volume(const core::Primitive& p, const core::Body& body) {
+  using Kind = core::Primitive::Kind;
+  switch (p.kind) {
+    case Kind::box: return (p.max - p.min).prod();
+    case Kind::cylinder: return kPi * p.radius * p.radius * (p.z_max - p.z_min);
+    case Kind::annulus:
+      return kPi * (p.radius * p.radius - p.inner_radius * p.inner_radius) * (p.z_max - p.z_min);
+    case Kind::surface_file: return std::max(0.0, exact_body_volume(body));
+  }
+  return 0;
+}
+
+/// Perimeter and shortest edge of a facet's rings [m] (one-vertex polygons are points).
+std::pair<double, double> facet_edges(const Plc& plc, const PlcFacet& f) {
+  double perimeter = 0, shortest = std::numeric_limits<double>::infinity();
+  for (const auto& ring : f.polygons) {
+    if (ring.size() < 2) continue;
+    for (size_t k = 0; k < ring.size(); ++k) {
+      const double e = (plc.vertices[ring[(k + 1) % ring.size()]] - plc.vertices[ring[k]]).norm();
+      perimeter += e;
+      if (e > 0) shortest = std::min(shortest, e);
+    }
+  }
+  return {perimeter, shortest};
+}
+
+/// Area of a facet [m^2]: its outer ring's, by the vector area of each ring (holes subtract
+/// themselves when wound the other way, and are counted whole otherwise: an upper bound).
+double facet_area(const Plc& plc, const PlcFacet& f) {
+  double area = 0;
+  for (const auto& ring : f.polygons) {
+    if (ring.size() < 3) continue;
+    Vector3d twice = Vector3d::Zero();
+    for (size_t k = 0; k < ring.size(); ++k)
+      twice += plc.vertices[ring[k]].cross(plc.vertices[ring[(k + 1) % ring.size()]]);
+    area = std::max(area, 0.5 * twice.norm());
+  }
+  return area;
+}
+
 }  // namespace
+
+MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc) {
+  MeshEstimate e;
+  // A regular tet of edge h has volume h^3 / (6 sqrt 2); TetGen's -a bound is that volume, and its
+  // tets come out smaller than the bound on average (kVolumeFill, measured on the shipped cases).
+  constexpr double kVolumeFill = 2.0;
+  for (size_t b = 0; b < spec.bodies.size(); ++b) {
+    const auto& body = spec.bodies[b];
+    double volume = 0;
+    for (const auto& p : body.add) volume += primitive_volume(p, body);
+    const double h = body.max_edge;
+    const double tets = kVolumeFill * volume / (h * h * h / (6.0 * std::sqrt(2.0)));
+    e.volume_tets += tets;
+    if (tets > e.finest_body_tets) e.finest_body_tets = tets, e.finest_body = static_cast<int>(b);
+  }
+  // A facet needs at least as many triangles as its boundary has shortest edges along it (a long
+  // thin strip: length / width), and no more than its area holds at that edge; each boundary
+  // triangle starts a graded layer of tets (kSurfaceFill).
+  constexpr double kSurfaceFill = 4.0;
+  for (const auto& f : plc.facets) {
+    const auto [perimeter, shortest] = facet_edges(plc, f);
+    if (!std::isfinite(shortest)) continue;
+    const double triangles =
+        std::max(1.0, std::min(perimeter / shortest, facet_area(plc, f) / (shortest * shortest)));
+    e.surface_tets += kSurfaceFill * triangles;
+  }
+  return e;
+}
+
+void require_mesh_within_bounds(const core::CaseSpec& spec, const MeshEstimate& e) {
+  if (e.tets() <= spec.mesh.max_tets) return;
+  std::ostringstream o;
+  o.precision(3);
+  o << spec.source.string() << ": the mesh would have about " << e.tets()
+    << " tetrahedra, more than mesh.max_tets = " << spec.mesh.max_tets << " (estimated before "
+    << "meshing: " << e.volume_tets << " from the bodies' volumes at their max_edge";
+  if (e.finest_body >= 0)
+    o << ", most in body '" << spec.bodies[e.finest_body].name
+      << "' at max_edge = " << spec.bodies[e.finest_body].max_edge << " m";
+  o << "; " << e.surface_tets << " from the surface facets, mesh.circle_segments = "
+    << spec.mesh.circle_segments << "). Hint: coarsen max_edge or circle_segments, or raise "
+    << "max_tets under [mesh] when the machine has the memory (about 1 GB per 100 000 tets of "
+       "order 2 in a run).";
+  throw core::MeshError(o.str());
+}
 
 TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
                       const std::vector<int>& point_vertex) {
@@ -222,7 +309,12 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
 
 TetMesh mesh_case(const core::CaseSpec& spec) {
   const ExtrudedPlc plc = extruded_plc(spec);
-  TetgenOptions options{spec.mesh.radius_edge_ratio, spec.mesh.min_dihedral_deg};
+  require_mesh_within_bounds(spec, mesh_estimate(spec, plc.plc));
+  TetgenOptions options;
+  options.radius_edge_ratio = spec.mesh.radius_edge_ratio;
+  options.min_dihedral_deg = spec.mesh.min_dihedral_deg;
+  options.time_limit_s = spec.mesh.time_limit_s;
+  options.memory_limit_GB = spec.mesh.memory_limit_GB;
   const LinearTets lin = tetgen::tetrahedralize(plc.plc, options);
   std::vector<int> vertex = plc.point_vertex;
   // Points inserted inside were appended after the PLC's vertices; find them exactly.

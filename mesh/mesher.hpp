@@ -27,7 +27,22 @@ struct MeshReport {
   std::vector<double> point_distance;  /// per named point: distance to its node [m]
 };
 
-/// Meshes the case: PLC, TetGen, mid-edge nodes, faces, groups, named points.
+/// Tetrahedra a case's PLC will give, estimated before TetGen starts (an upper-side guess).
+struct MeshEstimate {
+  double volume_tets = 0;   /// from each body's volume at its max_edge
+  double surface_tets = 0;  /// from the facets' shortest edges (fine circle_segments, slivers)
+  int finest_body = -1;     /// body with the most volume tets
+  double finest_body_tets = 0;
+  double tets() const { return volume_tets + surface_tets; }
+};
+MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc);
+
+/// Throws MeshError naming mesh.max_tets, the body and the keys to change when the estimate is
+/// beyond the case's mesh.max_tets.
+void require_mesh_within_bounds(const core::CaseSpec& spec, const MeshEstimate& estimate);
+
+/// Meshes the case: PLC (its size estimated and bounded), TetGen (bounded in time and memory),
+/// mid-edge nodes, faces, groups, named points.
 TetMesh mesh_case(const core::CaseSpec& spec);
 
 /// Turns TetGen's linear tets into the project's mesh (order from the spec).

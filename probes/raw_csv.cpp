@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 
 namespace tt::probes {
 namespace {
@@ -107,12 +109,27 @@ double resolved_constant(const std::string& file, const std::string& key,
                           "sample_rate_hz=10000 probe_distance_mm=150' or give it as an option"));
 }
 
+/// The whole file, refused beyond core::limits::kProbeFileBytes whatever it is (a device too).
+std::string bounded_text(const std::filesystem::path& path, const std::string& what) {
+  std::optional<std::string> text;
+  try {
+    text = core::limits::file_text_up_to(path, core::limits::kProbeFileBytes);
+  } catch (const core::IoError&) {
+    throw core::IoError(core::located(path.string(), 0, "cannot open the " + what + " for reading"));
+  }
+  if (!text)
+    throw core::DataError(core::located(
+        path.string(), 0,
+        "holds more than " + core::limits::bytes_text(core::limits::kProbeFileBytes) +
+            ", the limit for a " + what + "; split the recording"));
+  return std::move(*text);
+}
+
 }  // namespace
 
 ProbeRecord read_raw_csv(const std::filesystem::path& path, const RawCsvConstants& given) {
   const std::string file = path.string();
-  std::ifstream in(path);
-  if (!in) throw core::IoError(core::located(file, 0, "cannot open the raw probe CSV for reading"));
+  std::istringstream in(bounded_text(path, "raw probe CSV"));
 
   std::map<std::string, HeaderValue> header;
   std::vector<std::string> names;
@@ -310,9 +327,7 @@ std::string drift_csv_text(const DriftSeries& series) {
 
 DriftHistory read_drift_history_csv(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream in(path);
-  if (!in)
-    throw core::IoError(core::located(file, 0, "cannot open the drift history CSV for reading"));
+  std::istringstream in(bounded_text(path, "drift history CSV"));
   std::vector<std::string> names;
   std::map<std::string, std::size_t> column;
   DriftHistory out;

@@ -1,8 +1,10 @@
 #include "solvers/campaign.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 #include "core/rng.hpp"
 #include "solvers/elastic.hpp"
 #include "solvers/loads.hpp"
@@ -75,8 +77,16 @@ std::vector<Segment> irregular_cycle(double end, std::uint64_t seed, const std::
 }  // namespace
 
 std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed) {
-  if (!(hours > 0)) throw core::CaseError("campaign length " + std::to_string(hours) + " h: must be > 0");
+  if (!(hours > 0) || !std::isfinite(hours))
+    throw core::CaseError("campaign length (fit --hours) " + std::to_string(hours) +
+                          " h: must be a finite number > 0");
   const double end = 3600 * hours;
+  if (end / base.thermal.step > static_cast<double>(core::limits::kTimeSteps))
+    throw core::CaseError("campaign length (fit --hours) " + std::to_string(hours) +
+                          " h: each run would need " + std::to_string(end / base.thermal.step) +
+                          " time steps of thermal.step_s = " + std::to_string(base.thermal.step) +
+                          " s, more than the limit of " + std::to_string(core::limits::kTimeSteps) +
+                          "; shorten the runs or lengthen step_s");
   const double q = end / 4;
   const double t0 = base.thermal.initial_temperature_c;
   std::vector<CampaignRun> runs;

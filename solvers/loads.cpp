@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <string>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 
 namespace tt::solvers {
 
@@ -106,16 +109,39 @@ std::vector<double> switch_times(const core::CaseSpec& spec) {
   return s;
 }
 
+namespace {
+
+/// end / interval as a count, refused beyond `limit` before anything of that size is made.
+std::int64_t bounded_count(double end, double interval, std::int64_t limit, const char* key,
+                           const char* counted) {
+  if (!(interval > 0) || !std::isfinite(interval))
+    throw core::SolverError(std::string(key) + " = " + std::to_string(interval) +
+                            " s: must be a finite number > 0");
+  const double count = std::ceil(end / interval - 1e-9);
+  if (!(count <= static_cast<double>(limit)))
+    throw core::SolverError(std::string(key) + " = " + std::to_string(interval) + " s over " +
+                            std::to_string(end) + " s would need more than " +
+                            std::to_string(limit) + " " + counted +
+                            " (the limit, core/limits.hpp); lengthen " + key +
+                            " or shorten the run");
+  return std::max<std::int64_t>(1, static_cast<std::int64_t>(count));
+}
+
+}  // namespace
+
 std::vector<double> time_grid(const core::CaseSpec& spec, double max_step) {
   const double end = spec.duty_cycle.end;
-  if (!(max_step > 0)) throw core::SolverError("time step " + std::to_string(max_step) + " s: must be > 0");
+  bounded_count(end, max_step, core::limits::kTimeSteps, "thermal.step_s", "time steps");
   std::vector<double> marks = switch_times(spec);
   marks.push_back(end);
   std::vector<double> grid;
   double a = 0;
   for (double b : marks) {
-    const int k = std::max(1, static_cast<int>(std::ceil((b - a) / max_step - 1e-9)));
-    for (int i = 1; i < k; ++i) grid.push_back(a + (b - a) * i / k);
+    // Each piece is shorter than the run, so its count is within the limit too.
+    const std::int64_t k =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil((b - a) / max_step - 1e-9)));
+    for (std::int64_t i = 1; i < k; ++i)
+      grid.push_back(a + (b - a) * static_cast<double>(i) / static_cast<double>(k));
     grid.push_back(b);
     a = b;
   }
@@ -124,8 +150,11 @@ std::vector<double> time_grid(const core::CaseSpec& spec, double max_step) {
 
 std::vector<double> output_times(const core::CaseSpec& spec) {
   const double end = spec.duty_cycle.end, dt = spec.thermal.output_interval;
+  bounded_count(end, dt, core::limits::kOutputTimes, "thermal.output_interval_s",
+                "output times");
   std::vector<double> t;
-  for (int k = 1; k * dt < end * (1 - 1e-12); ++k) t.push_back(k * dt);
+  for (std::int64_t k = 1; static_cast<double>(k) * dt < end * (1 - 1e-12); ++k)
+    t.push_back(static_cast<double>(k) * dt);
   t.push_back(end);
   return t;
 }

@@ -38,10 +38,11 @@ double table_value(const core::TimeTable& table, double t);
 std::vector<double> switch_times(const core::CaseSpec& spec);
 
 /// Step end times t_1 < ... < t_N = end: every switch is a step end; between switches the steps
-/// are equal and no longer than `max_step`.
+/// are equal and no longer than `max_step`. Throws SolverError beyond core::limits::kTimeSteps.
 std::vector<double> time_grid(const core::CaseSpec& spec, double max_step);
 
-/// Output times: multiples of the output interval up to the end, plus the end.
+/// Output times: multiples of the output interval up to the end, plus the end. Throws
+/// SolverError beyond core::limits::kOutputTimes.
 std::vector<double> output_times(const core::CaseSpec& spec);
 
 /// Heat delivered by every source from 0 to the end, from the laws alone [J] (no mesh, no solver).

@@ -8,6 +8,8 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/finite.hpp"
+#include "core/limits.hpp"
 #include "core/parallel.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/kernels/element.hpp"
@@ -235,6 +237,43 @@ void check_resume(const ThermalCheckpoint& c, int nodes, const std::vector<doubl
     fail(std::to_string(c.outputs.cols()) + " output columns, at most " + std::to_string(times) + " expected");
 }
 
+/// Why a step's temperatures are not finite: the step, a node, and the loads that entered it
+/// (the case's numbers that can overflow: heat source powers, film coefficients, sinks).
+core::SolverError non_finite_temperature(const core::CaseSpec& spec, const LoadState& s,
+                                         const Eigen::VectorXd& temperature, std::size_t step,
+                                         double t) {
+  Eigen::Index node = 0;
+  while (node + 1 < temperature.size() && std::isfinite(temperature[node])) ++node;
+  std::ostringstream o;
+  o << spec.source.string() << ": the temperature is not finite (" << temperature[node]
+    << " at node " << node << ") after time step " << step + 1 << ", t = " << t
+    << " s; nothing is written. The step's loads:";
+  for (std::size_t k = 0; k < s.power.size(); ++k)
+    o << " heat source '" << spec.thermal.sources[k].name << "' " << s.power[k] << " W;";
+  for (std::size_t k = 0; k < s.h.size(); ++k)
+    o << " convection[" << k << "] h = " << s.h[k] << " W/(m^2 K), sink "
+      << s.sink_k[k] - kCelsiusOffset << " degC;";
+  o << " Hint: a power, flux or coefficient far beyond a machine's (thermal.heat_sources "
+       "power_ref_W, surface_flux flux_W_m2, h_W_m2K, the material values) overflows a double.";
+  return core::SolverError(o.str());
+}
+
+/// The temperature history (and the displacement history after it, three values per node) is
+/// kept whole in memory: refuse before allocating one beyond core::limits::kHistoryBytes.
+void require_history_fits(const core::CaseSpec& spec, int nodes, std::size_t times) {
+  const double per_node = spec.mechanical.enabled ? 4 : 1;
+  const double bytes = per_node * sizeof(double) * static_cast<double>(nodes) *
+                       static_cast<double>(times);
+  if (bytes <= static_cast<double>(core::limits::kHistoryBytes)) return;
+  throw core::SolverError(
+      spec.source.string() + ": thermal.output_interval_s = " +
+      std::to_string(spec.thermal.output_interval) + " s gives " + std::to_string(times) +
+      " output times of " + std::to_string(nodes) + " nodes: the histories would take " +
+      std::to_string(bytes / 1e9) + " GB, more than the limit of " +
+      core::limits::bytes_text(core::limits::kHistoryBytes) +
+      " (core/limits.hpp). Hint: lengthen output_interval_s or coarsen the mesh.");
+}
+
 template <int N>
 ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, const ThermalOperators& ops,
                          const Progress& progress, const Checkpointing& checkpointing) {
@@ -248,6 +287,8 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
   const double end = spec.duty_cycle.end;
   const std::vector<double> grid = time_grid(spec, spec.thermal.step);
   const std::vector<double> outs = output_times(spec);
+
+  require_history_fits(spec, n, outs.size() + 1);
 
   ThermalHistory hist;
   hist.times.push_back(0.0);
@@ -323,6 +364,7 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     const cholmod::Factor& factor = factor_for(dt, cn ? 0.5 : 1.0, s_new);
     Eigen::VectorXd next = rhs;
     factor.solve_in_place(next);
+    if (!next.allFinite()) throw non_finite_temperature(spec, s_new, next, i, t);
 
     double power = 0;
     for (double p : s_new.power) power += p;
@@ -369,6 +411,13 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     }
     hist.energy.heat_in_law += fl.flux * ops.flux_area[j].sum() * seconds;
   }
+  const std::string origin = "the heat the case puts in over the run overflowed (" +
+                             spec.source.string() +
+                             "); check thermal.heat_sources power_ref_W and surface_flux flux_W_m2";
+  core::require_finite(hist.energy.heat_in, "the heat put in [J]", origin);
+  core::require_finite(hist.energy.heat_in_law, "the heat the laws deliver [J]", origin);
+  core::require_finite(hist.energy.lost, "the heat lost [J]", origin);
+  core::require_finite(hist.energy.stored, "the heat stored [J]", origin);
   return hist;
 }
 

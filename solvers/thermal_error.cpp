@@ -1,6 +1,7 @@
 #include "solvers/thermal_error.hpp"
 
 #include "core/errors.hpp"
+#include "core/finite.hpp"
 
 namespace tt::solvers {
 
@@ -42,7 +43,11 @@ ThermalError thermal_error(const mesh::TetMesh& m, const core::CaseSpec& spec, c
   Eigen::MatrixXd rows(9, u.cols());
   for (int p = 0; p < 3; ++p)
     for (int d = 0; d < 3; ++d) rows.row(3 * p + d) = u.row(3 * nodes[p] + d);
-  return thermal_error_of(rows, (m.nodes.row(nodes[2]) - m.nodes.row(nodes[1])).norm());
+  ThermalError e = thermal_error_of(rows, (m.nodes.row(nodes[2]) - m.nodes.row(nodes[1])).norm());
+  core::require_finite(e.values, "the thermal error (row: output time, column: dx, dy, dz, ...)",
+                       "the TCP and probe displacements of " + spec.source.string() +
+                           " overflowed; check the heat loads");
+  return e;
 }
 
 }  // namespace tt::solvers

@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <tetgen.h>
 #include <unistd.h>
@@ -10,11 +12,14 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cmath>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <new>
 #include <sstream>
 #include <string>
@@ -114,7 +119,11 @@ std::string switches_for(const TetgenOptions& options) {
 //  - The child's stdout/stderr go to a second pipe so TetGen's own explanation (which facets
 //    intersect) reaches the error message, and the caller's terminal stays clean.
 //  - The parent only reads both pipes until they close and then reaps the child, so it never
-//    waits on a child blocked on a full pipe. The child never uses OpenMP, so forking a parent
+//    waits on a child blocked on a full pipe. It ends the child at the case's wall-time limit;
+//    the child's address space is limited (RLIMIT_AS) to what it inherits plus the case's
+//    memory limit, so TetGen's allocations fail (a MeshError) before the machine runs out; and
+//    the child is killed when the parent dies (PR_SET_PDEATHSIG), so killing thermotwin never
+//    leaves TetGen running. The child never uses OpenMP, so forking a parent
 //    that has started OpenMP threads is safe; it ends with _exit() and runs no atexit handlers.
 
 /// First bytes on the result pipe; the arrays follow in this order: #points x 3 coordinates [m]
@@ -214,10 +223,31 @@ bool send_mesh(const tetgenio& out) {
 
 /// What the child left behind.
 struct ChildOutput {
-  std::string result;  /// bytes of the result pipe
-  std::string log;     /// the last bytes TetGen printed
-  int status = 0;      /// from waitpid
+  std::string result;      /// bytes of the result pipe
+  std::string log;         /// the last bytes TetGen printed
+  int status = 0;          /// from waitpid
+  bool timed_out = false;  /// ended by the parent at the wall-time limit
 };
+
+/// Address space [bytes] this process holds now (/proc/self/statm's first field); 0 if unknown.
+std::uint64_t address_space_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::uint64_t pages = 0;
+  statm >> pages;
+  return pages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
+}
+
+/// In the child, right after fork(): die with the parent, and allocate at most `memory_bytes`
+/// beyond what was inherited. Only async-signal-safe calls until run_child.
+void bound_child(pid_t parent, std::uint64_t inherited_bytes, double memory_bytes) {
+  if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0) _exit(6);
+  if (::getppid() != parent) _exit(6);  // the parent died before prctl took effect
+  if (inherited_bytes > 0 && memory_bytes < 1e18) {
+    const rlimit as{static_cast<rlim_t>(inherited_bytes + static_cast<std::uint64_t>(memory_bytes)),
+                    RLIM_INFINITY};
+    if (::setrlimit(RLIMIT_AS, &as) != 0) _exit(6);
+  }
+}
 
 /// A pipe whose ends close with it.
 struct Pipe {
@@ -261,16 +291,22 @@ struct Child {
 }
 
 /// Runs TetGen on the filled `in` in a child process and collects what it sends and prints.
-ChildOutput run_isolated(const std::string& switches, tetgenio& in) {
+ChildOutput run_isolated(const std::string& switches, tetgenio& in, const TetgenOptions& options) {
   std::vector<char> buffer(switches.begin(), switches.end());
   buffer.push_back('\0');
   Pipe result, log;
   if (::pipe2(result.fd, O_CLOEXEC) != 0 || ::pipe2(log.fd, O_CLOEXEC) != 0)
     throw_system_error("pipe2()", switches);
+  const pid_t parent = ::getpid();
+  const std::uint64_t inherited = address_space_bytes();
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(std::min(options.time_limit_s, 1e9)));
   Child child;
   child.pid = ::fork();
   if (child.pid < 0) throw_system_error("fork()", switches);
   if (child.pid == 0) {
+    bound_child(parent, inherited, options.memory_limit_GB * 1e9);
     ::close(result.fd[0]);
     ::close(log.fd[0]);
     run_child(buffer.data(), &in, result.fd[1], log.fd[1]);
@@ -286,7 +322,15 @@ ChildOutput run_isolated(const std::string& switches, tetgenio& in) {
   pollfd fds[2] = {{result.fd[0], POLLIN, 0}, {log.fd[0], POLLIN, 0}};
   std::string* sinks[2] = {&output.result, &output.log};
   while (fds[0].fd >= 0 || fds[1].fd >= 0) {
-    if (::poll(fds, 2, -1) < 0) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      ::kill(child.pid, SIGKILL);  // its pipes close with it; the loop then ends
+      output.timed_out = true;
+      break;
+    }
+    const int ready = ::poll(fds, 2, static_cast<int>(std::min<long long>(left.count() + 1, 60000)));
+    if (ready < 0) {
       if (errno == EINTR) continue;
       throw_system_error("poll()", switches);
     }
@@ -335,22 +379,42 @@ std::string last_lines(const std::string& text, int count) {
   return joined;
 }
 
+/// What the limits were, for a failure that may have been one of them.
+std::string limits_text(const TetgenOptions& options) {
+  std::ostringstream o;
+  o << "mesh.memory_limit_GB = " << options.memory_limit_GB << " (memory TetGen may take)";
+  return o.str();
+}
+
 /// Why the child produced no mesh, or "" when `output` holds one.
-std::string failure_of(const ChildOutput& output) {
+std::string failure_of(const ChildOutput& output, const TetgenOptions& options) {
+  if (output.timed_out) {
+    std::ostringstream o;
+    o << "TetGen did not finish within mesh.time_limit_s = " << options.time_limit_s
+      << " s and was ended. Hint: a radius_edge_ratio near 1 or a min_dihedral_deg near 18 can "
+         "keep it refining for ever; relax them, coarsen the mesh, or raise time_limit_s under "
+         "[mesh]";
+    return o.str();
+  }
   ResultHeader header;
   const bool has_header = output.result.size() >= sizeof header;
   if (has_header) std::memcpy(&header, output.result.data(), sizeof header);
   if (has_header && header.magic == kResultMagic && header.threw == 1)
-    return error_text(header.code) + " (TetGen error code " + std::to_string(header.code) + ")";
+    return error_text(header.code) + " (TetGen error code " + std::to_string(header.code) + ")" +
+           (header.code == 1 ? " under " + limits_text(options) +
+                                   ". Hint: coarsen the mesh, or raise memory_limit_GB under "
+                                   "[mesh] when the machine has the memory"
+                             : "");
   if (output.status != -1 && WIFSIGNALED(output.status)) {
     const int sig = WTERMSIG(output.status);
     const char* abbrev = ::sigabbrev_np(sig);
     return "TetGen crashed with signal " + std::to_string(sig) + " (SIG" + (abbrev ? abbrev : "?") +
-           ")";
+           "), perhaps short of memory under " + limits_text(options);
   }
   if (output.status != -1 && WIFEXITED(output.status) && WEXITSTATUS(output.status) != 0)
     return "the TetGen process exited with status " + std::to_string(WEXITSTATUS(output.status)) +
-           " after sending " + std::to_string(output.result.size()) + " bytes";
+           " after sending " + std::to_string(output.result.size()) + " bytes, perhaps short of " +
+           "memory under " + limits_text(options);
   if (!has_header || header.magic != kResultMagic)
     return "the TetGen process sent " + std::to_string(output.result.size()) +
            " bytes instead of a mesh";
@@ -368,6 +432,10 @@ std::vector<T> array_at(const std::string& bytes, std::size_t offset, std::size_
 }  // namespace
 
 LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
+  if (!(options.time_limit_s > 0) || !(options.memory_limit_GB > 0))
+    throw core::MeshError("mesh limits time_limit_s = " + std::to_string(options.time_limit_s) +
+                          ", memory_limit_GB = " + std::to_string(options.memory_limit_GB) +
+                          ": both must be > 0");
   if (!(options.radius_edge_ratio >= 1.0) || !(options.min_dihedral_deg >= 0.0) ||
       options.min_dihedral_deg > 18.0)
     throw core::MeshError(
@@ -382,9 +450,13 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
   tetgenio in;
   fill_input(with_points, in);
   const std::string switches = switches_for(options);
-  const ChildOutput output = run_isolated(switches, in);
+  const ChildOutput output = run_isolated(switches, in, options);
 
-  if (const std::string failure = failure_of(output); !failure.empty()) {
+  if (output.timed_out)
+    throw core::MeshError("TetGen with switches '" + switches + "' on a PLC of " +
+                          std::to_string(plc.facets.size()) + " facets: " +
+                          failure_of(output, options) + ".");
+  if (const std::string failure = failure_of(output, options); !failure.empty()) {
     const std::string said = last_lines(output.log, 4);
     throw core::MeshError(
         "TetGen failed with switches '" + switches + "' on a PLC of " +

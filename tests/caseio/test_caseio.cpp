@@ -136,6 +136,9 @@ void expect_same(const CaseSpec& a, const CaseSpec& b, double tol = 0) {
   EXPECT_EQ(a.mesh.circle_segments, b.mesh.circle_segments);
   EXPECT_EQ(a.mesh.radius_edge_ratio, b.mesh.radius_edge_ratio);
   EXPECT_EQ(a.mesh.min_dihedral_deg, b.mesh.min_dihedral_deg);
+  EXPECT_EQ(a.mesh.max_tets, b.mesh.max_tets);
+  EXPECT_EQ(a.mesh.time_limit_s, b.mesh.time_limit_s);
+  EXPECT_EQ(a.mesh.memory_limit_GB, b.mesh.memory_limit_GB);
   EXPECT_EQ(a.duty_cycle.end, b.duty_cycle.end);
   ASSERT_EQ(a.duty_cycle.segments.size(), b.duty_cycle.segments.size());
   for (std::size_t i = 0; i < a.duty_cycle.segments.size(); ++i) {
@@ -550,7 +553,7 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
                   "machine = \"bench \\\"A\\\"\"");
   text +=
       "\n[mesh]\norder = 1\ncircle_segments = 24\nradius_edge_ratio = 2.0\n"
-      "min_dihedral_deg = 15.0\n";
+      "min_dihedral_deg = 15.0\nmax_tets = 2e6\ntime_limit_s = 600.0\nmemory_limit_GB = 4.5\n";
   text +=
       "\n[placement]\ncandidates = \"surface\"\nbodies = [\"pin\"]\ngroups = [\"joint\", "
       "\"base\"]\n"
@@ -576,6 +579,9 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
   EXPECT_EQ(s.duty_cycle.segments[2].speed_rpm, 3000);
   EXPECT_EQ(s.points[0].position, Eigen::Vector3d(0.05, 0.05, 0.2));
   EXPECT_EQ(s.mesh.order, 1);
+  EXPECT_EQ(s.mesh.max_tets, 2e6);
+  EXPECT_EQ(s.mesh.time_limit_s, 600);
+  EXPECT_EQ(s.mesh.memory_limit_GB, 4.5);
   EXPECT_FALSE(s.outputs.fields);
   EXPECT_EQ(s.outputs.fields_interval, 30);
   ASSERT_EQ(s.mechanical.point_supports.size(), 2u);
@@ -806,6 +812,40 @@ const BadInput bad_inputs[] = {
     {"placement_negative_max", "[points]",
      "[placement]\ncandidates = \"surface\"\ngroups = [\"rest\"]\nmax_candidates = -3\n\n[points]",
      "max_candidates", "placement.max_candidates = -3", "must lie in"},
+    // Issue 14: bounds named with their real limits, temperatures above absolute zero, counts
+    // that input decides bounded before anything of that size exists.
+    {"circle_segments_beyond_limit", "[outputs]", "[mesh]\ncircle_segments = 100001\n\n[outputs]",
+     "circle_segments", "mesh.circle_segments = 100001", "must lie in [8, 100000]"},
+    {"circle_segments_below_limit", "[outputs]", "[mesh]\ncircle_segments = 7\n\n[outputs]",
+     "circle_segments", "mesh.circle_segments = 7", "must lie in [8, 100000]"},
+    {"min_dihedral_beyond_tetgen", "[outputs]", "[mesh]\nmin_dihedral_deg = 30.0\n\n[outputs]",
+     "min_dihedral_deg", "mesh.min_dihedral_deg = 30.0", "must lie in [0, 18]"},
+    {"radius_edge_ratio_near_one", "[outputs]", "[mesh]\nradius_edge_ratio = 1.001\n\n[outputs]",
+     "radius_edge_ratio", "mesh.radius_edge_ratio = 1.001", "must be >= 1.1"},
+    {"zero_max_tets", "[outputs]", "[mesh]\nmax_tets = 0\n\n[outputs]", "max_tets",
+     "mesh.max_tets = 0", "must be > 0"},
+    {"nan_time_limit", "[outputs]", "[mesh]\ntime_limit_s = nan\n\n[outputs]", "time_limit_s",
+     "mesh.time_limit_s = nan", "finite"},
+    {"negative_memory_limit", "[outputs]", "[mesh]\nmemory_limit_GB = -1.0\n\n[outputs]",
+     "memory_limit_GB", "mesh.memory_limit_GB = -1.0", "must be > 0"},
+    {"initial_temperature_below_absolute_zero", "step_s = 10.0",
+     "step_s = 10.0\ninitial_temperature_degC = -300.0", "initial_temperature_degC",
+     "thermal.initial_temperature_degC = -300.0", "absolute zero"},
+    {"sink_below_absolute_zero", "sink_degC = 20.0", "sink_degC = -273.2", "sink_degC",
+     "thermal.convection[0].sink_degC = -273.2", "absolute zero"},
+    {"sink_table_below_absolute_zero", "sink_degC = 20.0",
+     "sink_table = [[0.0, 20.0], [50.0, -300.0]]", "sink_table",
+     "thermal.convection[0].sink_table[1][1] = -300.0", "absolute zero"},
+    {"reference_temperature_below_absolute_zero", "tcp = \"P1\"",
+     "tcp = \"P1\"\nreference_temperature_degC = -500", "reference_temperature_degC",
+     "mechanical.reference_temperature_degC = -500", "absolute zero"},
+    {"too_many_time_steps", "step_s = 10.0", "step_s = 1e-7", "step_s", "thermal.step_s = 1e-07",
+     "more than the limit of 5000000"},
+    {"run_too_long_for_its_step", "end_s = 100.0", "end_s = 1e12", "step_s = 10.0",
+     "thermal.step_s = 10.0", "1e+11 time steps"},
+    {"too_many_output_times", "step_s = 10.0", "step_s = 10.0\noutput_interval_s = 1e-300",
+     "output_interval_s", "thermal.output_interval_s = 1e-300",
+     "more than the limit of 200000"},
 };
 
 INSTANTIATE_TEST_SUITE_P(CaseReader, BadCase, ::testing::ValuesIn(bad_inputs),
@@ -838,6 +878,28 @@ TEST_F(CaseFiles, DutyCycleCsvErrorsNameTheCsvLine) {
   }
   fs::remove(dir_ / "p1.csv");
   EXPECT_THROW(read_case(file), CaseError);
+}
+
+TEST_F(CaseFiles, EndlessFilesAreRefusedAtTheirByteLimit) {
+  // /dev/zero never ends: as the case file, and as the duty-cycle CSV it names.
+  try {
+    read_case("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was read as a case";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: holds more than 16 MiB"), std::string::npos)
+        << e.what();
+  }
+  const std::string text = replaced(
+      mini_case,
+      "segments = [ { start_s = 0.0, speed_rpm = 1000.0 }, { start_s = 50.0, speed_rpm = 0.0 } ]",
+      "csv = \"/dev/zero\"");
+  try {
+    read_case(write("endless.toml", text));
+    ADD_FAILURE() << "/dev/zero was read as a duty cycle";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("duty_cycle.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than 64 MiB"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(CaseFiles, MissingCaseFileIsAnIoError) {

@@ -70,6 +70,25 @@ TEST(HostileData, NonFiniteTimeAndMetaNumbersAreRefused) {
   EXPECT_NE(data_error(f).find("meta.json"), std::string::npos) << data_error(f);
 }
 
+TEST(HostileData, TemperaturesBelowAbsoluteZeroAreRefused) {
+  Folder f("data_below_absolute_zero");
+  f.write("meta.json", meta_with_sensors(2));
+  f.write("data.csv", "time_s,speed_rpm,T0,T1\n0,0,20,20\n10,0,20.5,-300\n");
+  std::string msg = data_error(f);
+  EXPECT_NE(msg.find("data.csv:3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("T1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("absolute zero"), std::string::npos) << msg;
+  // A speed below -273.15 is not a temperature: only sensor columns are held to it.
+  f.write("data.csv", "time_s,speed_rpm,T0,T1\n0,-300,20,20\n");
+  EXPECT_EQ(data_error(f), "");
+  std::string meta = meta_with_sensors(2);
+  meta.insert(meta.size() - 1, ", \"initial_temperature_degC\": -274");
+  f.write("meta.json", meta);
+  msg = data_error(f);
+  EXPECT_NE(msg.find("initial_temperature_degC"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("absolute zero"), std::string::npos) << msg;
+}
+
 TEST(HostileData, TenThousandSensorsReadInBoundedMemory) {
   constexpr int kSensors = 10000, kRows = 200;
   Folder f("data_10k_sensors");
