@@ -28,6 +28,8 @@ inline CLI::Validator finite_number(bool positive = false) {
       expected, "FINITE");
 }
 
-inline CLI::Validator positive_number() { return finite_number(true); }
+inline CLI::Validator positive_number() {
+  return finite_number(true);
+}
 
 }  // namespace tt::app

@@ -45,11 +45,17 @@ int main(int argc, char** argv) {
   probes_in->excludes(probes_run);
   probes->add_option("--out", probes_args.out, "output directory")->required();
   probes->add_option("--truth", probes_args.truth, "true drift CSV to score the methods against");
-  probes->add_option("--speed-rpm", probes_args.speed_rpm, "measuring speed when the file does not say")
+  probes
+      ->add_option("--speed-rpm", probes_args.speed_rpm,
+                   "measuring speed when the file does not say")
       ->check(positive_number());
-  probes->add_option("--sample-rate-hz", probes_args.sample_rate_hz, "sample rate when the file does not say")
+  probes
+      ->add_option("--sample-rate-hz", probes_args.sample_rate_hz,
+                   "sample rate when the file does not say")
       ->check(positive_number());
-  probes->add_option("--probe-distance-mm", probes_args.probe_distance_mm, "D when the file does not say")
+  probes
+      ->add_option("--probe-distance-mm", probes_args.probe_distance_mm,
+                   "D when the file does not say")
       ->check(positive_number());
 
   PlaceArgs place_args;
@@ -74,14 +80,17 @@ int main(int argc, char** argv) {
   auto* fit_data = fit->add_option("--data", fit_data_args.runs, "measured runs (docs/measured-data.md) instead of a case")
                        ->check(CLI::ExistingDirectory);
   fit_case->excludes(fit_data);
-  fit->add_option("--test-from-s", fit_data_args.test_from_s, "with --data: test window start (default: published)")
+  fit->add_option("--test-from-s", fit_data_args.test_from_s,
+                  "with --data: test window start (default: published)")
       ->check(finite_number());
   fit->add_option("--test-to-s", fit_data_args.test_to_s, "with --data: test window end")
       ->check(finite_number());
   fit->add_option("--out", fit_args.out, "output directory")->required();
-  fit->add_option("--hours", fit_args.hours, "length of each campaign run (the standard's minimum: 5)")
+  fit->add_option("--hours", fit_args.hours,
+                  "length of each campaign run (the standard's minimum: 5)")
       ->check(positive_number());
-  fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it")
+  fit->add_option("--required-sm-um", fit_args.required_sm_um,
+                  "accuracy asked for: smallest m with test S_M below it")
       ->check(positive_number());
   fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
@@ -92,7 +101,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   calibrate->add_option("--train", calibrate_args.train, "measured runs to fit and study on")->check(CLI::ExistingDirectory);
   calibrate->add_option("--test", calibrate_args.test, "held-out measured runs")->check(CLI::ExistingDirectory);
-  calibrate->add_option("--split-s", calibrate_args.split_s, "a run in both --train and --test: train before, test from")
+  calibrate
+      ->add_option("--split-s", calibrate_args.split_s,
+                   "a run in both --train and --test: train before, test from")
       ->check(finite_number());
   calibrate->add_option("--out", calibrate_args.out, "output directory")->required();
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");

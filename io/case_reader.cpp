@@ -1031,8 +1031,8 @@ void check_count(const Tab& root, const CaseSpec& spec, std::string_view key, do
   if (const toml::node* n = thermal_key(root, key)) fail_value(*root.ctx, *n, path, expected, hint);
   const toml::node* end = root.get("duty_cycle")->as_table()->get("end_s");
   fail_value(*root.ctx, *end, "duty_cycle.end_s",
-             "would need " + number_text(std::ceil(count)) + " " + counted + " of " + path +
-                 " = " + number_text(interval) + " s (the default), more than the limit of " +
+             "would need " + number_text(std::ceil(count)) + " " + counted + " of " + path + " = " +
+                 number_text(interval) + " s (the default), more than the limit of " +
                  std::to_string(limit),
              "shorten the run or set " + std::string(key) + " in [thermal]");
 }
@@ -1371,7 +1371,8 @@ CaseSpec read_case(const fs::path& file) {
     throw core::IoError(file.string() + ": cannot open or read the case file");
   }
   if (!text)
-    throw CaseError(file.string() + ": holds more than " + core::limits::bytes_text(kCaseFileBytes) +
+    throw CaseError(file.string() + ": holds more than " +
+                    core::limits::bytes_text(kCaseFileBytes) +
                     ", the limit for a case file; is it the case file (a TOML text)?");
   return case_from_toml(*text, file);
 }

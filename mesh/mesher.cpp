@@ -1,10 +1,10 @@
 #include "mesh/mesher.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
-#include <Eigen/Geometry>
 #include <map>
 #include <sstream>
 #include <unordered_map>
@@ -90,11 +90,14 @@ bool selector_matches(const core::FaceSelector& s, const TetMesh& m, int f, cons
 double primitive_volume(const core::Primitive& p, const core::Body& body) {
   using Kind = core::Primitive::Kind;
   switch (p.kind) {
-    case Kind::box: return (p.max - p.min).prod();
-    case Kind::cylinder: return kPi * p.radius * p.radius * (p.z_max - p.z_min);
+    case Kind::box:
+      return (p.max - p.min).prod();
+    case Kind::cylinder:
+      return kPi * p.radius * p.radius * (p.z_max - p.z_min);
     case Kind::annulus:
       return kPi * (p.radius * p.radius - p.inner_radius * p.inner_radius) * (p.z_max - p.z_min);
-    case Kind::surface_file: return std::max(0.0, exact_body_volume(body));
+    case Kind::surface_file:
+      return std::max(0.0, exact_body_volume(body));
   }
   return 0;
 }
@@ -167,8 +170,9 @@ void require_mesh_within_bounds(const core::CaseSpec& spec, const MeshEstimate& 
   if (e.finest_body >= 0)
     o << ", most in body '" << spec.bodies[e.finest_body].name
       << "' at max_edge = " << spec.bodies[e.finest_body].max_edge << " m";
-  o << "; " << e.surface_tets << " from the surface facets, mesh.circle_segments = "
-    << spec.mesh.circle_segments << "). Hint: coarsen max_edge or circle_segments, or raise "
+  o << "; " << e.surface_tets
+    << " from the surface facets, mesh.circle_segments = " << spec.mesh.circle_segments
+    << "). Hint: coarsen max_edge or circle_segments, or raise "
     << "max_tets under [mesh] when the machine has the memory (about 1 GB per 100 000 tets of "
        "order 2 in a run).";
   throw core::MeshError(o.str());

@@ -33,8 +33,8 @@ struct Plc {
 struct TetgenOptions {
   double radius_edge_ratio = 1.5;
   double min_dihedral_deg = 12.0;
-  double time_limit_s = 3600;   /// wall time TetGen may take; then it is ended (MeshError)
-  double memory_limit_GB = 8;   /// address space TetGen may add to what it inherits [10^9 B]
+  double time_limit_s = 3600;  /// wall time TetGen may take; then it is ended (MeshError)
+  double memory_limit_GB = 8;  /// address space TetGen may add to what it inherits [10^9 B]
 };
 
 /// What the tetrahedraliser returns: linear tets (positively oriented) and their regions.

@@ -115,13 +115,14 @@ std::string bounded_text(const std::filesystem::path& path, const std::string& w
   try {
     text = core::limits::file_text_up_to(path, core::limits::kProbeFileBytes);
   } catch (const core::IoError&) {
-    throw core::IoError(core::located(path.string(), 0, "cannot open the " + what + " for reading"));
+    throw core::IoError(
+        core::located(path.string(), 0, "cannot open the " + what + " for reading"));
   }
   if (!text)
-    throw core::DataError(core::located(
-        path.string(), 0,
-        "holds more than " + core::limits::bytes_text(core::limits::kProbeFileBytes) +
-            ", the limit for a " + what + "; split the recording"));
+    throw core::DataError(
+        core::located(path.string(), 0,
+                      "holds more than " + core::limits::bytes_text(core::limits::kProbeFileBytes) +
+                          ", the limit for a " + what + "; split the recording"));
   return std::move(*text);
 }
 

@@ -1,10 +1,9 @@
 #include "solvers/elastic.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-
-#include <Eigen/Dense>
 
 #include "core/errors.hpp"
 #include "core/finite.hpp"
@@ -252,7 +251,8 @@ ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spe
   h.displacement = model.displacements(temperature);
   h.timings = model.timings();
   h.timings.solve_s = std::chrono::duration<double>(Clock::now() - t2).count();
-  core::require_finite(h.displacement, "the displacement [m] (row: 3 x node + direction, column: output time)",
+  core::require_finite(h.displacement,
+                       "the displacement [m] (row: 3 x node + direction, column: output time)",
                        "the thermal strain of the temperatures overflowed (peak " +
                            std::to_string(temperature.maxCoeff() - kCelsiusOffset) +
                            " degC); check the heat loads and expansion_per_K, youngs_modulus_Pa");

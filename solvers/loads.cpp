@@ -119,11 +119,10 @@ std::int64_t bounded_count(double end, double interval, std::int64_t limit, cons
                             " s: must be a finite number > 0");
   const double count = std::ceil(end / interval - 1e-9);
   if (!(count <= static_cast<double>(limit)))
-    throw core::SolverError(std::string(key) + " = " + std::to_string(interval) + " s over " +
-                            std::to_string(end) + " s would need more than " +
-                            std::to_string(limit) + " " + counted +
-                            " (the limit, core/limits.hpp); lengthen " + key +
-                            " or shorten the run");
+    throw core::SolverError(
+        std::string(key) + " = " + std::to_string(interval) + " s over " + std::to_string(end) +
+        " s would need more than " + std::to_string(limit) + " " + counted +
+        " (the limit, core/limits.hpp); lengthen " + key + " or shorten the run");
   return std::max<std::int64_t>(1, static_cast<std::int64_t>(count));
 }
 
@@ -150,8 +149,7 @@ std::vector<double> time_grid(const core::CaseSpec& spec, double max_step) {
 
 std::vector<double> output_times(const core::CaseSpec& spec) {
   const double end = spec.duty_cycle.end, dt = spec.thermal.output_interval;
-  bounded_count(end, dt, core::limits::kOutputTimes, "thermal.output_interval_s",
-                "output times");
+  bounded_count(end, dt, core::limits::kOutputTimes, "thermal.output_interval_s", "output times");
   std::vector<double> t;
   for (std::int64_t k = 1; static_cast<double>(k) * dt < end * (1 - 1e-12); ++k)
     t.push_back(static_cast<double>(k) * dt);

@@ -262,15 +262,15 @@ core::SolverError non_finite_temperature(const core::CaseSpec& spec, const LoadS
 /// kept whole in memory: refuse before allocating one beyond core::limits::kHistoryBytes.
 void require_history_fits(const core::CaseSpec& spec, int nodes, std::size_t times) {
   const double per_node = spec.mechanical.enabled ? 4 : 1;
-  const double bytes = per_node * sizeof(double) * static_cast<double>(nodes) *
-                       static_cast<double>(times);
+  const double bytes =
+      per_node * sizeof(double) * static_cast<double>(nodes) * static_cast<double>(times);
   if (bytes <= static_cast<double>(core::limits::kHistoryBytes)) return;
   throw core::SolverError(
-      spec.source.string() + ": thermal.output_interval_s = " +
-      std::to_string(spec.thermal.output_interval) + " s gives " + std::to_string(times) +
-      " output times of " + std::to_string(nodes) + " nodes: the histories would take " +
-      std::to_string(bytes / 1e9) + " GB, more than the limit of " +
-      core::limits::bytes_text(core::limits::kHistoryBytes) +
+      spec.source.string() +
+      ": thermal.output_interval_s = " + std::to_string(spec.thermal.output_interval) +
+      " s gives " + std::to_string(times) + " output times of " + std::to_string(nodes) +
+      " nodes: the histories would take " + std::to_string(bytes / 1e9) +
+      " GB, more than the limit of " + core::limits::bytes_text(core::limits::kHistoryBytes) +
       " (core/limits.hpp). Hint: lengthen output_interval_s or coarsen the mesh.");
 }
 

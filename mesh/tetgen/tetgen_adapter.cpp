@@ -12,9 +12,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -329,7 +329,8 @@ ChildOutput run_isolated(const std::string& switches, tetgenio& in, const Tetgen
       output.timed_out = true;
       break;
     }
-    const int ready = ::poll(fds, 2, static_cast<int>(std::min<long long>(left.count() + 1, 60000)));
+    const int ready =
+        ::poll(fds, 2, static_cast<int>(std::min<long long>(left.count() + 1, 60000)));
     if (ready < 0) {
       if (errno == EINTR) continue;
       throw_system_error("poll()", switches);
@@ -454,8 +455,8 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
 
   if (output.timed_out)
     throw core::MeshError("TetGen with switches '" + switches + "' on a PLC of " +
-                          std::to_string(plc.facets.size()) + " facets: " +
-                          failure_of(output, options) + ".");
+                          std::to_string(plc.facets.size()) +
+                          " facets: " + failure_of(output, options) + ".");
   if (const std::string failure = failure_of(output, options); !failure.empty()) {
     const std::string said = last_lines(output.log, 4);
     throw core::MeshError(

@@ -844,8 +844,7 @@ const BadInput bad_inputs[] = {
     {"run_too_long_for_its_step", "end_s = 100.0", "end_s = 1e12", "step_s = 10.0",
      "thermal.step_s = 10.0", "1e+11 time steps"},
     {"too_many_output_times", "step_s = 10.0", "step_s = 10.0\noutput_interval_s = 1e-300",
-     "output_interval_s", "thermal.output_interval_s = 1e-300",
-     "more than the limit of 200000"},
+     "output_interval_s", "thermal.output_interval_s = 1e-300", "more than the limit of 200000"},
 };
 
 INSTANTIATE_TEST_SUITE_P(CaseReader, BadCase, ::testing::ValuesIn(bad_inputs),

@@ -1,8 +1,7 @@
 // Issue 14 at the command line: numbers that make no sense are refused by the option's name
 // before any work starts, and killing thermotwin while TetGen meshes leaves no TetGen behind.
-#include <gtest/gtest.h>
-
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 
 #include <chrono>

@@ -22,7 +22,9 @@ namespace fs = std::filesystem;
 
 const fs::path kCases = fs::path(TT_SOURCE_DIR) / "cases";
 
-core::CaseSpec coarse() { return io::read_case(kCases / "sb1_coarse.toml"); }
+core::CaseSpec coarse() {
+  return io::read_case(kCases / "sb1_coarse.toml");
+}
 
 /// The message of the error of type E that `f` throws ("" when none).
 template <class E, class F>
@@ -38,7 +40,8 @@ std::string error_of(F&& f) {
 TEST(HostileBounds, TimeStepCountBeyondTheLimitIsRefusedNotWrapped) {
   core::CaseSpec spec = coarse();
   spec.thermal.step = 1e-7;  // 7.2e10 steps: once cast to int, it gave 5 steps
-  const std::string msg = error_of<core::SolverError>([&] { solvers::time_grid(spec, spec.thermal.step); });
+  const std::string msg =
+      error_of<core::SolverError>([&] { solvers::time_grid(spec, spec.thermal.step); });
   EXPECT_NE(msg.find("thermal.step_s"), std::string::npos) << msg;
   EXPECT_NE(msg.find("5000000"), std::string::npos) << msg;
 }
@@ -83,7 +86,8 @@ sink_degC = 20.0
 name = "runaway"
 body = "block"
 law = "constant"
-power_ref_W = )" + power + R"(
+power_ref_W = )" +
+         power + R"(
 [duty_cycle]
 end_s = 30.0
 segments = [ { start_s = 0.0, speed_rpm = 0.0 } ]
@@ -120,8 +124,8 @@ TEST(HostileBounds, AHundredThousandCircleSegmentsAreRefusedBeforeTetGen) {
 }
 
 TEST(HostileBounds, EveryShippedCaseIsWithinTheDefaultMeshEstimate) {
-  for (const char* name : {"sb1_coarse.toml", "sb1.toml", "sb1_refined.toml", "gm1_coarse.toml",
-                           "gm1.toml"}) {
+  for (const char* name :
+       {"sb1_coarse.toml", "sb1.toml", "sb1_refined.toml", "gm1_coarse.toml", "gm1.toml"}) {
     const core::CaseSpec spec = io::read_case(kCases / name);
     const mesh::MeshEstimate e = mesh::mesh_estimate(spec, mesh::extruded_plc(spec).plc);
     EXPECT_LT(e.tets(), spec.mesh.max_tets / 4) << name;
