@@ -130,9 +130,12 @@ double facet_area(const Plc& plc, const PlcFacet& f) {
   return area;
 }
 
+/// Each boundary triangle starts a graded layer of tets.
+constexpr double kSurfaceFill = 4.0;
+
 }  // namespace
 
-MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc) {
+MeshEstimate mesh_estimate(const core::CaseSpec& spec) {
   MeshEstimate e;
   // A regular tet of edge h has volume h^3 / (6 sqrt 2); TetGen's -a bound is that volume, and its
   // tets come out smaller than the bound on average (kVolumeFill, measured on the shipped cases).
@@ -146,10 +149,27 @@ MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc) {
     e.volume_tets += tets;
     if (tets > e.finest_body_tets) e.finest_body_tets = tets, e.finest_body = static_cast<int>(b);
   }
+  // Each side strip of a faceted cylinder (width w = 2 pi r / n, height h) needs about h / w
+  // triangles: known from the spec alone, before the PLC (whose building grows with n too).
+  const double n = spec.mesh.circle_segments;
+  for (const auto& body : spec.bodies)
+    for (const auto* list : {&body.add, &body.subtract})
+      for (const auto& p : *list) {
+        using Kind = core::Primitive::Kind;
+        if (p.kind != Kind::cylinder && p.kind != Kind::annulus) continue;
+        const double h = p.z_max - p.z_min;
+        for (const double r : {p.radius, p.kind == Kind::annulus ? p.inner_radius : 0.0})
+          if (r > 0) e.surface_tets += kSurfaceFill * n * std::max(1.0, h * n / (2 * kPi * r));
+      }
+  return e;
+}
+
+MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc) {
+  MeshEstimate e = mesh_estimate(spec);
+  e.surface_tets = 0;
   // A facet needs at least as many triangles as its boundary has shortest edges along it (a long
   // thin strip: length / width), and no more than its area holds at that edge; each boundary
   // triangle starts a graded layer of tets (kSurfaceFill).
-  constexpr double kSurfaceFill = 4.0;
   for (const auto& f : plc.facets) {
     const auto [perimeter, shortest] = facet_edges(plc, f);
     if (!std::isfinite(shortest)) continue;
@@ -312,6 +332,7 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
 }
 
 TetMesh mesh_case(const core::CaseSpec& spec) {
+  require_mesh_within_bounds(spec, mesh_estimate(spec));
   const ExtrudedPlc plc = extruded_plc(spec);
   require_mesh_within_bounds(spec, mesh_estimate(spec, plc.plc));
   TetgenOptions options;

@@ -36,6 +36,8 @@ struct MeshEstimate {
   double tets() const { return volume_tets + surface_tets; }
 };
 MeshEstimate mesh_estimate(const core::CaseSpec& spec, const Plc& plc);
+/// The same from the spec alone (curved sides for the surface part), before the PLC is built.
+MeshEstimate mesh_estimate(const core::CaseSpec& spec);
 
 /// Throws MeshError naming mesh.max_tets, the body and the keys to change when the estimate is
 /// beyond the case's mesh.max_tets.
