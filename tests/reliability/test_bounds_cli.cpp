@@ -51,6 +51,22 @@ TEST(BoundsCli, NonFiniteNumbersAreRefusedByTheOptionsName) {
   }
 }
 
+TEST(BoundsCli, TetGenIsRefusedMemoryBeyondTheLimit) {
+  // A fresh process: the TetGen child may reuse what it inherits (free heap, cached stacks), and
+  // SB-1's default mesh needs far more than that and 2 MB beyond it.
+  const fs::path dir = scratch("bounds_cli_memory");
+  std::string text = read_text(fs::path(TT_SOURCE_DIR) / "cases" / "sb1.toml");
+  const std::string key = "min_dihedral_deg = 12.0\n";
+  text.replace(text.find(key), key.size(), key + "memory_limit_GB = 0.002\n");
+  std::ofstream(dir / "case.toml") << text;
+  const auto [code, log] =
+      run_logged({"mesh", (dir / "case.toml").string(), "--out", (dir / "out").string()},
+                 dir / "log");
+  EXPECT_EQ(code, 1) << log;
+  EXPECT_NE(log.find("mesh.memory_limit_GB = 0.002"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 /// Processes whose parent is `parent` (from /proc/*/stat).
 std::vector<pid_t> children_of(pid_t parent) {
   std::vector<pid_t> out;

@@ -140,12 +140,5 @@ TEST(HostileBounds, TetGenIsEndedAtTheTimeLimit) {
   EXPECT_NE(msg.find("mesh.time_limit_s = 0.3"), std::string::npos) << msg;
 }
 
-TEST(HostileBounds, TetGenIsRefusedMemoryBeyondTheLimit) {
-  core::CaseSpec spec = coarse();
-  spec.mesh.memory_limit_GB = 0.002;  // 2 MB more than the process holds
-  const std::string msg = error_of<core::MeshError>([&] { mesh::mesh_case(spec); });
-  EXPECT_NE(msg.find("mesh.memory_limit_GB = 0.002"), std::string::npos) << msg;
-}
-
 }  // namespace
 }  // namespace tt::reliability_test
