@@ -71,6 +71,8 @@ int main(int argc, char** argv) {
   fit_case->excludes(fit_data);
   fit->add_option("--test-from-s", fit_data_args.test_from_s, "with --data: test window start (default: published)");
   fit->add_option("--test-to-s", fit_data_args.test_to_s, "with --data: test window end");
+  fit->add_option("--test", fit_data_args.test_runs, "with --data: held-out measured runs, tested whole")
+      ->check(CLI::ExistingDirectory);
   fit->add_option("--out", fit_args.out, "output directory")->required();
   fit->add_option("--hours", fit_args.hours, "length of each campaign run (the standard's minimum: 5)");
   fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it");
