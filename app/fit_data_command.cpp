@@ -147,9 +147,9 @@ std::vector<fitting::Candidate> data_candidates(int sensor_count, bool has_input
   none.reject_gross_errors = false;
   out.push_back({all, none});
   out.push_back({all, fitting::ModelSpec{}});
-  const std::vector<double> lambdas = quick ? std::vector<double>{1e-4, 1e-2, 1.0}
-                                            : std::vector<double>{1e-6, 1e-5, 1e-4, 1e-3,
-                                                                  1e-2, 1e-1, 1.0,  10.0};
+  const std::vector<double> lambdas =
+      quick ? std::vector<double>{1e-4, 1e-2, 1.0}
+            : std::vector<double>{1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0};
   for (double lambda : lambdas) {
     // Ridge is not the standard's model: its shrinkage, not the 3σ criterion, guards it.
     fitting::ModelSpec ridge;
@@ -476,7 +476,8 @@ int fit_data_command(const FitDataArgs& args) {
     if (!out_of_range.empty()) {
       md << "\n**Test inputs outside the training range** (the models extrapolate there):";
       for (const auto& o : out_of_range)
-        md << " " << o.column << " (" << std::lround(o.share_outside * 100.0) << " % of test samples)";
+        md << " " << o.column << " (" << std::lround(o.share_outside * 100.0)
+           << " % of test samples)";
       md << ".\n";
     }
     if (published)
