@@ -5,12 +5,16 @@
 //   thermotwin calibrate --train RUN... --test RUN... --out DIR [--split-s T]
 // A run given both as --train and --test is split in time: training before T, test from T (default:
 // the start of the last speed cycle that begins before 70 % of the run).
-// 1. Training and test runs cut into segments at their speed cycles, drift re-zeroed per segment.
+// 1. Training and test runs cut into segments at their speed cycles (kept whole when a run has no
+//    speed), drift re-zeroed per segment; fewer than 4 training pieces are cut into time blocks
+//    (fitting::cross_validation_blocks).
 // 2. Per channel, fitting::residual_study: baseline sensors by forward selection on the
 //    leave-one-segment-out residual, then candidate terms claimed only when their share of that
-//    residual, less 1 % per coefficient, beats the best of 19 time-shifted copies.
-// 3. The residual on the test segments, before and after, and how it still correlates with speed,
-//    time and temperatures.
+//    residual, less 1 % per coefficient, beats the best of 19 phase-randomised surrogates (and
+//    zero), and their per-segment held-out gain exceeds two standard errors.
+// 3. The residual on the test segments, before and after, and how it still correlates with speed
+//    (when there is one), time and temperatures; a channel whose test error is worse after than
+//    before is said to be so.
 // Writes calibration.json, report.md, residual_<channel>.csv/.png.
 #include <algorithm>
 #include <cmath>
@@ -103,6 +107,15 @@ nlohmann::json effect_json(const fitting::Effect& e, const fitting::ChannelStudy
           {"null_fraction", std::isfinite(e.null_fraction) ? nlohmann::json(e.null_fraction)
                                                            : nlohmann::json(nullptr)},
           {"added_coefficients", e.parameters},
+          {"heldout_training_rms_um_before", std::isfinite(e.heldout_rms_before)
+                                                 ? nlohmann::json(e.heldout_rms_before * 1e6)
+                                                 : nlohmann::json(nullptr)},
+          {"heldout_training_rms_um_with_it", std::isfinite(e.heldout_rms_after)
+                                                  ? nlohmann::json(e.heldout_rms_after * 1e6)
+                                                  : nlohmann::json(nullptr)},
+          {"heldout_gain_t", std::isfinite(e.gain_t) ? nlohmann::json(e.gain_t)
+                                                     : nlohmann::json(e.gain_t > 0 ? 1e300 : 0.0)},
+          {"segments_improved", e.segments_improved},
           {"claimed", e.claimed}};
 }
 
@@ -125,7 +138,8 @@ int calibrate_data_command(const CalibrateArgs& args) {
     throw core::DataError(
         "calibrate: give --train RUN... and --test RUN... (the same run in both splits it in "
         "time)");
-  std::vector<fitting::Segment> training, testing;
+  std::vector<fitting::Segment> pieces, testing;
+  bool has_speed = false;
   std::vector<io::MeasuredRun> runs;
   nlohmann::json splits = nlohmann::json::array();
   std::set<std::string> test_names;
@@ -138,6 +152,14 @@ int calibrate_data_command(const CalibrateArgs& args) {
     const std::string key = std::filesystem::weakly_canonical(folder).string();
     const bool shared = train_names.count(key) && test_names.count(key);
     io::MeasuredRun run = io::read_measured_run(folder);
+    const bool speed = io::measured_speed(run).size() != 0;
+    if (index > 0 && speed != has_speed)
+      throw core::DataError(folder.string() +
+                            (speed ? " has a speed input but " : " has none but ") +
+                            runs.front().folder.string() + (speed ? " has none" : " has one") +
+                            ": every run must have the same inputs; hint: drop the speed column "
+                            "from all runs, or give it in all");
+    has_speed = speed;
     const double split = shared ? args.split_s.value_or(default_split(run)) : kInf;
     const std::string name = "run" + std::to_string(++index) + (is_train ? ".train" : ".test");
     auto segments = is_train ? io::measured_segments(run, name, -kInf, shared ? split : kInf)
@@ -151,12 +173,20 @@ int calibrate_data_command(const CalibrateArgs& args) {
                                            {"from_s", s.group.time(0)},
                                            {"to_s", s.group.time(s.group.time.size() - 1)},
                                            {"dropped_rows", s.dropped_rows}});
-    auto& into = is_train ? training : testing;
+    auto& into = is_train ? pieces : testing;
     into.insert(into.end(), segments.begin(), segments.end());
     runs.push_back(std::move(run));
   };
   for (const auto& f : args.train) add(f, true);
   for (const auto& f : args.test) add(f, false);
+  const fitting::Blocks blocks = fitting::cross_validation_blocks(pieces);
+  const std::vector<fitting::Segment>& training = blocks.segments;
+  const std::string block_origin =
+      (has_speed ? "speed cycles; " : "whole runs (no speed input, so no speed cycles); ") +
+      blocks.origin;
+  if (!args.quiet)
+    std::cerr << "thermotwin: calibrate: " << training.size() << " training blocks ("
+              << block_origin << "), " << testing.size() << " test segments\n";
   const auto& sensor_names = training.front().group.sensor_names;
   const auto& targets = training.front().group.target_names;
   fitting::ResidualStudyOptions options;
@@ -180,7 +210,11 @@ int calibrate_data_command(const CalibrateArgs& args) {
     const std::string& ch = targets[static_cast<std::size_t>(target)];
     channels_before[ch] = {{"rms_um", rms(before) * 1e6},
                            {"mae_um", before.cwiseAbs().mean() * 1e6}};
-    channels_after[ch] = {{"rms_um", rms(after) * 1e6}, {"mae_um", after.cwiseAbs().mean() * 1e6}};
+    channels_after[ch] = {{"rms_um", rms(after) * 1e6},
+                          {"mae_um", after.cwiseAbs().mean() * 1e6},
+                          {"max_abs_um", after.cwiseAbs().maxCoeff() * 1e6},
+                          {"worse_than_before", rms(after) > rms(before)}};
+    channels_before[ch]["max_abs_um"] = before.cwiseAbs().maxCoeff() * 1e6;
     sum_before += before.squaredNorm();
     sum_after += after.squaredNorm();
     count += before.size();
@@ -219,12 +253,13 @@ int calibrate_data_command(const CalibrateArgs& args) {
         dt.col(c).segment(at, k) = s.group.temperature.col(c).array() - s.group.temperature(0, c);
       at += k;
     }
-    nlohmann::json d{{"speed", correlation(after, speed)},
-                     {"time_since_segment_start", correlation(after, since)}};
+    // A run with no speed input has no speed to correlate with: no column of zeros.
+    nlohmann::json d{{"time_since_segment_start", correlation(after, since)}};
+    if (has_speed) d["speed"] = correlation(after, speed);
     for (Eigen::Index c = 0; c < dt.cols(); ++c)
       d["dT[" + sensor_names[static_cast<std::size_t>(c)] + "]"] = correlation(after, dt.col(c));
     diagnosis[ch] = {{"before", nlohmann::json::object()}, {"after", d}};
-    diagnosis[ch]["before"]["speed"] = correlation(before, speed);
+    if (has_speed) diagnosis[ch]["before"]["speed"] = correlation(before, speed);
     diagnosis[ch]["before"]["time_since_segment_start"] = correlation(before, since);
     Eigen::MatrixXd table(n, 6);
     Eigen::VectorXd measured(n);
@@ -237,6 +272,9 @@ int calibrate_data_command(const CalibrateArgs& args) {
         after * 1e6;
     tables.emplace_back(ch, table);
   }
+  std::vector<std::string> worse;
+  for (const auto& ch : targets)
+    if (channels_after[ch]["worse_than_before"].get<bool>()) worse.push_back(ch);
   std::stable_sort(
       effects.begin(), effects.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
         return a["explained_fraction"].get<double>() > b["explained_fraction"].get<double>();
@@ -271,14 +309,14 @@ int calibrate_data_command(const CalibrateArgs& args) {
          "effect removes (given the effects added before it)"},
         {"threshold",
          "claimed when step_fraction - 0.01 x added_coefficients > null_fraction, the largest "
-         "share "
-         "reached by 19 phase-randomised surrogates of the same term (same amplitude spectrum, "
-         "random "
-         "phases, one surrogate per segment), each searched over the same settings: a term with no "
-         "relation to the residual beats all 19 with probability 1/20"},
-        {"segments",
-         "runs cut at speed cycles (a start after a stop); each segment's drift re-zeroed at its "
-         "start"}}}};
+         "share reached by 19 phase-randomised surrogates of the same term (same amplitude "
+         "spectrum, random phases, one surrogate per segment), each searched over the same "
+         "settings, and never below 0 (a term with no relation to the residual beats all 19 with "
+         "probability 1/20), and when its per-segment held-out gain is more than 2 standard "
+         "errors above 0 (heldout_gain_t > 2: the gain holds from segment to segment)"},
+        {"segments", block_origin + "; each segment's drift re-zeroed at its start"}}},
+      {"speed_input", has_speed},
+      {"after_worse_than_before_on_test", worse}};
 
   // 4. Outputs, all or nothing.
   io::OutputDir out(args.out);
@@ -287,8 +325,9 @@ int calibrate_data_command(const CalibrateArgs& args) {
   std::ostringstream md;
   md.setf(std::ios::fixed);
   md.precision(2);
-  md << "# calibrate (data-driven)\n\nTraining segments: " << training.size()
-     << ", test segments: " << testing.size()
+  md << "# calibrate (data-driven)\n\nTraining segments: " << training.size() << " ("
+     << block_origin << "), test segments: " << testing.size()
+     << (has_speed ? "" : ". The runs have no speed input: no speed term is tried")
      << ". No machine model: temperatures are inputs, not predictions, so `temperature_rms_K` is "
         "null.\n\n"
      << "| channel | test RMS before [um] | test RMS after [um] | test MAE before [um] | test MAE "
@@ -300,32 +339,57 @@ int calibrate_data_command(const CalibrateArgs& args) {
        << channels_before[ch]["mae_um"].get<double>() << " | "
        << channels_after[ch]["mae_um"].get<double>() << " |\n";
   md << "| all | " << doc["before"]["displacement_rms_um"].get<double>() << " | "
-     << doc["after"]["displacement_rms_um"].get<double>() << " | | |\n\n## Effects claimed\n\n";
+     << doc["after"]["displacement_rms_um"].get<double>() << " | | |\n\n";
+  if (!worse.empty()) {
+    md << "**Worse after than before on the test data:**";
+    for (const auto& ch : worse)
+      md << " " << ch << " (" << channels_before[ch]["rms_um"].get<double>() << " -> "
+         << channels_after[ch]["rms_um"].get<double>() << " um RMS)";
+    md << ". The effects were claimed on held-out training segments only; on these test data "
+          "they do not hold.\n\n";
+  }
+  md << "## Effects claimed\n\n";
   if (effects.empty())
-    md << "None: no candidate term beat its time-shifted copies.\n";
+    md << "None: no candidate term beat its surrogates with a gain that holds from segment to "
+          "segment.\n";
   else {
-    md << "| kind | channel | parameters | explained fraction | step fraction | null threshold | "
-          "test RMS with it [um] |\n"
-       << "|---|---|---|---|---|---|---|\n";
+    md << "| kind | channel | parameters | explained fraction | null threshold | held-out "
+          "training RMS before -> with it [um] | gain t | test RMS with it [um] |\n"
+       << "|---|---|---|---|---|---|---|---|\n";
     md.precision(3);
     for (const auto& e : effects)
       md << "| " << e["kind"].get<std::string>() << " | "
          << e["location"]["channel"].get<std::string>() << " | `" << e["parameters"].dump()
          << "` | " << e["explained_fraction"].get<double>() << " | "
-         << e["step_fraction"].get<double>() << " | " << e["null_fraction"].get<double>() << " | "
+         << e["null_fraction"].get<double>() << " | "
+         << e["heldout_training_rms_um_before"].get<double>() << " -> "
+         << e["heldout_training_rms_um_with_it"].get<double>() << " | "
+         << e["heldout_gain_t"].get<double>() << " | "
          << e["test_rms_um_with_effects_so_far"].get<double>() << " |\n";
   }
   md << "\nHow an effect is claimed: " << doc["method"]["threshold"].get<std::string>()
      << ".\n\n## Test residual\n\n";
   for (const auto& [ch, table] : tables) {
     const auto csv = dir / ("residual_" + ch + ".csv");
-    io::write_csv(csv,
-                  {"time_s", "speed_krpm", "measured_um", "predicted_before_um",
-                   "residual_before_um", "residual_after_um"},
-                  table);
-    plot({"lines", csv.string(), (dir / ("residual_" + ch + ".png")).string(), "--x", "time_s",
-          "--columns", "speed_krpm,measured_um,residual_before_um,residual_after_um", "--ylabel",
-          "um (speed: krpm)", "--title", "test segments, channel " + ch});
+    if (has_speed) {
+      io::write_csv(csv,
+                    {"time_s", "speed_krpm", "measured_um", "predicted_before_um",
+                     "residual_before_um", "residual_after_um"},
+                    table);
+      plot({"lines", csv.string(), (dir / ("residual_" + ch + ".png")).string(), "--x", "time_s",
+            "--columns", "speed_krpm,measured_um,residual_before_um,residual_after_um", "--ylabel",
+            "um (speed: krpm)", "--title", "test segments, channel " + ch});
+    } else {
+      Eigen::MatrixXd no_speed(table.rows(), 5);
+      no_speed << table.col(0), table.rightCols(4);
+      io::write_csv(csv,
+                    {"time_s", "measured_um", "predicted_before_um", "residual_before_um",
+                     "residual_after_um"},
+                    no_speed);
+      plot({"lines", csv.string(), (dir / ("residual_" + ch + ".png")).string(), "--x", "time_s",
+            "--columns", "measured_um,residual_before_um,residual_after_um", "--ylabel", "um",
+            "--title", "test segments, channel " + ch});
+    }
     md << "![" << ch << "](residual_" << ch << ".png)\n";
   }
   io::write_file_atomically(dir / "report.md", md.str());

@@ -42,6 +42,8 @@ struct FitArgs {
 /// fit --data RUN...: measured runs with no machine model (app/fit_data_command.cpp).
 struct FitDataArgs {
   std::vector<std::filesystem::path> runs;
+  /// held-out runs, tested whole (then no test window is cut from `runs`)
+  std::vector<std::filesystem::path> test_runs;
   std::filesystem::path out;
   std::optional<double> test_from_s, test_to_s;  /// test window; default: the published one, if any
   bool quick = false, quiet = false;

@@ -85,6 +85,9 @@ int main(int argc, char** argv) {
       ->check(finite_number());
   fit->add_option("--test-to-s", fit_data_args.test_to_s, "with --data: test window end")
       ->check(finite_number());
+  fit->add_option("--test", fit_data_args.test_runs,
+                  "with --data: held-out measured runs, tested whole")
+      ->check(CLI::ExistingDirectory);
   fit->add_option("--out", fit_args.out, "output directory")->required();
   fit->add_option("--hours", fit_args.hours,
                   "length of each campaign run (the standard's minimum: 5)")
@@ -92,7 +95,8 @@ int main(int argc, char** argv) {
   fit->add_option("--required-sm-um", fit_args.required_sm_um,
                   "accuracy asked for: smallest m with test S_M below it")
       ->check(positive_number());
-  fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
+  fit->add_flag("--quick", fit_args.quick,
+                "least squares only (no model search); with --data: a coarser ridge grid");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
 
   CalibrateArgs calibrate_args;

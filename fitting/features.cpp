@@ -28,10 +28,22 @@ Eigen::VectorXd low_pass(const Eigen::VectorXd& time, const Eigen::VectorXd& u, 
 }
 
 Eigen::MatrixXd feature_matrix(const FeatureMap& map, const Group& group) {
-  const Eigen::MatrixXd increments = temperature_increments(group, map.sensors);
+  const Eigen::MatrixXd temperatures = temperature_increments(group, map.sensors);
+  const Eigen::Index n = temperatures.rows();
+  Eigen::MatrixXd increments(n, temperatures.cols() + static_cast<Eigen::Index>(map.inputs.size()));
+  increments.leftCols(temperatures.cols()) = temperatures;
+  for (std::size_t k = 0; k < map.inputs.size(); ++k) {
+    const int c = map.inputs[k];
+    if (c < 0 || c >= group.inputs.cols())
+      throw core::DataError("input column " + std::to_string(c) + " in group '" + group.name +
+                            "'; expected a column in [0, " + std::to_string(group.inputs.cols()) +
+                            ")");
+    increments.col(temperatures.cols() + static_cast<Eigen::Index>(k)) =
+        group.inputs.col(c).array() - group.inputs(0, c);
+  }
   const Eigen::Index k = increments.cols();
   const Eigen::Index blocks = 1 + static_cast<Eigen::Index>(map.time_constants.size());
-  Eigen::MatrixXd features(increments.rows(), k * blocks);
+  Eigen::MatrixXd features(n, k * blocks);
   features.leftCols(k) = increments;
   for (std::size_t t = 0; t < map.time_constants.size(); ++t)
     for (Eigen::Index j = 0; j < k; ++j)
@@ -41,12 +53,14 @@ Eigen::MatrixXd feature_matrix(const FeatureMap& map, const Group& group) {
 }
 
 std::vector<std::string> feature_names(const FeatureMap& map) {
-  std::vector<std::string> names;
-  for (const std::string& s : map.sensor_names) names.push_back("dT[" + s + "]");
+  std::vector<std::string> base;
+  for (const std::string& s : map.sensor_names) base.push_back("dT[" + s + "]");
+  for (const std::string& s : map.input_names) base.push_back("d[" + s + "]");
+  std::vector<std::string> names = base;
   for (double tau : map.time_constants) {
     std::ostringstream prefix;
     prefix << "lp" << tau << "s(";
-    for (const std::string& s : map.sensor_names) names.push_back(prefix.str() + "dT[" + s + "])");
+    for (const std::string& b : base) names.push_back(prefix.str() + b + ")");
   }
   return names;
 }
@@ -54,8 +68,8 @@ std::vector<std::string> feature_names(const FeatureMap& map) {
 StackedRows stacked_rows(const FeatureMap& map, const std::vector<Group>& groups, int target) {
   Eigen::Index rows = 0;
   for (const Group& g : groups) rows += g.time.size();
-  const Eigen::Index cols =
-      static_cast<Eigen::Index>(map.sensors.size() * (1 + map.time_constants.size()));
+  const Eigen::Index cols = static_cast<Eigen::Index>((map.sensors.size() + map.inputs.size()) *
+                                                      (1 + map.time_constants.size()));
   StackedRows stacked{Eigen::MatrixXd(rows, cols), Eigen::VectorXd(rows)};
   Eigen::Index row = 0;
   for (const Group& g : groups) {

@@ -19,6 +19,10 @@ struct FeatureMap {
   std::vector<std::string> sensor_names;
   /// low-pass time constants [s]; empty for a static model
   std::vector<double> time_constants;
+  /// columns of Group::inputs read beside the temperatures (as increments, like them)
+  std::vector<int> inputs;
+  /// names of those columns, kept for reports
+  std::vector<std::string> input_names;
 };
 
 /// Response y of the filter τ·y' + y = u to the samples u (taken as piecewise linear between
@@ -26,11 +30,12 @@ struct FeatureMap {
 /// it holds on a non-uniform time grid.
 Eigen::VectorXd low_pass(const Eigen::VectorXd& time, const Eigen::VectorXd& u, double tau);
 
-/// #samples x (#sensors·(1 + #time_constants)) regressors of one group: first the increments
-/// ΔT_k, then for each time constant the filtered increments, sensor by sensor [K].
+/// #samples x ((#sensors + #inputs)·(1 + #time_constants)) regressors of one group: first the
+/// increments ΔT_k [K], then the input increments (speed [rpm]), then for each time constant the
+/// filtered versions of all of them in the same order.
 Eigen::MatrixXd feature_matrix(const FeatureMap& map, const Group& group);
 
-/// Names of feature_matrix's columns, e.g. "dT[t3]" and "lp1800s(dT[t3])".
+/// Names of feature_matrix's columns, e.g. "dT[t3]", "d[speed_rpm]" and "lp1800s(dT[t3])".
 std::vector<std::string> feature_names(const FeatureMap& map);
 
 /// The fitting rows of several groups stacked, each group's features computed on its own time.

@@ -45,6 +45,17 @@ void require_consistent_groups(const std::vector<Group>& groups) {
     if (group.target_names != first.target_names)
       throw core::DataError(label + ": target names differ from those of group 0 '" + first.name +
                             "'");
+    if (static_cast<std::size_t>(group.inputs.cols()) != group.input_names.size() ||
+        (group.inputs.cols() > 0 && group.inputs.rows() != n))
+      throw core::DataError(label + ": " + std::to_string(group.inputs.rows()) + " x " +
+                            std::to_string(group.inputs.cols()) + " inputs with " +
+                            std::to_string(group.input_names.size()) +
+                            " input names; expected one row per time and one name per column");
+    if (group.input_names != first.input_names)
+      throw core::DataError(label + ": inputs differ from those of group 0 '" + first.name +
+                            "'; hint: give every run the same inputs (or none)");
+    if (!group.inputs.allFinite())
+      throw core::DataError(label + ": an input holds NaN or an infinite value");
     if (!group.time.allFinite() || !group.temperature.allFinite() || !group.error.allFinite())
       throw core::DataError(label +
                             ": contains NaN or infinite values; hint: drop or interpolate "

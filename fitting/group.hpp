@@ -22,6 +22,11 @@ struct Group {
   std::vector<std::string> sensor_names;
   /// #targets names (e.g. "z", "x"), the same in every group of a campaign
   std::vector<std::string> target_names;
+  /// #samples x #inputs operating inputs (spindle speed [rpm]); no columns when the runs record
+  /// none
+  Eigen::MatrixXd inputs;
+  /// #inputs names, e.g. "speed_rpm", the same in every group of a campaign
+  std::vector<std::string> input_names;
 };
 
 /// Indices into a campaign's groups. Fitting groups fit the coefficients, validation groups

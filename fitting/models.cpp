@@ -27,6 +27,11 @@ FeatureMap feature_map(const ModelSpec& spec, const Group& group, const std::vec
           "one, e.g. {1800} s");
     map.time_constants = spec.time_constants;
   }
+  if (spec.use_inputs)
+    for (std::size_t c = 0; c < group.input_names.size(); ++c) {
+      map.inputs.push_back(static_cast<int>(c));
+      map.input_names.push_back(group.input_names[c]);
+    }
   return map;
 }
 
@@ -34,6 +39,8 @@ using Body = std::variant<LinearFit, PprModel>;
 
 Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   switch (spec.kind) {
+    case ModelKind::no_compensation:
+      return LinearFit{0.0, Eigen::VectorXd::Zero(x.cols())};
     case ModelKind::least_squares:
       return linear_fit(x, y, 0.0);
     case ModelKind::ridge:
@@ -61,6 +68,8 @@ Eigen::MatrixXd selected_rows(const Eigen::MatrixXd& m, const std::vector<Eigen:
 
 std::string kind_name(ModelKind kind) {
   switch (kind) {
+    case ModelKind::no_compensation:
+      return "no_compensation";
     case ModelKind::least_squares:
       return "least_squares";
     case ModelKind::ridge:
@@ -77,6 +86,7 @@ std::string model_label(const ModelSpec& spec) {
   std::ostringstream out;
   out << kind_name(spec.kind);
   switch (spec.kind) {
+    case ModelKind::no_compensation:
     case ModelKind::least_squares:
       break;
     case ModelKind::ridge:
@@ -92,7 +102,24 @@ std::string model_label(const ModelSpec& spec) {
       out << ",lambda=" << spec.ridge_lambda << ")";
       break;
   }
+  if (spec.use_inputs && spec.kind != ModelKind::no_compensation) out << "+inputs";
   return out.str();
+}
+
+int coefficient_count(const ModelSpec& spec, int sensors, int inputs) {
+  const int base = sensors + (spec.use_inputs ? inputs : 0);
+  switch (spec.kind) {
+    case ModelKind::no_compensation:
+      return 0;
+    case ModelKind::least_squares:
+    case ModelKind::ridge:
+      return base;
+    case ModelKind::distributed_lag:
+      return base * (1 + static_cast<int>(spec.time_constants.size()));
+    case ModelKind::projection_pursuit:
+      return base * std::max(1, spec.ppr.max_terms);
+  }
+  return base;
 }
 
 FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
@@ -127,7 +154,7 @@ FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups
       y(static_cast<Eigen::Index>(i)) = rows.error(kept[i]);
     model.body = body_fit(spec, x, y);
     model.rejection.passes = pass;
-    if (!spec.reject_gross_errors) break;
+    if (!spec.reject_gross_errors || spec.kind == ModelKind::no_compensation) break;
     const Eigen::VectorXd residual = y - body_prediction(model.body, x);
     const double limit = 3.0 * residual_std(residual);
     std::vector<Eigen::Index> next;

@@ -17,6 +17,8 @@
 namespace tt::fitting {
 
 enum class ModelKind {
+  /// E = 0: the machine left uncompensated, the candidate every model must beat on validation
+  no_compensation,
   /// the standard's E = β0 + Σ β_k ΔT_k (DB3401/T 326-2024 7.3)
   least_squares,
   /// the same model with standardised ridge shrinkage ridge_lambda
@@ -39,13 +41,20 @@ struct ModelSpec {
   /// the standard's 3σ criterion on the fitting samples (6.2.2): refit and drop samples whose
   /// residual exceeds 3 residual standard deviations until none does
   bool reject_gross_errors = true;
+  /// read the groups' operating inputs (spindle speed) beside the temperatures, as increments
+  bool use_inputs = false;
 };
 
-/// "least_squares", "ridge", "projection_pursuit" or "distributed_lag".
+/// "no_compensation", "least_squares", "ridge", "projection_pursuit" or "distributed_lag".
 std::string kind_name(ModelKind kind);
 
 /// A short label naming the kind and its settings, e.g. "ridge(lambda=0.001)".
 std::string model_label(const ModelSpec& spec);
+
+/// How many coefficients (besides the intercept) the spec fits on `sensors` sensors and `inputs`
+/// inputs: the order of simplicity of the one-standard-error rule (PPR counts as its projections'
+/// inputs times its largest number of terms).
+int coefficient_count(const ModelSpec& spec, int sensors, int inputs);
 
 /// How many fitting samples the 3σ criterion dropped.
 struct GrossErrorRejection {

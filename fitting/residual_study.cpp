@@ -41,20 +41,27 @@ Eigen::VectorXd solved(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
   return regular.ldlt().solve(b);
 }
 
-/// Leave-one-segment-out residual sum of squares [µm²] from per-segment Grams.
-double heldout_rss_of(const std::vector<Gram>& grams) {
+/// Leave-one-segment-out residual sum of squares [µm²] of each segment, from per-segment Grams.
+Eigen::VectorXd heldout_rss_per_segment(const std::vector<Gram>& grams) {
   Gram total{Eigen::MatrixXd::Zero(grams[0].xx.rows(), grams[0].xx.cols()),
              Eigen::VectorXd::Zero(grams[0].xy.size()), 0.0};
   for (const auto& g : grams) {
     total.xx += g.xx;
     total.xy += g.xy;
   }
-  double rss = 0.0;
-  for (const auto& g : grams) {
+  Eigen::VectorXd rss(static_cast<Eigen::Index>(grams.size()));
+  for (std::size_t k = 0; k < grams.size(); ++k) {
+    const auto& g = grams[k];
     const Eigen::VectorXd beta = solved(total.xx - g.xx, total.xy - g.xy);
-    rss += std::max(0.0, g.yy - 2.0 * beta.dot(g.xy) + beta.dot(g.xx * beta));
+    rss(static_cast<Eigen::Index>(k)) =
+        std::max(0.0, g.yy - 2.0 * beta.dot(g.xy) + beta.dot(g.xx * beta));
   }
   return rss;
+}
+
+/// Leave-one-segment-out residual sum of squares [µm²] from per-segment Grams.
+double heldout_rss_of(const std::vector<Gram>& grams) {
+  return heldout_rss_per_segment(grams).sum();
 }
 
 Eigen::VectorXd increment(const Segment& s, int sensor) {
@@ -186,11 +193,36 @@ struct Workspace {
   std::vector<Eigen::VectorXd> y;        /// per segment, the target [µm]
 };
 
-double rss_with(const Workspace& w, const std::vector<Eigen::MatrixXd>& extra) {
+Eigen::VectorXd rss_per_segment_with(const Workspace& w,
+                                     const std::vector<Eigen::MatrixXd>& extra) {
   std::vector<Gram> grams;
   for (std::size_t g = 0; g < w.y.size(); ++g)
     grams.push_back(gram_of(joined_columns(w.current[g], extra[g]), w.y[g]));
-  return heldout_rss_of(grams);
+  return heldout_rss_per_segment(grams);
+}
+
+double rss_with(const Workspace& w, const std::vector<Eigen::MatrixXd>& extra) {
+  return rss_per_segment_with(w, extra).sum();
+}
+
+/// Held-out RSS of each segment [µm²] with one term added to the workspace's model.
+Eigen::VectorXd rss_per_segment_with_term(const EffectTerm& term, const std::vector<int>& sensors,
+                                          const std::vector<Segment>& segments,
+                                          const Workspace& w) {
+  std::vector<Eigen::MatrixXd> extra;
+  for (const auto& s : segments) extra.push_back(term_columns(term, sensors, s));
+  return rss_per_segment_with(w, extra);
+}
+
+/// t statistic of the mean of per-segment gains (mean over its standard error); +inf when every
+/// gain is equal and positive.
+double gain_t(const Eigen::VectorXd& gains) {
+  const auto k = static_cast<double>(gains.size());
+  const double mean = gains.mean();
+  if (gains.size() < 2) return mean > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  const double sd = std::sqrt((gains.array() - mean).square().sum() / (k - 1.0));
+  if (!(sd > 0.0)) return mean > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return mean / (sd / std::sqrt(k));
 }
 
 /// The best term of a grid: its index and held-out RSS [m²]. With a surrogate stream, every
@@ -350,6 +382,9 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   bool has_speed = false;
   for (const auto& s : training) has_speed = has_speed || s.speed.cwiseAbs().maxCoeff() > 0.0;
 
+  Eigen::Index rows = 0;
+  for (const auto& s : training) rows += s.group.time.size();
+
   ChannelStudy study;
   study.target = target;
   study.target_name = training.front().group.target_names[static_cast<std::size_t>(target)];
@@ -424,8 +459,21 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
                                     .second;
         null = std::max(null, (rss - null_rss) / rss);
       }
-      e.null_fraction = null;
-      if (margin > null) {
+      // A share that no surrogate reaches is still no evidence when it is negative: the threshold
+      // is never below zero.
+      e.null_fraction = std::max(null, 0.0);
+      // The gain must also hold from segment to segment, not come from one of them: the mean
+      // per-segment held-out gain must exceed min_gain_t standard errors.
+      std::vector<Eigen::MatrixXd> nothing;
+      for (const auto& t : training) nothing.emplace_back(t.group.time.size(), 0);
+      const Eigen::VectorXd before_rss = rss_per_segment_with(w, nothing);
+      const Eigen::VectorXd with_rss = rss_per_segment_with_term(e.term, sensors, training, w);
+      const Eigen::VectorXd gains = before_rss - with_rss;
+      e.gain_t = gain_t(gains);
+      e.segments_improved = static_cast<int>((gains.array() > 0.0).count());
+      e.heldout_rms_before = std::sqrt(before_rss.sum() / static_cast<double>(rows)) / kMicrometres;
+      e.heldout_rms_after = std::sqrt(with_rss.sum() / static_cast<double>(rows)) / kMicrometres;
+      if (margin > e.null_fraction && e.gain_t > options.min_gain_t) {
         e.claimed = true;
         claimed = static_cast<int>(order[rank]);
         break;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,9 @@ struct ResidualStudyOptions {
   double penalty_per_parameter = 0.01;
   /// at most this many effects
   int max_effects = 4;
+  /// the mean per-segment held-out gain of a claimed term must exceed this many standard errors
+  /// (a gain that one segment carries is not claimed)
+  double min_gain_t = 2.0;
   /// temperature column of the ambient sensor, -1 when the run names none
   int ambient_sensor = -1;
   /// master seed of the surrogates
@@ -99,10 +103,17 @@ struct Effect {
   double step_fraction = 0.0;
   /// the same reduction as a share of the baseline's held-out residual (comparable across effects)
   double explained_fraction = 0.0;
-  /// the largest step share reached by its surrogates (the noise threshold); NaN when
-  /// not computed (its step share was below the penalty already)
+  /// the largest step share reached by its surrogates, never below 0 (the noise threshold); NaN
+  /// when not computed (its step share was below the penalty already)
   double null_fraction = 0.0;
-  /// step_fraction − penalty·parameters > null_fraction
+  /// the held-out (leave-one-segment-out) RMS of the training segments before and with the
+  /// term [m]; NaN when not computed
+  double heldout_rms_before = std::numeric_limits<double>::quiet_NaN();
+  double heldout_rms_after = std::numeric_limits<double>::quiet_NaN();
+  /// per-segment held-out gains: their mean over its standard error, and how many are positive
+  double gain_t = std::numeric_limits<double>::quiet_NaN();
+  int segments_improved = 0;
+  /// step_fraction − penalty·parameters > null_fraction and gain_t > min_gain_t
   bool claimed = false;
 };
 

@@ -4,6 +4,8 @@
 #include <limits>
 
 #include "core/errors.hpp"
+#include "core/parallel.hpp"
+#include "fitting/features.hpp"
 
 namespace tt::fitting {
 
@@ -92,6 +94,10 @@ Segment segment_of(const std::string& name, const Eigen::VectorXd& time,
     s.group.error.row(r) = error.row(i) - error.row(kept.front());
     if (speed.size() != 0) s.speed(r) = speed(i);
   }
+  if (speed.size() != 0) {
+    s.group.inputs = s.speed;
+    s.group.input_names = {"speed_rpm"};
+  }
   return s;
 }
 
@@ -101,14 +107,72 @@ std::vector<Group> segment_groups(const std::vector<Segment>& segments) {
   return groups;
 }
 
-Evaluation cross_validated_evaluation(const std::vector<Group>& groups,
-                                      const std::vector<int>& pool, const std::vector<int>& test,
-                                      int target, const std::vector<SensorSet>& sensor_sets,
-                                      const std::vector<ModelSpec>& specs) {
+namespace {
+
+/// Coefficients of a candidate, then the weaker shrinkage: the order of simplicity.
+std::pair<int, double> simplicity(const Candidate& c, int inputs) {
+  return {coefficient_count(c.spec, static_cast<int>(c.sensor_set.sensors.size()), inputs),
+          -c.spec.ridge_lambda};
+}
+
+}  // namespace
+
+Blocks cross_validation_blocks(const std::vector<Segment>& pieces, int min_blocks,
+                               Eigen::Index min_rows) {
+  if (pieces.empty())
+    throw core::DataError(
+        "no training data: every run lies in the test window; hint: give more runs or a "
+        "shorter test window");
+  const int count = static_cast<int>(pieces.size());
+  Blocks blocks;
+  if (count >= min_blocks) {
+    blocks.segments = pieces;
+    blocks.origin = std::to_string(count) +
+                    " training pieces as given (speed cycles where a run has a speed, whole runs "
+                    "otherwise)";
+    return blocks;
+  }
+  const int per_piece = (min_blocks + count - 1) / count;
+  for (const auto& piece : pieces) {
+    const Group& g = piece.group;
+    const Eigen::Index n = g.time.size();
+    if (n < per_piece * min_rows)
+      throw core::DataError(
+          "training piece '" + g.name + "' has " + std::to_string(n) + " samples: " +
+          std::to_string(count) + " piece(s) give fewer than " + std::to_string(min_blocks) +
+          " cross-validation blocks, and cutting it into " + std::to_string(per_piece) +
+          " time blocks needs at least " + std::to_string(per_piece * min_rows) +
+          " samples; hint: give longer runs, more runs, or a speed column whose stops cut the run "
+          "into cycles");
+    const double t0 = g.time(0), t1 = g.time(n - 1);
+    std::vector<double> cuts;
+    for (int k = 1; k < per_piece; ++k) cuts.push_back(t0 + (t1 - t0) * k / per_piece);
+    int k = 0;
+    for (const RowRange& r : ranges_at(g.time, cuts)) {
+      // The speed is handed on only when the run had one (group.inputs), so that a run with no
+      // speed column keeps none.
+      const Eigen::VectorXd speed = g.inputs.cols() > 0 ? piece.speed : Eigen::VectorXd();
+      blocks.segments.push_back(segment_of(g.name + ".b" + std::to_string(++k), g.time, speed,
+                                           g.temperature, g.error, g.sensor_names, g.target_names,
+                                           r));
+    }
+  }
+  blocks.cut_in_time = true;
+  blocks.origin = std::to_string(count) + " training piece(s) (fewer than " +
+                  std::to_string(min_blocks) + ") each cut into " + std::to_string(per_piece) +
+                  " time blocks of equal duration, re-zeroed at each block start: " +
+                  std::to_string(blocks.segments.size()) + " blocks";
+  return blocks;
+}
+
+Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vector<int>& pool,
+                              const std::vector<int>& test, int target,
+                              const std::vector<Candidate>& candidates) {
   if (pool.size() < 2)
     throw core::DataError(
         "cross-validated choice on " + std::to_string(pool.size()) +
         " groups: expected at least 2 (each validates once while the others fit)");
+  if (candidates.empty()) throw core::DataError("cross-validated choice among no candidates");
   require_valid_split(Split{pool, {}, test}, static_cast<int>(groups.size()));
   require_consistent_groups(groups);
   Evaluation result;
@@ -117,54 +181,120 @@ Evaluation cross_validated_evaluation(const std::vector<Group>& groups,
   result.fitting_groups = group_names(groups, pool);
   result.validation_groups = group_names(groups, pool);
   result.test_groups = group_names(groups, test);
-  result.sensor_sets = sensor_sets;
-  result.specs = specs;
-
-  std::vector<std::vector<double>> s;  // per candidate, validation S of each fold
-  std::vector<std::string> failure;
-  for (std::size_t k = 0; k < pool.size(); ++k) {
-    std::vector<int> fit;
-    for (std::size_t j = 0; j < pool.size(); ++j)
-      if (j != k) fit.push_back(pool[j]);
-    const Selection fold = selection_on_validation(
-        group_subset(groups, fit), group_subset(groups, {pool[k]}), target, sensor_sets, specs);
-    if (k == 0) {
-      result.selection.candidates = fold.candidates;
-      s.resize(fold.candidates.size());
-      failure.resize(fold.candidates.size());
-    }
-    for (std::size_t c = 0; c < fold.candidates.size(); ++c) {
-      const auto& candidate = fold.candidates[c];
-      if (!candidate.model) {
-        failure[c] = candidate.failure;
-        continue;
-      }
-      if (!candidate.validation.s.empty()) s[c].push_back(candidate.validation.s.front());
-    }
+  for (const auto& c : candidates) {
+    result.sensor_sets.push_back(c.sensor_set);
+    result.specs.push_back(c.spec);
   }
-  double best_sm = std::numeric_limits<double>::infinity();
-  for (std::size_t c = 0; c < s.size(); ++c) {
-    auto& candidate = result.selection.candidates[c];
-    if (!failure[c].empty() || s[c].size() != pool.size()) {
-      candidate.model.reset();
-      candidate.failure = failure[c].empty() ? "no validation score in some fold" : failure[c];
+  auto& scored = result.selection.candidates;
+  scored.resize(candidates.size());
+  // Candidate scoring is an approved parallel loop: each candidate writes only its own slot.
+  core::parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t i) {
+    CandidateResult& c = scored[static_cast<std::size_t>(i)];
+    c.sensor_set = static_cast<int>(i);
+    c.spec = static_cast<int>(i);
+    const Candidate& candidate = candidates[static_cast<std::size_t>(i)];
+    std::vector<double> s;
+    try {
+      for (std::size_t k = 0; k < pool.size(); ++k) {
+        std::vector<int> fit;
+        for (std::size_t j = 0; j < pool.size(); ++j)
+          if (j != k) fit.push_back(pool[j]);
+        const FittedModel m = fitted_model(candidate.spec, group_subset(groups, fit),
+                                           candidate.sensor_set.sensors, target);
+        const Group& held = groups[static_cast<std::size_t>(pool[k])];
+        s.push_back(residual_std(held.error.col(target) - predicted_error(m, held)));
+        if (k == 0) c.model = m;
+      }
+      c.validation = accuracy(s);
+    } catch (const std::exception& e) {
+      c.model.reset();
+      c.failure = e.what();
+    }
+  });
+  // One-standard-error rule: the lowest mean sets the bar (its mean plus its standard error over
+  // the folds); the simplest candidate under the bar is chosen, so that a richer model must beat
+  // a simpler one by more than the fold-to-fold scatter to be taken.
+  const int inputs = static_cast<int>(groups.front().input_names.size());
+  const double folds = static_cast<double>(pool.size());
+  for (std::size_t c = 0; c < scored.size(); ++c)
+    if (scored[c].model &&
+        (result.selection.lowest < 0 ||
+         scored[c].validation.sm <
+             scored[static_cast<std::size_t>(result.selection.lowest)].validation.sm))
+      result.selection.lowest = static_cast<int>(c);
+  if (result.selection.lowest < 0)
+    throw core::DataError("target " + result.target_name +
+                          ": every candidate failed (first: " + scored.front().failure + ")");
+  const auto& lowest = scored[static_cast<std::size_t>(result.selection.lowest)].validation;
+  result.selection.threshold_sm = lowest.sm + lowest.s_sigma / std::sqrt(folds);
+  for (std::size_t c = 0; c < scored.size(); ++c) {
+    if (!scored[c].model || scored[c].validation.sm > result.selection.threshold_sm) continue;
+    const auto& best = result.selection.best;
+    if (best < 0) {
+      result.selection.best = static_cast<int>(c);
       continue;
     }
-    candidate.validation = accuracy(s[c]);
-    if (candidate.validation.sm < best_sm) {
-      best_sm = candidate.validation.sm;
+    const auto a = simplicity(candidates[c], inputs);
+    const auto b = simplicity(candidates[static_cast<std::size_t>(best)], inputs);
+    if (a < b ||
+        (a == b && scored[c].validation.sm < scored[static_cast<std::size_t>(best)].validation.sm))
       result.selection.best = static_cast<int>(c);
-    }
   }
-  if (result.selection.best < 0)
-    throw core::DataError("target " + result.target_name +
-                          ": every (sensor set, model) pair failed in some fold");
-  const auto& best = result.selection.candidates[static_cast<std::size_t>(result.selection.best)];
+  const Candidate& chosen = candidates[static_cast<std::size_t>(result.selection.best)];
   result.model =
-      fitted_model(specs[static_cast<std::size_t>(best.spec)], group_subset(groups, pool),
-                   sensor_sets[static_cast<std::size_t>(best.sensor_set)].sensors, target);
+      fitted_model(chosen.spec, group_subset(groups, pool), chosen.sensor_set.sensors, target);
   if (!test.empty()) result.test = model_accuracy(result.model, group_subset(groups, test));
   return result;
+}
+
+std::vector<OutOfRange> out_of_training_range(const std::vector<Group>& training,
+                                              const std::vector<Group>& test) {
+  require_consistent_groups(training);
+  FeatureMap all;
+  for (std::size_t c = 0; c < training.front().sensor_names.size(); ++c) {
+    all.sensors.push_back(static_cast<int>(c));
+    all.sensor_names.push_back(training.front().sensor_names[c]);
+  }
+  for (std::size_t c = 0; c < training.front().input_names.size(); ++c) {
+    all.inputs.push_back(static_cast<int>(c));
+    all.input_names.push_back(training.front().input_names[c]);
+  }
+  const auto range = [&](const std::vector<Group>& groups) {
+    Eigen::MatrixXd lo = Eigen::RowVectorXd::Constant(
+        static_cast<Eigen::Index>(all.sensors.size() + all.inputs.size()),
+        std::numeric_limits<double>::infinity());
+    Eigen::MatrixXd hi = -lo;
+    for (const auto& g : groups) {
+      const Eigen::MatrixXd x = feature_matrix(all, g);
+      lo = lo.cwiseMin(x.colwise().minCoeff());
+      hi = hi.cwiseMax(x.colwise().maxCoeff());
+    }
+    return std::pair{lo, hi};
+  };
+  const auto [train_lo, train_hi] = range(training);
+  const std::vector<std::string> names = feature_names(all);
+  std::vector<OutOfRange> out;
+  for (Eigen::Index c = 0; c < train_lo.cols(); ++c) {
+    const double margin = 0.05 * (train_hi(0, c) - train_lo(0, c));
+    OutOfRange o;
+    o.column = names[static_cast<std::size_t>(c)];
+    o.training_min = train_lo(0, c);
+    o.training_max = train_hi(0, c);
+    o.test_min = std::numeric_limits<double>::infinity();
+    o.test_max = -o.test_min;
+    Eigen::Index outside = 0, samples = 0;
+    for (const auto& g : test) {
+      const Eigen::VectorXd x = feature_matrix(all, g).col(c);
+      o.test_min = std::min(o.test_min, x.minCoeff());
+      o.test_max = std::max(o.test_max, x.maxCoeff());
+      outside +=
+          (x.array() < o.training_min - margin || x.array() > o.training_max + margin).count();
+      samples += x.size();
+    }
+    o.share_outside = samples ? static_cast<double>(outside) / static_cast<double>(samples) : 0.0;
+    if (outside > 0) out.push_back(o);
+  }
+  return out;
 }
 
 }  // namespace tt::fitting

@@ -54,14 +54,54 @@ Segment segment_of(const std::string& name, const Eigen::VectorXd& time,
 /// The groups of segments, in order.
 std::vector<Group> segment_groups(const std::vector<Segment>& segments);
 
-/// Chooses the (sensor set, model spec) pair with the smallest mean validation S over folds in
-/// which each group of `pool` in turn validates and the other pool groups fit; refits it on all of
-/// `pool` and measures it on `test`. The Evaluation's candidates hold, per pair, the S of every
-/// fold's validation group and the model of the first fold; validation_groups lists the pool.
-/// Needs at least 2 pool groups. Throws DataError when every pair fails.
-Evaluation cross_validated_evaluation(const std::vector<Group>& groups,
-                                      const std::vector<int>& pool, const std::vector<int>& test,
-                                      int target, const std::vector<SensorSet>& sensor_sets,
-                                      const std::vector<ModelSpec>& specs);
+/// Blocks for blocked cross-validation, and how they were made.
+struct Blocks {
+  std::vector<Segment> segments;
+  /// true when the pieces were too few and were cut into time blocks
+  bool cut_in_time = false;
+  /// how the blocks were made, in words for the reports
+  std::string origin;
+};
+
+/// The training pieces (speed cycles or whole runs) as cross-validation blocks: as given when
+/// there are at least min_blocks; else each piece is cut into equal-duration time blocks,
+/// re-zeroed at each block start, so that there are at least min_blocks. Throws DataError naming
+/// the piece, its length and what would work when a piece is too short for blocks of min_rows.
+Blocks cross_validation_blocks(const std::vector<Segment>& pieces, int min_blocks = 4,
+                               Eigen::Index min_rows = 10);
+
+/// One candidate of a blocked choice.
+struct Candidate {
+  SensorSet sensor_set;
+  ModelSpec spec;
+};
+
+/// Blocked cross-validation with the one-standard-error rule. Each group of `pool` (whole runs,
+/// speed cycles or time blocks) validates in turn while the other pool groups fit; a candidate's
+/// validation Accuracy holds its S per fold. The lowest mean S sets a threshold, that mean plus
+/// its standard error (S_σ/√K); among the candidates at or below it the one with the fewest
+/// coefficients (then the strongest ridge, then the lowest mean) is chosen, refitted on all of
+/// `pool` and measured on `test`. List a no_compensation candidate: then a model whose mean S is
+/// not below it by a standard error is never chosen. The Evaluation's sensor_sets and specs hold
+/// one entry per candidate. Throws DataError on fewer than 2 pool groups or when every candidate
+/// fails.
+Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vector<int>& pool,
+                              const std::vector<int>& test, int target,
+                              const std::vector<Candidate>& candidates);
+
+/// A temperature or input increment the test groups take outside the training groups' range.
+struct OutOfRange {
+  /// e.g. "dT[t3]", "d[speed_rpm]"
+  std::string column;
+  /// [K] or the input's unit
+  double training_min = 0.0, training_max = 0.0, test_min = 0.0, test_max = 0.0;
+  /// share of the test samples beyond the training range by more than 5 % of its width
+  double share_outside = 0.0;
+};
+
+/// The columns (every sensor's and input's increment) whose test values leave the training range
+/// by more than 5 % of its width: a model is extrapolating there.
+std::vector<OutOfRange> out_of_training_range(const std::vector<Group>& training,
+                                              const std::vector<Group>& test);
 
 }  // namespace tt::fitting

@@ -2,6 +2,7 @@
 // groups only, the choice is refitted, and only then measured on test groups it has never seen.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -37,9 +38,13 @@ struct CandidateResult {
 struct Selection {
   /// every pair, sensor-set major
   std::vector<CandidateResult> candidates;
-  /// index into candidates of the smallest validation S_M (the first one on a tie, so list
-  /// simpler models first)
+  /// index into candidates of the chosen one: the smallest validation S_M (the first one on a
+  /// tie, so list simpler models first), or under blocked_evaluation's one-standard-error rule
   int best = -1;
+  /// blocked_evaluation only: the candidate of the smallest mean validation S, and the threshold
+  /// (that mean plus its standard error) the chosen one is within [m]
+  int lowest = -1;
+  double threshold_sm = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Fits every (sensor set, spec) pair on `fitting` and scores it on `validation`. It is never

@@ -40,7 +40,9 @@ json accuracy_json(const fitting::Accuracy& a, const std::vector<std::string>& g
 
 json settings_json(const fitting::ModelSpec& spec) {
   json s{{"reject_gross_errors_3sigma", spec.reject_gross_errors}};
+  if (spec.use_inputs) s["inputs"] = true;
   switch (spec.kind) {
+    case fitting::ModelKind::no_compensation:
     case fitting::ModelKind::least_squares:
       break;
     case fitting::ModelKind::ridge:

@@ -12,7 +12,10 @@ Eigen::VectorXd measured_speed(const MeasuredRun& run) {
   for (std::size_t i = 0; i < run.inputs.size(); ++i)
     if (run.inputs[i] == "speed_rpm") column = static_cast<int>(i);
   if (column < 0 && !run.inputs.empty()) column = 0;  // every input of this format is in rpm
-  if (column < 0) return Eigen::VectorXd::Zero(n);
+  if (column < 0) return Eigen::VectorXd();
+  if (run.input_values.rows() != n)
+    throw core::DataError(run.folder.string() + ": " + std::to_string(run.input_values.rows()) +
+                          " input rows for " + std::to_string(n) + " samples");
   return run.input_values.col(column);
 }
 
@@ -27,7 +30,8 @@ std::vector<fitting::Segment> measured_segments(const MeasuredRun& run, const st
                           ") s: expected at least 2");
   const Eigen::VectorXd speed_all = measured_speed(run);
   const Eigen::VectorXd time = run.time.segment(begin, end - begin);
-  Eigen::VectorXd speed = speed_all.segment(begin, end - begin);
+  const Eigen::VectorXd speed =
+      speed_all.size() ? Eigen::VectorXd(speed_all.segment(begin, end - begin)) : speed_all;
   const Eigen::MatrixXd temperature = run.temperature.middleRows(begin, end - begin);
   const Eigen::MatrixXd displacement = run.displacement.middleRows(begin, end - begin);
   // A missing speed reading does not start a cycle: hold the last one for the cutting only.
@@ -38,6 +42,13 @@ std::vector<fitting::Segment> measured_segments(const MeasuredRun& run, const st
   for (const auto& s : run.sensors) sensors.push_back(s.id);
   for (const auto& p : run.displacements) targets.push_back(p.id);
   std::vector<fitting::Segment> segments;
+  if (speed.size() == 0) {
+    // No speed, so no cycles: the window's rows are one piece (fitting::cross_validation_blocks
+    // cuts it into time blocks when the pieces are too few).
+    segments.push_back(fitting::segment_of(name + ".whole", time, speed, temperature, displacement,
+                                           sensors, targets, {0, time.size()}));
+    return segments;
+  }
   int k = 0;
   for (const auto& range : fitting::speed_cycles(held)) {
     double first = 0.0;

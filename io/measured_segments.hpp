@@ -13,12 +13,13 @@
 namespace tt::io {
 
 /// #samples spindle speed [rpm]: the input "speed_rpm", else the first input with the unit rpm;
-/// zeros when the run has no input.
+/// empty when the run has no input (then there are no speed cycles and no speed term).
 Eigen::VectorXd measured_speed(const MeasuredRun& run);
 
 /// The run's rows with from_s <= time < to_s cut at its speed cycles (fitting::speed_cycles),
 /// named "<name>.c<k>_<speed>rpm" after the first nonzero speed of each cycle; targets are the
 /// displacement ids, sensors the sensor ids. Rows with a missing reading are dropped per segment.
+/// A run with no speed gives one segment, "<name>.whole".
 std::vector<fitting::Segment> measured_segments(
     const MeasuredRun& run, const std::string& name,
     double from_s = -std::numeric_limits<double>::infinity(),
