@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/network_candidate.hpp"
 #include "core/errors.hpp"
 #include "fitting/features.hpp"
 #include "fitting/linear.hpp"
@@ -154,7 +155,15 @@ WindowPrediction continuous_prediction(const fitting::FittedModel& chosen,
     y(static_cast<Eigen::Index>(k)) = g.error(fit_rows[k], chosen.target);
   const Eigen::MatrixXd x_test = rows_of(test_rows);
   WindowPrediction w;
-  if (chosen.spec.kind == fitting::ModelKind::projection_pursuit) {
+  if (chosen.spec.kind == fitting::ModelKind::cnn_bigru_attention) {
+    std::vector<bool> fit_row(static_cast<std::size_t>(g.time.size()));
+    for (Eigen::Index i = 0; i < g.time.size(); ++i)
+      fit_row[static_cast<std::size_t>(i)] = !(g.time(i) >= from && g.time(i) < to);
+    const Eigen::VectorXd all = fitting::refitted_prediction(chosen, g, fit_row);
+    w.predicted.resize(static_cast<Eigen::Index>(test_rows.size()));
+    for (std::size_t k = 0; k < test_rows.size(); ++k)
+      w.predicted(static_cast<Eigen::Index>(k)) = all(test_rows[k]);
+  } else if (chosen.spec.kind == fitting::ModelKind::projection_pursuit) {
     const auto model = fitting::ppr_fit(rows_of(fit_rows), y, chosen.spec.ppr);
     w.predicted = fitting::ppr_prediction(model, x_test);
   } else {
@@ -274,6 +283,8 @@ int fit_data_command(const FitDataArgs& args) {
     for (const auto& spec : fitting::default_model_candidates())
       if (spec.kind != fitting::ModelKind::projection_pursuit) specs.push_back(spec);
   }
+  if (args.network) specs.push_back(driver_network_spec(1));
+  std::map<std::string, NetworkFigures> networks;
 
   // 3. Per channel: choice on several validation groups, test on the window's groups.
   std::vector<fitting::Evaluation> evals;
@@ -285,6 +296,10 @@ int fit_data_command(const FitDataArgs& args) {
     const auto corr =
         fitting::correlation_sensor_sets(fitting::group_subset(groups, pool), target, 4);
     sets.insert(sets.end(), corr.begin(), corr.end());
+    if (args.network) {
+      const auto grey = network_sensor_sets(placed, target);
+      sets.insert(sets.end(), grey.begin(), grey.end());
+    }
     evals.push_back(fitting::cross_validated_evaluation(groups, pool, test, target, sets, specs));
     const auto& e = evals.back();
     if (!args.quiet)
@@ -324,6 +339,27 @@ int fit_data_command(const FitDataArgs& args) {
     for (double v : e.test.s) s["test_s_um"].push_back(v * 1e6);
     if (published && published->mae_um.count(name))
       s["published_mae_um"] = published->mae_um.at(name);
+    if (args.network) {
+      // The network's own held-out figures beside the chosen model's, on the same groups.
+      auto n = network_figures(e, fitting::group_subset(groups, pool),
+                               fitting::group_subset(groups, test));
+      if (n) {
+        Eigen::VectorXd residual(0);
+        for (int i : test) {
+          const auto& g = groups[static_cast<std::size_t>(i)];
+          const Eigen::VectorXd r = g.error.col(target) - fitting::predicted_error(n->model, g);
+          residual.conservativeResize(residual.size() + r.size());
+          residual.tail(r.size()) = r;
+        }
+        const WindowPrediction nw = continuous_prediction(
+            n->model, whole_runs[static_cast<std::size_t>(window_run)], from, to);
+        s["network"] = network_json(*n);
+        s["network"]["window_mae_rezeroed_um"] = mean_abs(residual) * 1e6;
+        s["network"]["window_mae_continuous_um"] = mean_abs(nw.measured - nw.predicted) * 1e6;
+        s["network"]["file"] = "network_" + name + ".pt";
+        networks.emplace(name, std::move(*n));
+      }
+    }
     summary[name] = s;
     Eigen::MatrixXd rows(w.time.size(), 3);
     rows << w.time, w.measured * 1e6, w.predicted * 1e6;
@@ -374,6 +410,9 @@ int fit_data_command(const FitDataArgs& args) {
                           {"others_mae_um", published->others_um}};
     }
     io::write_json(dir / "fit.json", doc);
+    for (const auto& [channel, n] : networks)
+      std::get<torchnet::Network>(n.model.body)
+          .save_torchscript(dir / ("network_" + channel + ".pt"));
     std::vector<fitting::FittedModel> models;
     for (const auto& ev : evals) models.push_back(ev.model);
     io::write_compensation_csv(dir / "compensation.csv", models,

@@ -75,6 +75,8 @@ int main(int argc, char** argv) {
   fit->add_option("--hours", fit_args.hours, "length of each campaign run (the standard's minimum: 5)");
   fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it");
   fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
+  fit->add_flag("--network", fit_args.network,
+                "also try the CNN-BiGRU-attention network (seed 004); writes network_<target>.pt");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
 
   CalibrateArgs calibrate_args;
@@ -103,6 +105,7 @@ int main(int argc, char** argv) {
       if (!fit_data_args.runs.empty()) {
         fit_data_args.out = fit_args.out;
         fit_data_args.quick = fit_args.quick;
+        fit_data_args.network = fit_args.network;
         fit_data_args.quiet = fit_args.quiet;
         return fit_data_command(fit_data_args);
       }
