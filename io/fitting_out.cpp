@@ -183,6 +183,7 @@ json model_json(const FittedModel& model) {
     j["inputs"] = fitting::feature_names(model.features);
     j["window_steps"] = o.window_steps;
     j["window_stride_samples"] = o.window_stride;
+    j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;
     j["input_mean_K"] = vector_json(network->input_mean());
     j["input_scale_K"] = vector_json(network->input_scale());
     j["output_mean_um"] = vector_json(network->output_mean(), um);

@@ -30,10 +30,19 @@ std::mutex& torch_lock() {
 
 class TorchThreads {
  public:
+  // at::set_num_threads also resizes torch's pthreadpool, which is rebuilt on every change: it is
+  // called only when the count changes; the OpenMP team size that torch's parallel loops read is
+  // set (and restored) on every call, which costs nothing.
   explicit TorchThreads(int threads) : lock_(torch_lock()), saved_(omp_get_max_threads()) {
-    at::set_num_threads(std::max(1, threads));
+    static int torch_threads = 0;  // guarded by the lock
+    threads = std::max(1, threads);
+    if (torch_threads != threads) {
+      at::set_num_threads(threads);
+      torch_threads = threads;
+    }
+    omp_set_num_threads(threads);
   }
-  ~TorchThreads() { at::set_num_threads(std::max(1, saved_)); }
+  ~TorchThreads() { omp_set_num_threads(std::max(1, saved_)); }
   TorchThreads(const TorchThreads&) = delete;
   TorchThreads& operator=(const TorchThreads&) = delete;
 
@@ -166,14 +175,15 @@ Eigen::MatrixXd stacked(const std::vector<Eigen::MatrixXd>& parts) {
   return out;
 }
 
-/// Windows (steps x #inputs) ending at rows [begin, end) of one group, appended to `x`, and the
-/// outputs at those rows appended to `y`; all standardised, float.
+/// Windows (steps x #inputs) ending at every train_every-th row of [begin, end) of one group,
+/// appended to `x`, and the outputs at those rows appended to `y`; all standardised, float.
 void append_windows(const Eigen::MatrixXd& inputs, const Eigen::MatrixXd& outputs,
                     Eigen::Index begin, Eigen::Index end, const NetworkOptions& o,
                     const Eigen::VectorXd& in_mean, const Eigen::VectorXd& in_scale,
                     const Eigen::VectorXd& out_mean, const Eigen::VectorXd& out_scale,
                     std::vector<float>& x, std::vector<float>& y) {
-  for (Eigen::Index i = begin; i < end; ++i) {
+  const int every = o.train_every > 0 ? o.train_every : o.window_stride;
+  for (Eigen::Index i = begin; i < end; i += every) {
     for (int j = 0; j < o.window_steps; ++j) {
       const Eigen::Index r = std::max<Eigen::Index>(
           0, i - static_cast<Eigen::Index>(o.window_steps - 1 - j) * o.window_stride);
@@ -216,6 +226,7 @@ void require_options(const NetworkOptions& o) {
   };
   if (o.window_steps < 2) bad("window_steps", o.window_steps, ">= 2 (pooling halves it)");
   if (o.window_stride < 1) bad("window_stride", o.window_stride, ">= 1");
+  if (o.train_every < 0) bad("train_every", o.train_every, ">= 0 (0: window_stride)");
   if (o.conv_channels < 1) bad("conv_channels", o.conv_channels, ">= 1");
   if (o.kernel_size < 1 || o.kernel_size % 2 == 0) bad("kernel_size", o.kernel_size, "odd, >= 1");
   if (o.gru_hidden < 1) bad("gru_hidden", o.gru_hidden, ">= 1");
@@ -514,6 +525,11 @@ Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
   std::vector<float> x = raw_windows(windows);
   return run_script(module, x, static_cast<int64_t>(windows.size()), static_cast<int>(steps),
                     static_cast<int>(inputs));
+}
+
+std::string parallel_info() {
+  std::lock_guard<std::mutex> lock(torch_lock());
+  return at::get_parallel_info();
 }
 
 }  // namespace tt::torchnet

@@ -21,6 +21,10 @@ struct NetworkOptions {
   int window_steps = 16;
   /// samples between two entries of a window
   int window_stride = 1;
+  /// training and early-stopping windows end every this many samples (0: window_stride):
+  /// neighbouring windows of a finely sampled run are nearly the same, and training on each one
+  /// costs time without adding information
+  int train_every = 0;
   /// channels of both convolutions
   int conv_channels = 16;
   /// odd convolution kernel size
@@ -107,5 +111,8 @@ Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
 /// The window ending at each of the rows `rows` of `inputs` (window_steps x #inputs each).
 std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
                                         const std::vector<Eigen::Index>& rows);
+
+/// libtorch's report of its threading backend and thread counts, for benchmark records.
+std::string parallel_info();
 
 }  // namespace tt::torchnet
