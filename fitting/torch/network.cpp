@@ -60,8 +60,7 @@ struct NetImpl : torch::nn::Module {
             "conv2", torch::nn::Conv1d(
                          torch::nn::Conv1dOptions(o.conv_channels, o.conv_channels, o.kernel_size)
                              .padding(o.kernel_size / 2)))),
-        norm(register_module("norm", torch::nn::LayerNorm(torch::nn::LayerNormOptions(
-                                         std::vector<int64_t>{o.conv_channels})))),
+        norm(register_module("norm", torch::nn::BatchNorm1d(o.conv_channels))),
         gru(register_module("gru",
                             torch::nn::GRU(torch::nn::GRUOptions(o.conv_channels, o.gru_hidden)
                                                .num_layers(o.gru_layers)
@@ -75,8 +74,7 @@ struct NetImpl : torch::nn::Module {
     x = x.transpose(1, 2);
     x = torch::relu(conv1->forward(x));
     x = torch::relu(conv2->forward(x));
-    x = torch::max_pool1d(x, {2}, {2});
-    x = norm->forward(x.transpose(1, 2));
+    x = norm->forward(torch::max_pool1d(x, {2}, {2})).transpose(1, 2);
     const torch::Tensor y = std::get<0>(gru->forward(x));
     const torch::Tensor c = y.select(1, -1);
     // Feature attention: the weight of each of the 2·hidden features is the softmax of its term
@@ -87,7 +85,10 @@ struct NetImpl : torch::nn::Module {
   }
 
   torch::nn::Conv1d conv1, conv2;
-  torch::nn::LayerNorm norm;
+  // Batch normalisation, not layer normalisation: once trained it is a fixed affine map, so the
+  // features keep the amplitude of the temperature rise (layer normalisation over the channels
+  // would divide it out at every time step).
+  torch::nn::BatchNorm1d norm;
   torch::nn::GRU gru;
   torch::nn::Linear key, head;
 };
@@ -103,8 +104,8 @@ std::string script_source(const NetworkOptions& o, int gru_tensors) {
     << "    x = torch.relu(torch.conv1d(x, self.conv1_w, self.conv1_b, [1], [" << pad << "]))\n"
     << "    x = torch.relu(torch.conv1d(x, self.conv2_w, self.conv2_b, [1], [" << pad << "]))\n"
     << "    x = torch.max_pool1d(x, [2], [2])\n"
-    << "    x = torch.layer_norm(x.transpose(1, 2), [" << o.conv_channels
-    << "], self.norm_w, self.norm_b, 1e-05)\n"
+    << "    x = torch.batch_norm(x, self.norm_w, self.norm_b, self.norm_mean, self.norm_var, "
+       "False, 0.1, 1e-05, False).transpose(1, 2)\n"
     << "    h0 = torch.zeros([" << 2 * o.gru_layers << ", x.size(0), " << o.gru_hidden
     << "], dtype=x.dtype)\n"
     << "    y, h = torch.gru(x, h0, [";
@@ -142,6 +143,8 @@ torch::jit::Module script_module(Net& net, const NetworkOptions& o, const Eigen:
   param("conv2_b", net->conv2->bias);
   param("norm_w", net->norm->weight);
   param("norm_b", net->norm->bias);
+  m.register_buffer("norm_mean", net->norm->running_mean.detach().clone());
+  m.register_buffer("norm_var", net->norm->running_var.detach().clone());
   const std::vector<torch::Tensor> gru = net->gru->all_weights();
   for (std::size_t i = 0; i < gru.size(); ++i) param("gru_" + std::to_string(i), gru[i]);
   param("key_w", net->key->weight);
@@ -266,6 +269,7 @@ void initialise(Net& net, at::Generator& gen, int gru_hidden) {
 
 double mean_squared(Net& net, const torch::Tensor& x, const torch::Tensor& y) {
   torch::NoGradGuard no_grad;
+  net->eval();
   double sum = 0.0;
   const int64_t n = x.size(0);
   for (int64_t b = 0; b < n; b += 4096) {
@@ -457,6 +461,7 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
     double best_loss = std::numeric_limits<double>::infinity();
     for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
       const torch::Tensor order = torch::randperm(nf, gen, torch::TensorOptions(torch::kLong));
+      net->train();
       for (int64_t b = 0; b < nf; b += o.batch_size) {
         const torch::Tensor idx = order.slice(0, b, std::min(nf, b + o.batch_size));
         adam.zero_grad();
@@ -472,6 +477,7 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
         impl->report.best_epoch = epoch;
         best.clear();
         for (const auto& p : net->parameters()) best.push_back(p.detach().clone());
+        for (const auto& b : net->buffers()) best.push_back(b.detach().clone());
       }
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -487,7 +493,10 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
     {
       torch::NoGradGuard no_grad;
       auto params = net->parameters();
+      const auto buffers = net->buffers();
       for (std::size_t i = 0; i < params.size(); ++i) params[i].copy_(best[i]);
+      for (std::size_t i = 0; i < buffers.size(); ++i) buffers[i].copy_(best[params.size() + i]);
+      net->eval();
       for (const auto& p : params) {
         const torch::Tensor flat = p.detach().contiguous().view(-1);
         const float* d = flat.data_ptr<float>();

@@ -1,7 +1,7 @@
 // The gantry patent's CNN-BiGRU-attention thermal-error network (seed 004), on libtorch, behind a
 // plain C++ interface: nothing outside fitting/torch/ includes a torch header.
 // Structure: standardised input windows -> two 1-D convolutions (ReLU) -> max pooling by 2 ->
-// layer normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
+// batch normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
 // dimension of the last GRU output -> one fully connected layer to every output at once.
 // Trained on CPU with Adam on the mean squared standardised error, early stopping on validation
 // windows and a time budget. The same seed and thread count give the same weights.
