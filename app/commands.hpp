@@ -37,6 +37,7 @@ struct FitArgs {
   std::filesystem::path case_file, out;
   double hours = 5, required_sm_um = 1.0;
   bool quick = false, quiet = false;
+  bool network = false;  /// also try the CNN-BiGRU-attention network (seed 004)
 };
 
 /// fit --data RUN...: measured runs with no machine model (app/fit_data_command.cpp).
@@ -47,6 +48,7 @@ struct FitDataArgs {
   std::filesystem::path out;
   std::optional<double> test_from_s, test_to_s;  /// test window; default: the published one, if any
   bool quick = false, quiet = false;
+  bool network = false;  /// also try the CNN-BiGRU-attention network (seed 004)
 };
 
 /// calibrate: with --case the model-based path, without it the data-driven one.

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "app/commands.hpp"
+#include "app/network_candidate.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
 #include "fitting/group.hpp"
@@ -126,8 +127,10 @@ int fit_command(const FitArgs& args) {
   const Histories first = histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
   const placement::PlacementResult placed = placement_on(groups, split.fitting, first.positions, spec.seed);
   // 4. Per target: choose model, settings and placement method on validation; test; count sensors.
-  const std::vector<fitting::ModelSpec> specs =
+  std::vector<fitting::ModelSpec> specs =
       args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}} : fitting::default_model_candidates();
+  if (args.network) specs.push_back(driver_network_spec(spec.seed));
+  std::map<std::string, NetworkFigures> networks;
   std::vector<fitting::Evaluation> evals;
   std::vector<fitting::SensorCountTable> tables;
   nlohmann::json summary = nlohmann::json::object();
@@ -143,6 +146,10 @@ int fit_command(const FitArgs& args) {
     std::vector<fitting::SensorSet> at_most_4 = sensor_sets(placed, target, 4);
     const auto corr = standard_sets(4);
     at_most_4.insert(at_most_4.end(), corr.begin(), corr.end());
+    if (args.network) {
+      const auto grey = network_sensor_sets(placed, target);
+      at_most_4.insert(at_most_4.end(), grey.begin(), grey.end());
+    }
     evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
     const auto corr6 = standard_sets(6);
@@ -160,6 +167,18 @@ int fit_command(const FitArgs& args) {
                                                {"test_s_sigma_um", e.test.s_sigma * 1e6},
                                                {"uncompensated_std_um", drift * 1e6},
                                                {"test_sm_over_uncompensated", e.test.sm / drift}};
+    if (args.network) {
+      // The network's own held-out figures beside the chosen model's, on the same groups.
+      std::vector<int> refit = split.fitting;
+      refit.insert(refit.end(), split.validation.begin(), split.validation.end());
+      if (auto n = network_figures(e, fitting::group_subset(groups, refit), fitting::group_subset(groups, split.test))) {
+        const std::string& name = groups[0].target_names[target];
+        summary[name]["network"] = network_json(*n);
+        summary[name]["network"]["test_sm_over_uncompensated"] = n->test.sm / drift;
+        summary[name]["network"]["file"] = "network_" + name + ".pt";
+        networks.emplace(name, std::move(*n));
+      }
+    }
   }
   // 5. Outputs, all or nothing.
   io::OutputDir out(args.out);
@@ -172,6 +191,8 @@ int fit_command(const FitArgs& args) {
     doc["campaign"].push_back({{"name", r.name}, {"shape", r.shape}, {"hours", r.spec.duty_cycle.end / 3600.0},
                                {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
   io::write_json(dir / "fit.json", doc);
+  for (const auto& [name, n] : networks)
+    std::get<torchnet::Network>(n.model.body).save_torchscript(dir / ("network_" + name + ".pt"));
   io::ModellingConditions conditions;
   conditions.machine_model = spec.machine.empty() ? spec.name : spec.machine;
   conditions.machine_number = "virtual";

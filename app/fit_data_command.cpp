@@ -28,6 +28,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/network_candidate.hpp"
 #include "core/errors.hpp"
 #include "fitting/features.hpp"
 #include "fitting/linear.hpp"
@@ -40,6 +41,7 @@
 #include "io/measured_data.hpp"
 #include "io/measured_segments.hpp"
 #include "io/reports.hpp"
+#include "placement/place.hpp"
 
 namespace tt::app {
 namespace {
@@ -116,6 +118,14 @@ WindowPrediction continuous_prediction(const fitting::FittedModel& chosen,
   WindowPrediction w;
   if (chosen.spec.kind == fitting::ModelKind::no_compensation) {
     w.predicted = Eigen::VectorXd::Zero(x_test.rows());
+  } else if (chosen.spec.kind == fitting::ModelKind::cnn_bigru_attention) {
+    std::vector<bool> fit_row(static_cast<std::size_t>(g.time.size()));
+    for (Eigen::Index i = 0; i < g.time.size(); ++i)
+      fit_row[static_cast<std::size_t>(i)] = !(g.time(i) >= from && g.time(i) < to);
+    const Eigen::VectorXd all = fitting::refitted_prediction(chosen, g, fit_row);
+    w.predicted.resize(static_cast<Eigen::Index>(test_rows.size()));
+    for (std::size_t k = 0; k < test_rows.size(); ++k)
+      w.predicted(static_cast<Eigen::Index>(k)) = all(test_rows[k]);
   } else if (chosen.spec.kind == fitting::ModelKind::projection_pursuit) {
     const auto model = fitting::ppr_fit(rows_of(fit_rows), y, chosen.spec.ppr);
     w.predicted = fitting::ppr_prediction(model, x_test);
@@ -130,6 +140,41 @@ WindowPrediction continuous_prediction(const fitting::FittedModel& chosen,
     w.measured(static_cast<Eigen::Index>(k)) = g.error(test_rows[k], chosen.target);
   }
   return w;
+}
+
+/// The candidate sensors ranked on the training groups laid end to end (for --network).
+placement::PlacementResult placed_on(const std::vector<fitting::Group>& groups,
+                                     std::uint64_t seed) {
+  Eigen::Index rows = 0;
+  for (const auto& g : groups) rows += g.time.size();
+  const auto& g0 = groups.front();
+  placement::PlacementInput in;
+  for (std::size_t c = 0; c < g0.sensor_names.size(); ++c)
+    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
+  in.positions_m = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(g0.sensor_names.size()), 3);
+  in.times_s.resize(rows);
+  in.temperatures_K.resize(rows, g0.temperature.cols());
+  std::vector<Eigen::VectorXd> targets(g0.target_names.size(), Eigen::VectorXd(rows));
+  Eigen::Index r = 0;
+  double offset = 0.0;
+  for (const auto& g : groups) {
+    const Eigen::Index n = g.time.size();
+    in.times_s.segment(r, n) = g.time.array() - g.time(0) + offset;
+    in.temperatures_K.middleRows(r, n) = g.temperature;
+    for (std::size_t t = 0; t < targets.size(); ++t)
+      targets[t].segment(r, n) = g.error.col(static_cast<Eigen::Index>(t));
+    offset = in.times_s(r + n - 1) + 1.0;
+    r += n;
+  }
+  for (std::size_t t = 0; t < targets.size(); ++t)
+    in.targets.push_back({g0.target_names[t], targets[t]});
+  placement::PlacementOptions options;
+  options.samples =
+      400;  // resampled: the MI searches need no more than this, the runs have 10^4 rows
+  options.m_max = 4;
+  options.seed = seed;
+  options.mirror_twins = false;
+  return placement::place_all(in, options);
 }
 
 /// The candidates of one channel: no compensation, least squares on all temperature rises, and
@@ -300,6 +345,10 @@ int fit_data_command(const FitDataArgs& args) {
   const int sensor_count = static_cast<int>(groups.front().sensor_names.size());
   const auto training = fitting::group_subset(groups, pool);
   const auto out_of_range = fitting::out_of_training_range(training, group_subset(groups, test));
+  // With --network: the grey relational grade's sensors, for the network only (seed 004).
+  std::optional<placement::PlacementResult> placed;
+  if (args.network) placed = placed_on(training, 1);
+  std::map<std::string, NetworkFigures> networks;
 
   // 3. Per channel: blocked choice on the training blocks, test on the held-out groups.
   std::vector<fitting::Evaluation> evals;
@@ -308,7 +357,11 @@ int fit_data_command(const FitDataArgs& args) {
       window_rows;  /// per channel: time_s, measured_um, predicted_um
   const auto candidates = data_candidates(sensor_count, has_speed, args.quick);
   for (int target = 0; target < static_cast<int>(targets.size()); ++target) {
-    evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, candidates));
+    std::vector<fitting::Candidate> target_candidates = candidates;
+    if (placed)
+      for (const auto& set : network_sensor_sets(*placed, target))
+        target_candidates.push_back({set, driver_network_spec(1)});
+    evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, target_candidates));
     const auto& e = evals.back();
     const auto& chosen = e.selection.candidates[static_cast<std::size_t>(e.selection.best)];
     const auto& lowest = e.selection.candidates[static_cast<std::size_t>(e.selection.lowest)];
@@ -362,6 +415,29 @@ int fit_data_command(const FitDataArgs& args) {
       Eigen::MatrixXd rows(w.time.size(), 3);
       rows << w.time, w.measured * 1e6, w.predicted * 1e6;
       window_rows[name] = rows;
+    }
+    if (args.network) {
+      // The network's own held-out figures beside the chosen model's, on the same groups.
+      auto n = network_figures(e, fitting::group_subset(groups, pool),
+                               fitting::group_subset(groups, test));
+      if (n) {
+        Eigen::VectorXd residual(0);
+        for (int i : test) {
+          const auto& g = groups[static_cast<std::size_t>(i)];
+          const Eigen::VectorXd r = g.error.col(target) - fitting::predicted_error(n->model, g);
+          residual.conservativeResize(residual.size() + r.size());
+          residual.tail(r.size()) = r;
+        }
+        s["network"] = network_json(*n);
+        s["network"]["window_mae_rezeroed_um"] = mean_abs(residual) * 1e6;
+        if (window_inside_run) {
+          const WindowPrediction nw = continuous_prediction(
+              n->model, whole_runs[static_cast<std::size_t>(window_run)], from, to);
+          s["network"]["window_mae_continuous_um"] = mean_abs(nw.measured - nw.predicted) * 1e6;
+        }
+        s["network"]["file"] = "network_" + name + ".pt";
+        networks.emplace(name, std::move(*n));
+      }
     }
     summary[name] = s;
   }
@@ -430,6 +506,9 @@ int fit_data_command(const FitDataArgs& args) {
                           {"others_mae_um", published->others_um}};
     }
     io::write_json(dir / "fit.json", doc);
+    for (const auto& [channel, n] : networks)
+      std::get<torchnet::Network>(n.model.body)
+          .save_torchscript(dir / ("network_" + channel + ".pt"));
     std::vector<fitting::FittedModel> models;
     for (const auto& ev : evals) models.push_back(ev.model);
     io::write_compensation_csv(dir / "compensation.csv", models,

@@ -97,6 +97,8 @@ int main(int argc, char** argv) {
       ->check(positive_number());
   fit->add_flag("--quick", fit_args.quick,
                 "least squares only (no model search); with --data: a coarser ridge grid");
+  fit->add_flag("--network", fit_args.network,
+                "also try the CNN-BiGRU-attention network (seed 004); writes network_<target>.pt");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
 
   CalibrateArgs calibrate_args;
@@ -128,6 +130,7 @@ int main(int argc, char** argv) {
       if (!fit_data_args.runs.empty()) {
         fit_data_args.out = fit_args.out;
         fit_data_args.quick = fit_args.quick;
+        fit_data_args.network = fit_args.network;
         fit_data_args.quiet = fit_args.quiet;
         return fit_data_command(fit_data_args);
       }

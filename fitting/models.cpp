@@ -1,6 +1,7 @@
 #include "fitting/models.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <numeric>
 #include <sstream>
@@ -35,7 +36,34 @@ FeatureMap feature_map(const ModelSpec& spec, const Group& group, const std::vec
   return map;
 }
 
-using Body = std::variant<LinearFit, PprModel>;
+using Body = std::variant<LinearFit, PprModel, torchnet::Network>;
+
+/// Samples between two entries of a network window: window_span_s over (window_steps − 1), in
+/// units of the median sampling interval of the groups.
+int window_stride(const NetworkSettings& settings, const std::vector<Group>& groups) {
+  std::vector<double> dt;
+  for (const Group& g : groups)
+    for (Eigen::Index i = 1; i < g.time.size(); ++i) dt.push_back(g.time(i) - g.time(i - 1));
+  if (dt.empty() || !(settings.window_span_s > 0.0)) return 1;
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  const double median = dt[dt.size() / 2];
+  const double entries = std::max(1, settings.options.window_steps - 1);
+  return std::max(1, static_cast<int>(std::lround(settings.window_span_s / entries / median)));
+}
+
+torchnet::Network network_fit(const torchnet::NetworkOptions& options, const FeatureMap& features,
+                              const std::vector<Group>& groups, int target) {
+  // With three or more groups the last one stops the training early; with fewer, the adapter
+  // holds out the last fifth of each group.
+  torchnet::Sequences fit, validation;
+  const bool hold_last = groups.size() >= 3;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    torchnet::Sequences& s = hold_last && g + 1 == groups.size() ? validation : fit;
+    s.inputs.push_back(feature_matrix(features, groups[g]));
+    s.outputs.push_back(groups[g].error.col(target));
+  }
+  return torchnet::trained_network(fit, validation, options);
+}
 
 Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
   switch (spec.kind) {
@@ -48,12 +76,16 @@ Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::Vect
       return linear_fit(x, y, spec.ridge_lambda);
     case ModelKind::projection_pursuit:
       return ppr_fit(x, y, spec.ppr);
+    case ModelKind::cnn_bigru_attention:
+      break;  // trained on sequences (network_fit), never on stacked rows
   }
-  throw core::DataError("unknown model kind");
+  throw core::DataError("model kind '" + kind_name(spec.kind) + "' cannot be fitted on rows");
 }
 
 Eigen::VectorXd body_prediction(const Body& body, const Eigen::MatrixXd& x) {
   if (const auto* linear = std::get_if<LinearFit>(&body)) return linear_prediction(*linear, x);
+  if (const auto* network = std::get_if<torchnet::Network>(&body))
+    return network->prediction(x).col(0);  // x: one group's rows in time order
   return ppr_prediction(std::get<PprModel>(body), x);
 }
 
@@ -78,6 +110,8 @@ std::string kind_name(ModelKind kind) {
       return "projection_pursuit";
     case ModelKind::distributed_lag:
       return "distributed_lag";
+    case ModelKind::cnn_bigru_attention:
+      return "cnn_bigru_attention";
   }
   return "unknown";
 }
@@ -101,6 +135,12 @@ std::string model_label(const ModelSpec& spec) {
         out << (t ? "/" : "") << spec.time_constants[t];
       out << ",lambda=" << spec.ridge_lambda << ")";
       break;
+    case ModelKind::cnn_bigru_attention:
+      out << "(window=" << spec.network.options.window_steps << "x" << spec.network.window_span_s
+          << "s,conv=" << spec.network.options.conv_channels
+          << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden
+          << ",seed=" << spec.network.options.seed << ")";
+      break;
   }
   if (spec.use_inputs && spec.kind != ModelKind::no_compensation) out << "+inputs";
   return out.str();
@@ -118,6 +158,9 @@ int coefficient_count(const ModelSpec& spec, int sensors, int inputs) {
       return base * (1 + static_cast<int>(spec.time_constants.size()));
     case ModelKind::projection_pursuit:
       return base * std::max(1, spec.ppr.max_terms);
+    case ModelKind::cnn_bigru_attention:
+      // Thousands of weights: the one-standard-error rule prefers any linear model within reach.
+      return std::numeric_limits<int>::max() / 2;
   }
   return base;
 }
@@ -138,6 +181,14 @@ FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups
   model.target = target;
   model.target_name = first.target_names[static_cast<std::size_t>(target)];
   for (const Group& g : groups) model.fitted_on.push_back(g.name);
+  if (spec.kind == ModelKind::cnn_bigru_attention) {
+    torchnet::NetworkOptions options = spec.network.options;
+    options.window_stride = window_stride(spec.network, groups);
+    model.body = network_fit(options, model.features, groups, target);
+    for (const Group& g : groups) model.rejection.samples += static_cast<int>(g.time.size());
+    model.rejection.passes = 1;
+    return model;
+  }
 
   const StackedRows rows = stacked_rows(model.features, groups, target);
   const Eigen::Index n = rows.error.size();
@@ -175,6 +226,45 @@ FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups
     if (!is_kept[static_cast<std::size_t>(row)])
       model.rejection.rejected_rows.push_back(static_cast<int>(row));
   return model;
+}
+
+Eigen::VectorXd refitted_prediction(const FittedModel& chosen, const Group& group,
+                                    const std::vector<bool>& fit_row) {
+  if (static_cast<Eigen::Index>(fit_row.size()) != group.time.size())
+    throw core::DataError("refit mask of " + std::to_string(fit_row.size()) + " rows on group '" +
+                          group.name + "' of " + std::to_string(group.time.size()) + " samples");
+  const Eigen::MatrixXd x = feature_matrix(chosen.features, group);
+  const Eigen::VectorXd e = group.error.col(chosen.target);
+  if (const auto* network = std::get_if<torchnet::Network>(&chosen.body)) {
+    torchnet::Sequences fit;
+    for (Eigen::Index i = 0; i < x.rows();) {
+      Eigen::Index j = i;
+      while (j < x.rows() && fit_row[static_cast<std::size_t>(j)]) ++j;
+      if (j - i >= 2) {
+        fit.inputs.push_back(x.middleRows(i, j - i));
+        fit.outputs.push_back(e.segment(i, j - i));
+      }
+      i = j + 1;
+    }
+    return torchnet::trained_network(fit, {}, network->options()).prediction(x).col(0);
+  }
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    if (fit_row[static_cast<std::size_t>(i)]) rows.push_back(i);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) y(static_cast<Eigen::Index>(i)) = e(rows[i]);
+  return body_prediction(body_fit(chosen.spec, selected_rows(x, rows), y), x);
+}
+
+ModelSpec network_spec(const torchnet::NetworkOptions& options, double window_span_s,
+                       const std::string& sensor_method) {
+  ModelSpec spec;
+  spec.kind = ModelKind::cnn_bigru_attention;
+  spec.network.options = options;
+  spec.network.window_span_s = window_span_s;
+  spec.sensor_method = sensor_method;
+  spec.reject_gross_errors = false;
+  return spec;
 }
 
 Eigen::VectorXd predicted_error(const FittedModel& model, const Group& group) {

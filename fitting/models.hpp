@@ -13,6 +13,7 @@
 #include "fitting/linear.hpp"
 #include "fitting/metrics.hpp"
 #include "fitting/ppr.hpp"
+#include "fitting/torch/network.hpp"
 
 namespace tt::fitting {
 
@@ -27,6 +28,17 @@ enum class ModelKind {
   projection_pursuit,
   /// linear in ΔT_k and in ΔT_k low-pass filtered with each of time_constants (distributed lags)
   distributed_lag,
+  /// the gantry patent's CNN-BiGRU-attention network on windows of the increments (seed 004)
+  cnn_bigru_attention,
+};
+
+/// Settings of cnn_bigru_attention.
+struct NetworkSettings {
+  /// the network's structure and training; window_stride is derived from window_span_s
+  torchnet::NetworkOptions options;
+  /// time an input window spans [s]: the stride between its entries is this over
+  /// (window_steps − 1), in samples of the fitting groups' median interval
+  double window_span_s = 1800.0;
 };
 
 /// A model type with its settings: one candidate of the selection.
@@ -38,14 +50,21 @@ struct ModelSpec {
   std::vector<double> time_constants;
   /// settings of projection_pursuit
   PprOptions ppr;
+  /// settings of cnn_bigru_attention
+  NetworkSettings network;
+  /// when not empty, the selection tries this spec only with sensor sets of this method (a
+  /// network is trained on one sensor set, not on every set of every method)
+  std::string sensor_method;
   /// the standard's 3σ criterion on the fitting samples (6.2.2): refit and drop samples whose
-  /// residual exceeds 3 residual standard deviations until none does
+  /// residual exceeds 3 residual standard deviations until none does (not for the network, which
+  /// is trained once)
   bool reject_gross_errors = true;
   /// read the groups' operating inputs (spindle speed) beside the temperatures, as increments
   bool use_inputs = false;
 };
 
-/// "no_compensation", "least_squares", "ridge", "projection_pursuit" or "distributed_lag".
+/// "no_compensation", "least_squares", "ridge", "projection_pursuit", "distributed_lag" or
+/// "cnn_bigru_attention".
 std::string kind_name(ModelKind kind);
 
 /// A short label naming the kind and its settings, e.g. "ridge(lambda=0.001)".
@@ -72,8 +91,9 @@ struct FittedModel {
   FeatureMap features;
   int target = 0;
   std::string target_name;
-  /// LinearFit for least_squares, ridge and distributed_lag; PprModel for projection_pursuit
-  std::variant<LinearFit, PprModel> body;
+  /// LinearFit for least_squares, ridge and distributed_lag; PprModel for projection_pursuit;
+  /// a Network with one output for cnn_bigru_attention
+  std::variant<LinearFit, PprModel, torchnet::Network> body;
   GrossErrorRejection rejection;
   /// names of the groups the coefficients were fitted on
   std::vector<std::string> fitted_on;
@@ -83,6 +103,18 @@ struct FittedModel {
 /// Throws DataError on inconsistent groups or too few samples.
 FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
                          const std::vector<int>& sensors, int target);
+
+/// The model's form refitted on the rows of `group` where fit_row is true (#samples), predicting
+/// every row of the group: #samples [m]. The features run from the group's first reading, so a
+/// window of rows can be held out of a continuous run. The network trains on each unbroken run of
+/// fitting rows as a sequence.
+Eigen::VectorXd refitted_prediction(const FittedModel& chosen, const Group& group,
+                                    const std::vector<bool>& fit_row);
+
+/// The network candidate of the patent: cnn_bigru_attention with `options`, tried with the sensor
+/// sets of `sensor_method` only.
+ModelSpec network_spec(const torchnet::NetworkOptions& options, double window_span_s,
+                       const std::string& sensor_method);
 
 /// #samples predicted error of the model's target on a group [m].
 Eigen::VectorXd predicted_error(const FittedModel& model, const Group& group);

@@ -46,6 +46,13 @@ Selection selection_on_validation(const std::vector<Group>& fitting,
     CandidateResult& c = selection.candidates[static_cast<std::size_t>(i)];
     c.sensor_set = static_cast<int>(static_cast<std::size_t>(i) / specs.size());
     c.spec = static_cast<int>(static_cast<std::size_t>(i) % specs.size());
+    const ModelSpec& spec = specs[static_cast<std::size_t>(c.spec)];
+    const SensorSet& set = sensor_sets[static_cast<std::size_t>(c.sensor_set)];
+    if (!spec.sensor_method.empty() && spec.sensor_method != set.method) {
+      c.failure = "not tried: '" + model_label(spec) + "' pairs with '" + spec.sensor_method +
+                  "' sensor sets only";
+      return;
+    }
     try {
       c.model = fitted_model(specs[static_cast<std::size_t>(c.spec)], fitting,
                              sensor_sets[static_cast<std::size_t>(c.sensor_set)].sensors, target);

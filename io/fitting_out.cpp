@@ -62,6 +62,24 @@ json settings_json(const fitting::ModelSpec& spec) {
       s["refine"] = spec.ppr.refine;
       s["seed"] = spec.ppr.seed;
       break;
+    case fitting::ModelKind::cnn_bigru_attention: {
+      const auto& o = spec.network.options;
+      s["window_steps"] = o.window_steps;
+      s["window_span_s"] = spec.network.window_span_s;
+      s["conv_channels"] = o.conv_channels;
+      s["kernel_size"] = o.kernel_size;
+      s["gru_hidden"] = o.gru_hidden;
+      s["gru_layers"] = o.gru_layers;
+      s["max_epochs"] = o.max_epochs;
+      s["patience"] = o.patience;
+      s["batch_size"] = o.batch_size;
+      s["learning_rate"] = o.learning_rate;
+      s["time_budget_s"] = o.time_budget_s;
+      s["seed"] = o.seed;
+      s["threads"] = o.threads;
+      s["sensor_method"] = spec.sensor_method;
+      break;
+    }
   }
   return s;
 }
@@ -125,6 +143,11 @@ std::string equation_text(const FittedModel& model) {
     out << "   (coefficients in um/K, dT in K)";
     return out.str();
   }
+  if (std::holds_alternative<torchnet::Network>(model.body)) {
+    out << "E_" << model.target_name << " = CNN-BiGRU-attention network on windows of dT of "
+        << joined(model.features.sensor_names) << " (TorchScript file and JSON record)";
+    return out.str();
+  }
   const auto& ppr = std::get<fitting::PprModel>(model.body);
   out << "E_" << model.target_name << " [um] = " << ppr.mean * um << " + sum of "
       << ppr.terms.size() << " polynomial ridge functions of projections of "
@@ -154,6 +177,30 @@ json model_json(const FittedModel& model) {
            {"um_per_K", number(linear->coefficients(static_cast<Eigen::Index>(k)) * um)}});
     j["intercept_um"] = number(linear->intercept * um);
     j["terms"] = terms;
+    return j;
+  }
+  if (const auto* network = std::get_if<torchnet::Network>(&model.body)) {
+    const auto& o = network->options();
+    const auto& r = network->report();
+    j["inputs"] = fitting::feature_names(model.features);
+    j["window_steps"] = o.window_steps;
+    j["window_stride_samples"] = o.window_stride;
+    j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;
+    j["input_mean_K"] = vector_json(network->input_mean());
+    j["input_scale_K"] = vector_json(network->input_scale());
+    j["output_mean_um"] = vector_json(network->output_mean(), um);
+    j["output_scale_um"] = vector_json(network->output_scale(), um);
+    j["training"] = {{"epochs", r.epochs},
+                     {"best_epoch", r.best_epoch},
+                     {"validation_loss_standardised", number(r.validation_loss)},
+                     {"seconds", number(r.seconds)},
+                     {"time_budget_reached", r.budget_reached},
+                     {"training_windows", r.training_windows},
+                     {"validation_windows", r.validation_windows}};
+    j["note"] =
+        "TorchScript forward(x): x float32 batch x window_steps x inputs, the increments dT [K] "
+        "of the inputs at rows i - (window_steps-1-j)*window_stride_samples (the first row "
+        "repeated before the group's start); returns batch x 1 error [m]; standardisation inside";
     return j;
   }
   const auto& ppr = std::get<fitting::PprModel>(model.body);

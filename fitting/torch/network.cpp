@@ -1,0 +1,544 @@
+#include "fitting/torch/network.hpp"
+
+#include <ATen/CPUGeneratorImpl.h>
+#include <ATen/Parallel.h>
+#include <omp.h>
+#include <torch/script.h>
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace tt::torchnet {
+
+namespace {
+
+/// Torch's thread count is process-wide and, with its OpenMP backend, set_num_threads also sets
+/// the calling thread's OpenMP team size: every torch call holds this lock and restores the
+/// caller's team size afterwards, so the project's own parallel loops keep their threads.
+std::mutex& torch_lock() {
+  static std::mutex m;
+  return m;
+}
+
+class TorchThreads {
+ public:
+  // at::set_num_threads also resizes torch's pthreadpool, which is rebuilt on every change: it is
+  // called only when the count changes; the OpenMP team size that torch's parallel loops read is
+  // set (and restored) on every call, which costs nothing.
+  explicit TorchThreads(int threads) : lock_(torch_lock()), saved_(omp_get_max_threads()) {
+    static int torch_threads = 0;  // guarded by the lock
+    threads = std::max(1, threads);
+    if (torch_threads != threads) {
+      at::set_num_threads(threads);
+      torch_threads = threads;
+    }
+    omp_set_num_threads(threads);
+  }
+  ~TorchThreads() { omp_set_num_threads(std::max(1, saved_)); }
+  TorchThreads(const TorchThreads&) = delete;
+  TorchThreads& operator=(const TorchThreads&) = delete;
+
+ private:
+  std::lock_guard<std::mutex> lock_;
+  int saved_;
+};
+
+struct NetImpl : torch::nn::Module {
+  NetImpl(int inputs, int outputs, const NetworkOptions& o)
+      : conv1(register_module("conv1", torch::nn::Conv1d(torch::nn::Conv1dOptions(
+                                                             inputs, o.conv_channels, o.kernel_size)
+                                                             .padding(o.kernel_size / 2)))),
+        conv2(register_module(
+            "conv2", torch::nn::Conv1d(
+                         torch::nn::Conv1dOptions(o.conv_channels, o.conv_channels, o.kernel_size)
+                             .padding(o.kernel_size / 2)))),
+        norm(register_module("norm", torch::nn::BatchNorm1d(o.conv_channels))),
+        gru(register_module("gru",
+                            torch::nn::GRU(torch::nn::GRUOptions(o.conv_channels, o.gru_hidden)
+                                               .num_layers(o.gru_layers)
+                                               .bidirectional(true)
+                                               .batch_first(true)))),
+        key(register_module("key", torch::nn::Linear(2 * o.gru_hidden, 2 * o.gru_hidden))),
+        head(register_module("head", torch::nn::Linear(2 * o.gru_hidden, outputs))) {}
+
+  /// x: batch x steps x inputs, standardised; returns batch x outputs, standardised.
+  torch::Tensor forward(torch::Tensor x) {
+    x = x.transpose(1, 2);
+    x = torch::relu(conv1->forward(x));
+    x = torch::relu(conv2->forward(x));
+    x = norm->forward(torch::max_pool1d(x, {2}, {2})).transpose(1, 2);
+    const torch::Tensor y = std::get<0>(gru->forward(x));
+    const torch::Tensor c = y.select(1, -1);
+    // Feature attention: the weight of each of the 2·hidden features is the softmax of its term
+    // of the dot product between the last GRU output and a learned projection of it; scaled so
+    // that equal weights leave the output unchanged.
+    const torch::Tensor a = torch::softmax(c * key->forward(c), 1);
+    return head->forward(a * c * static_cast<double>(c.size(1)));
+  }
+
+  torch::nn::Conv1d conv1, conv2;
+  // Batch normalisation, not layer normalisation: once trained it is a fixed affine map, so the
+  // features keep the amplitude of the temperature rise (layer normalisation over the channels
+  // would divide it out at every time step).
+  torch::nn::BatchNorm1d norm;
+  torch::nn::GRU gru;
+  torch::nn::Linear key, head;
+};
+TORCH_MODULE(Net);
+
+/// The same forward in TorchScript, reading the parameters registered by script_module.
+std::string script_source(const NetworkOptions& o, int gru_tensors) {
+  std::ostringstream s;
+  const int pad = o.kernel_size / 2;
+  s << "def forward(self, x: Tensor) -> Tensor:\n"
+    << "    x = (x - self.in_mean) / self.in_scale\n"
+    << "    x = x.transpose(1, 2)\n"
+    << "    x = torch.relu(torch.conv1d(x, self.conv1_w, self.conv1_b, [1], [" << pad << "]))\n"
+    << "    x = torch.relu(torch.conv1d(x, self.conv2_w, self.conv2_b, [1], [" << pad << "]))\n"
+    << "    x = torch.max_pool1d(x, [2], [2])\n"
+    << "    x = torch.batch_norm(x, self.norm_w, self.norm_b, self.norm_mean, self.norm_var, "
+       "False, 0.1, 1e-05, False).transpose(1, 2)\n"
+    << "    h0 = torch.zeros([" << 2 * o.gru_layers << ", x.size(0), " << o.gru_hidden
+    << "], dtype=x.dtype)\n"
+    << "    y, h = torch.gru(x, h0, [";
+  for (int i = 0; i < gru_tensors; ++i) s << (i ? ", " : "") << "self.gru_" << i;
+  s << "], True, " << o.gru_layers << ", 0.0, False, True, True)\n"
+    << "    c = y[:, -1, :]\n"
+    << "    a = torch.softmax(c * torch.linear(c, self.key_w, self.key_b), 1)\n"
+    << "    z = torch.linear(a * c * " << 2 * o.gru_hidden << ".0, self.head_w, self.head_b)\n"
+    << "    return z * self.out_scale + self.out_mean\n";
+  return s.str();
+}
+
+torch::Tensor float_tensor(const Eigen::VectorXd& v) {
+  torch::Tensor t = torch::empty({v.size()}, torch::kFloat32);
+  for (Eigen::Index i = 0; i < v.size(); ++i) t[i] = static_cast<float>(v(i));
+  return t;
+}
+
+torch::jit::Module script_module(Net& net, const NetworkOptions& o, const Eigen::VectorXd& in_mean,
+                                 const Eigen::VectorXd& in_scale, const Eigen::VectorXd& out_mean,
+                                 const Eigen::VectorXd& out_scale) {
+  torch::jit::Module m("ThermotwinCnnBiGruAttention");
+  const auto param = [&](const std::string& name, const torch::Tensor& t) {
+    m.register_parameter(name, t.detach().clone(), false);
+  };
+  m.register_buffer("in_mean", float_tensor(in_mean));
+  m.register_buffer("in_scale", float_tensor(in_scale));
+  m.register_buffer("out_mean", float_tensor(out_mean));
+  m.register_buffer("out_scale", float_tensor(out_scale));
+  m.register_attribute("window_steps", c10::IntType::get(), o.window_steps);
+  m.register_attribute("window_stride", c10::IntType::get(), o.window_stride);
+  param("conv1_w", net->conv1->weight);
+  param("conv1_b", net->conv1->bias);
+  param("conv2_w", net->conv2->weight);
+  param("conv2_b", net->conv2->bias);
+  param("norm_w", net->norm->weight);
+  param("norm_b", net->norm->bias);
+  m.register_buffer("norm_mean", net->norm->running_mean.detach().clone());
+  m.register_buffer("norm_var", net->norm->running_var.detach().clone());
+  const std::vector<torch::Tensor> gru = net->gru->all_weights();
+  for (std::size_t i = 0; i < gru.size(); ++i) param("gru_" + std::to_string(i), gru[i]);
+  param("key_w", net->key->weight);
+  param("key_b", net->key->bias);
+  param("head_w", net->head->weight);
+  param("head_b", net->head->bias);
+  m.define(script_source(o, static_cast<int>(gru.size())));
+  m.eval();
+  return m;
+}
+
+/// Standard deviation, or 1 for a constant column so that it standardises to zeros.
+Eigen::VectorXd column_scale(const Eigen::MatrixXd& rows, const Eigen::VectorXd& mean) {
+  Eigen::VectorXd scale(rows.cols());
+  for (Eigen::Index c = 0; c < rows.cols(); ++c) {
+    const double sd = std::sqrt((rows.col(c).array() - mean(c)).square().mean());
+    scale(c) = sd > 1e-12 * std::max(1.0, std::abs(mean(c))) ? sd : 1.0;
+  }
+  return scale;
+}
+
+Eigen::MatrixXd stacked(const std::vector<Eigen::MatrixXd>& parts) {
+  Eigen::Index rows = 0;
+  for (const auto& p : parts) rows += p.rows();
+  Eigen::MatrixXd out(rows, parts.front().cols());
+  Eigen::Index r = 0;
+  for (const auto& p : parts) {
+    out.middleRows(r, p.rows()) = p;
+    r += p.rows();
+  }
+  return out;
+}
+
+/// Windows (steps x #inputs) ending at every train_every-th row of [begin, end) of one group,
+/// appended to `x`, and the outputs at those rows appended to `y`; all standardised, float.
+void append_windows(const Eigen::MatrixXd& inputs, const Eigen::MatrixXd& outputs,
+                    Eigen::Index begin, Eigen::Index end, const NetworkOptions& o,
+                    const Eigen::VectorXd& in_mean, const Eigen::VectorXd& in_scale,
+                    const Eigen::VectorXd& out_mean, const Eigen::VectorXd& out_scale,
+                    std::vector<float>& x, std::vector<float>& y) {
+  const int every = o.train_every > 0 ? o.train_every : o.window_stride;
+  for (Eigen::Index i = begin; i < end; i += every) {
+    for (int j = 0; j < o.window_steps; ++j) {
+      const Eigen::Index r = std::max<Eigen::Index>(
+          0, i - static_cast<Eigen::Index>(o.window_steps - 1 - j) * o.window_stride);
+      for (Eigen::Index c = 0; c < inputs.cols(); ++c)
+        x.push_back(static_cast<float>((inputs(r, c) - in_mean(c)) / in_scale(c)));
+    }
+    for (Eigen::Index c = 0; c < outputs.cols(); ++c)
+      y.push_back(static_cast<float>((outputs(i, c) - out_mean(c)) / out_scale(c)));
+  }
+}
+
+torch::Tensor tensor_of(std::vector<float>& values, std::vector<int64_t> shape) {
+  return torch::from_blob(values.data(), shape, torch::kFloat32).clone();
+}
+
+void require_sequences(const Sequences& s, const std::string& what, int inputs, int outputs) {
+  if (s.inputs.size() != s.outputs.size())
+    throw core::DataError(what + ": " + std::to_string(s.inputs.size()) + " input and " +
+                          std::to_string(s.outputs.size()) +
+                          " output sequences; expected one of each per group");
+  for (std::size_t g = 0; g < s.inputs.size(); ++g) {
+    const auto& x = s.inputs[g];
+    const auto& y = s.outputs[g];
+    if (x.rows() != y.rows() || x.rows() < 1 || x.cols() != inputs || y.cols() != outputs)
+      throw core::DataError(what + " group " + std::to_string(g) + ": " + std::to_string(x.rows()) +
+                            "x" + std::to_string(x.cols()) + " inputs and " +
+                            std::to_string(y.rows()) + "x" + std::to_string(y.cols()) +
+                            " outputs; expected the same rows, " + std::to_string(inputs) +
+                            " input and " + std::to_string(outputs) + " output columns");
+    if (!x.allFinite() || !y.allFinite())
+      throw core::DataError(what + " group " + std::to_string(g) +
+                            ": a non-finite value; hint: drop incomplete rows first");
+  }
+}
+
+void require_options(const NetworkOptions& o) {
+  const auto bad = [](const std::string& key, double v, const std::string& expected) {
+    throw core::DataError("network option " + key + " = " + std::to_string(v) + ": expected " +
+                          expected);
+  };
+  if (o.window_steps < 2) bad("window_steps", o.window_steps, ">= 2 (pooling halves it)");
+  if (o.window_stride < 1) bad("window_stride", o.window_stride, ">= 1");
+  if (o.train_every < 0) bad("train_every", o.train_every, ">= 0 (0: window_stride)");
+  if (o.conv_channels < 1) bad("conv_channels", o.conv_channels, ">= 1");
+  if (o.kernel_size < 1 || o.kernel_size % 2 == 0) bad("kernel_size", o.kernel_size, "odd, >= 1");
+  if (o.gru_hidden < 1) bad("gru_hidden", o.gru_hidden, ">= 1");
+  if (o.gru_layers < 1) bad("gru_layers", o.gru_layers, ">= 1");
+  if (o.max_epochs < 1) bad("max_epochs", o.max_epochs, ">= 1");
+  if (o.patience < 1) bad("patience", o.patience, ">= 1");
+  if (o.batch_size < 1) bad("batch_size", o.batch_size, ">= 1");
+  if (!(o.learning_rate > 0.0)) bad("learning_rate", o.learning_rate, "> 0");
+  if (!(o.time_budget_s > 0.0)) bad("time_budget_s", o.time_budget_s, "> 0");
+  if (o.threads < 1) bad("threads", o.threads, ">= 1");
+}
+
+/// Weights drawn from the network's own generator (never torch's global one), so that training
+/// is reproducible and independent of other torch users: uniform ±1/sqrt(fan-in) for weights,
+/// zero biases, unit normalisation gains.
+void initialise(Net& net, at::Generator& gen, int gru_hidden) {
+  torch::NoGradGuard no_grad;
+  for (auto& item : net->named_parameters()) {
+    const std::string& name = item.key();
+    torch::Tensor& p = item.value();
+    if (name.rfind("norm.", 0) == 0) {
+      if (name == "norm.weight")
+        p.fill_(1.0);
+      else
+        p.zero_();
+    } else if (name.find("bias") != std::string::npos) {
+      p.zero_();
+    } else {
+      const double fan_in = name.rfind("gru.", 0) == 0
+                                ? gru_hidden
+                                : static_cast<double>(p.numel() / std::max<int64_t>(1, p.size(0)));
+      const double bound = 1.0 / std::sqrt(fan_in);
+      p.uniform_(-bound, bound, gen);
+    }
+  }
+}
+
+double mean_squared(Net& net, const torch::Tensor& x, const torch::Tensor& y) {
+  torch::NoGradGuard no_grad;
+  net->eval();
+  double sum = 0.0;
+  const int64_t n = x.size(0);
+  for (int64_t b = 0; b < n; b += 4096) {
+    const int64_t e = std::min(n, b + 4096);
+    sum += (net->forward(x.slice(0, b, e)) - y.slice(0, b, e)).pow(2).sum().item<double>();
+  }
+  return sum / static_cast<double>(y.numel());
+}
+
+Eigen::MatrixXd run_script(torch::jit::Module module, std::vector<float>& windows, int64_t count,
+                           int steps, int inputs) {
+  torch::NoGradGuard no_grad;
+  const torch::Tensor x = torch::from_blob(windows.data(), {count, steps, inputs}, torch::kFloat32);
+  std::vector<torch::Tensor> parts;
+  for (int64_t b = 0; b < count; b += 8192)
+    parts.push_back(module.forward({x.slice(0, b, std::min(count, b + 8192))}).toTensor());
+  const torch::Tensor y = torch::cat(parts, 0).to(torch::kFloat64).contiguous();
+  Eigen::MatrixXd out(y.size(0), y.size(1));
+  const double* data = y.data_ptr<double>();
+  for (int64_t i = 0; i < y.size(0); ++i)
+    for (int64_t c = 0; c < y.size(1); ++c) out(i, c) = data[i * y.size(1) + c];
+  return out;
+}
+
+std::vector<float> raw_windows(const std::vector<Eigen::MatrixXd>& windows) {
+  std::vector<float> out;
+  for (const auto& w : windows)
+    for (Eigen::Index r = 0; r < w.rows(); ++r)
+      for (Eigen::Index c = 0; c < w.cols(); ++c) out.push_back(static_cast<float>(w(r, c)));
+  return out;
+}
+
+}  // namespace
+
+struct Network::Impl {
+  NetworkOptions options;
+  TrainingReport report;
+  int inputs = 0, outputs = 0;
+  Eigen::VectorXd in_mean, in_scale, out_mean, out_scale;
+  /// the trained network as TorchScript: the one inference path, in memory and on file
+  torch::jit::Module script;
+  std::vector<float> weights;
+};
+
+Network::Network(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+int Network::inputs() const {
+  return impl_->inputs;
+}
+int Network::outputs() const {
+  return impl_->outputs;
+}
+const NetworkOptions& Network::options() const {
+  return impl_->options;
+}
+const TrainingReport& Network::report() const {
+  return impl_->report;
+}
+Eigen::VectorXd Network::input_mean() const {
+  return impl_->in_mean;
+}
+Eigen::VectorXd Network::input_scale() const {
+  return impl_->in_scale;
+}
+Eigen::VectorXd Network::output_mean() const {
+  return impl_->out_mean;
+}
+Eigen::VectorXd Network::output_scale() const {
+  return impl_->out_scale;
+}
+std::vector<float> Network::flat_weights() const {
+  return impl_->weights;
+}
+
+std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
+                                        const std::vector<Eigen::Index>& rows) {
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(rows.size());
+  for (Eigen::Index i : rows) {
+    Eigen::MatrixXd w(steps, inputs.cols());
+    for (int j = 0; j < steps; ++j)
+      w.row(j) = inputs.row(
+          std::max<Eigen::Index>(0, i - static_cast<Eigen::Index>(steps - 1 - j) * stride));
+    out.push_back(std::move(w));
+  }
+  return out;
+}
+
+Eigen::MatrixXd Network::prediction(const Eigen::MatrixXd& inputs) const {
+  const Impl& n = *impl_;
+  if (inputs.cols() != n.inputs || !inputs.allFinite())
+    throw core::DataError("network prediction on " + std::to_string(inputs.cols()) +
+                          " input columns (or a non-finite value); expected " +
+                          std::to_string(n.inputs) + " finite columns");
+  if (inputs.rows() == 0) return Eigen::MatrixXd(0, n.outputs);
+  std::vector<Eigen::Index> rows(static_cast<std::size_t>(inputs.rows()));
+  for (Eigen::Index i = 0; i < inputs.rows(); ++i) rows[static_cast<std::size_t>(i)] = i;
+  std::vector<float> x =
+      raw_windows(windows_at(inputs, n.options.window_steps, n.options.window_stride, rows));
+  TorchThreads threads(n.options.threads);
+  return run_script(n.script, x, inputs.rows(), n.options.window_steps, n.inputs);
+}
+
+Eigen::VectorXd Network::window_prediction(const Eigen::MatrixXd& window) const {
+  const Impl& n = *impl_;
+  if (window.rows() != n.options.window_steps || window.cols() != n.inputs)
+    throw core::DataError("network window of " + std::to_string(window.rows()) + "x" +
+                          std::to_string(window.cols()) + "; expected " +
+                          std::to_string(n.options.window_steps) + "x" + std::to_string(n.inputs));
+  std::vector<float> x = raw_windows({window});
+  TorchThreads threads(n.options.threads);
+  return run_script(n.script, x, 1, n.options.window_steps, n.inputs).row(0).transpose();
+}
+
+void Network::save_torchscript(const std::filesystem::path& file) const {
+  const std::filesystem::path part = file.string() + ".part";
+  try {
+    TorchThreads threads(impl_->options.threads);
+    impl_->script.save(part.string());
+  } catch (const c10::Error& e) {
+    std::filesystem::remove(part);
+    throw core::DataError(file.string() +
+                          ": cannot write the TorchScript network: " + e.what_without_backtrace());
+  }
+  std::filesystem::rename(part, file);
+}
+
+Network trained_network(const Sequences& fit, const Sequences& validation,
+                        const NetworkOptions& o) {
+  require_options(o);
+  if (fit.inputs.empty())
+    throw core::DataError("network training with no fitting group; expected at least one");
+  const int inputs = static_cast<int>(fit.inputs.front().cols());
+  const int outputs = static_cast<int>(fit.outputs.empty() ? 0 : fit.outputs.front().cols());
+  if (inputs < 1 || outputs < 1)
+    throw core::DataError("network training with " + std::to_string(inputs) + " inputs and " +
+                          std::to_string(outputs) + " outputs; expected at least one of each");
+  require_sequences(fit, "network fitting", inputs, outputs);
+  require_sequences(validation, "network validation", inputs, outputs);
+
+  auto impl = std::make_shared<Network::Impl>();
+  impl->options = o;
+  impl->inputs = inputs;
+  impl->outputs = outputs;
+  const Eigen::MatrixXd x_all = stacked(fit.inputs), y_all = stacked(fit.outputs);
+  impl->in_mean = x_all.colwise().mean().transpose();
+  impl->in_scale = column_scale(x_all, impl->in_mean);
+  impl->out_mean = y_all.colwise().mean().transpose();
+  impl->out_scale = column_scale(y_all, impl->out_mean);
+
+  // Windows: every row of the fitting groups; the validation groups', or the last fifth of each
+  // fitting group's rows when there are none.
+  std::vector<float> xf, yf, xv, yv;
+  const auto add = [&](const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, Eigen::Index b,
+                       Eigen::Index e, std::vector<float>& xs, std::vector<float>& ys) {
+    append_windows(x, y, b, e, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
+                   xs, ys);
+  };
+  for (std::size_t g = 0; g < fit.inputs.size(); ++g) {
+    const Eigen::Index n = fit.inputs[g].rows();
+    const Eigen::Index cut = validation.inputs.empty() ? n - n / 5 : n;
+    add(fit.inputs[g], fit.outputs[g], 0, cut, xf, yf);
+    add(fit.inputs[g], fit.outputs[g], cut, n, xv, yv);
+  }
+  for (std::size_t g = 0; g < validation.inputs.size(); ++g)
+    add(validation.inputs[g], validation.outputs[g], 0, validation.inputs[g].rows(), xv, yv);
+  const int64_t nf = static_cast<int64_t>(yf.size()) / outputs;
+  const int64_t nv = static_cast<int64_t>(yv.size()) / outputs;
+  if (nf < 2 || nv < 1)
+    throw core::DataError("network training on " + std::to_string(nf) + " fitting and " +
+                          std::to_string(nv) +
+                          " validation windows; expected at least 2 and 1; hint: give longer "
+                          "groups");
+  impl->report.training_windows = nf;
+  impl->report.validation_windows = nv;
+
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    TorchThreads threads(o.threads);
+    const torch::Tensor x_fit = tensor_of(xf, {nf, o.window_steps, inputs});
+    const torch::Tensor y_fit = tensor_of(yf, {nf, outputs});
+    const torch::Tensor x_val = tensor_of(xv, {nv, o.window_steps, inputs});
+    const torch::Tensor y_val = tensor_of(yv, {nv, outputs});
+    at::Generator gen = at::detail::createCPUGenerator(o.seed);
+    Net net(inputs, outputs, o);
+    initialise(net, gen, o.gru_hidden);
+    torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(o.learning_rate));
+    std::vector<torch::Tensor> best;
+    double best_loss = std::numeric_limits<double>::infinity();
+    for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
+      const torch::Tensor order = torch::randperm(nf, gen, torch::TensorOptions(torch::kLong));
+      net->train();
+      for (int64_t b = 0; b < nf; b += o.batch_size) {
+        const torch::Tensor idx = order.slice(0, b, std::min(nf, b + o.batch_size));
+        adam.zero_grad();
+        const torch::Tensor loss =
+            torch::mse_loss(net->forward(x_fit.index_select(0, idx)), y_fit.index_select(0, idx));
+        loss.backward();
+        adam.step();
+      }
+      const double loss = mean_squared(net, x_val, y_val);
+      impl->report.epochs = epoch;
+      if (std::isfinite(loss) && loss < best_loss) {
+        best_loss = loss;
+        impl->report.best_epoch = epoch;
+        best.clear();
+        for (const auto& p : net->parameters()) best.push_back(p.detach().clone());
+        for (const auto& b : net->buffers()) best.push_back(b.detach().clone());
+      }
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (seconds > o.time_budget_s) {
+        impl->report.budget_reached = true;
+        break;
+      }
+      if (epoch - impl->report.best_epoch >= o.patience) break;
+    }
+    if (best.empty())
+      throw core::DataError(
+          "network training gave no finite validation loss; hint: lower learning_rate");
+    {
+      torch::NoGradGuard no_grad;
+      auto params = net->parameters();
+      const auto buffers = net->buffers();
+      for (std::size_t i = 0; i < params.size(); ++i) params[i].copy_(best[i]);
+      for (std::size_t i = 0; i < buffers.size(); ++i) buffers[i].copy_(best[params.size() + i]);
+      net->eval();
+      for (const auto& p : params) {
+        const torch::Tensor flat = p.detach().contiguous().view(-1);
+        const float* d = flat.data_ptr<float>();
+        impl->weights.insert(impl->weights.end(), d, d + flat.numel());
+      }
+    }
+    impl->report.validation_loss = best_loss;
+    impl->script =
+        script_module(net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale);
+  } catch (const c10::Error& e) {
+    throw core::DataError(std::string("network training failed in libtorch: ") +
+                          e.what_without_backtrace());
+  }
+  impl->report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Network(impl);
+}
+
+Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
+                                       const std::vector<Eigen::MatrixXd>& windows) {
+  if (windows.empty()) return Eigen::MatrixXd(0, 0);
+  const Eigen::Index steps = windows.front().rows(), inputs = windows.front().cols();
+  for (const auto& w : windows)
+    if (w.rows() != steps || w.cols() != inputs)
+      throw core::DataError("TorchScript prediction on windows of different shapes; expected " +
+                            std::to_string(steps) + "x" + std::to_string(inputs) + " each");
+  TorchThreads threads(1);
+  torch::jit::Module module;
+  try {
+    module = torch::jit::load(file.string());
+  } catch (const c10::Error& e) {
+    throw core::DataError(file.string() + ": not a TorchScript network (" +
+                          e.what_without_backtrace() + ")");
+  }
+  std::vector<float> x = raw_windows(windows);
+  return run_script(module, x, static_cast<int64_t>(windows.size()), static_cast<int>(steps),
+                    static_cast<int>(inputs));
+}
+
+std::string parallel_info() {
+  std::lock_guard<std::mutex> lock(torch_lock());
+  return at::get_parallel_info();
+}
+
+}  // namespace tt::torchnet

@@ -1,0 +1,118 @@
+// The gantry patent's CNN-BiGRU-attention thermal-error network (seed 004), on libtorch, behind a
+// plain C++ interface: nothing outside fitting/torch/ includes a torch header.
+// Structure: standardised input windows -> two 1-D convolutions (ReLU) -> max pooling by 2 ->
+// batch normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
+// dimension of the last GRU output -> one fully connected layer to every output at once.
+// Trained on CPU with Adam on the mean squared standardised error, early stopping on validation
+// windows and a time budget. The same seed and thread count give the same weights.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tt::torchnet {
+
+struct NetworkOptions {
+  /// entries of an input window, the last one the sample predicted
+  int window_steps = 16;
+  /// samples between two entries of a window
+  int window_stride = 1;
+  /// training and early-stopping windows end every this many samples (0: window_stride):
+  /// neighbouring windows of a finely sampled run are nearly the same, and training on each one
+  /// costs time without adding information
+  int train_every = 0;
+  /// channels of both convolutions
+  int conv_channels = 16;
+  /// odd convolution kernel size
+  int kernel_size = 3;
+  /// GRU state size per direction
+  int gru_hidden = 16;
+  int gru_layers = 2;
+  int max_epochs = 200;
+  /// epochs without a better validation loss before training stops
+  int patience = 25;
+  int batch_size = 64;
+  double learning_rate = 3e-3;
+  /// wall-clock limit of training [s]; reaching it ends training with the best weights so far
+  /// (then the result depends on the machine's speed: the report says so)
+  double time_budget_s = 300.0;
+  std::uint64_t seed = 1;
+  /// torch intra-op threads while training and predicting; 1 keeps the result independent of
+  /// the caller's OpenMP team (inside a parallel region torch runs serially anyway)
+  int threads = 1;
+};
+
+/// Sequences of several groups (runs): per group #samples x #inputs and #samples x #outputs,
+/// rows equally spaced in time.
+struct Sequences {
+  std::vector<Eigen::MatrixXd> inputs;
+  std::vector<Eigen::MatrixXd> outputs;
+};
+
+struct TrainingReport {
+  int epochs = 0;
+  /// epoch (1-based) whose weights were kept
+  int best_epoch = 0;
+  /// mean squared standardised error on the validation windows at best_epoch
+  double validation_loss = 0.0;
+  double seconds = 0.0;
+  bool budget_reached = false;
+  long training_windows = 0;
+  long validation_windows = 0;
+};
+
+/// A trained network; copies share the (immutable) weights.
+class Network {
+ public:
+  /// #samples x #outputs: at each sample the prediction from the window ending there (entries
+  /// before the first sample repeat the first row). inputs: #samples x #inputs.
+  Eigen::MatrixXd prediction(const Eigen::MatrixXd& inputs) const;
+  /// #outputs from one window, window_steps x #inputs: the real-time call.
+  Eigen::VectorXd window_prediction(const Eigen::MatrixXd& window) const;
+  /// The network as TorchScript, with the standardisation inside: forward(x) takes a float32
+  /// batch x window_steps x #inputs tensor in the training inputs' units and returns batch x
+  /// #outputs in the outputs' units. Written to a temporary name and renamed.
+  void save_torchscript(const std::filesystem::path& file) const;
+
+  int inputs() const;
+  int outputs() const;
+  const NetworkOptions& options() const;
+  const TrainingReport& report() const;
+  /// #inputs mean and scale of the standardisation (x - mean) / scale, and #outputs likewise.
+  Eigen::VectorXd input_mean() const;
+  Eigen::VectorXd input_scale() const;
+  Eigen::VectorXd output_mean() const;
+  Eigen::VectorXd output_scale() const;
+  /// Every weight in a fixed order: for comparing two trainings.
+  std::vector<float> flat_weights() const;
+
+  struct Impl;
+  explicit Network(std::shared_ptr<const Impl> impl);
+
+ private:
+  std::shared_ptr<const Impl> impl_;
+};
+
+/// Trains on the windows of `fit` and stops early on those of `validation`; with no validation
+/// sequences the last fifth of each fitting group's windows validates (and is not trained on).
+/// Throws core::DataError on inconsistent sizes, non-finite values or too few windows.
+Network trained_network(const Sequences& fit, const Sequences& validation,
+                        const NetworkOptions& options);
+
+/// Loads a file written by save_torchscript with torch::jit::load and runs it on windows (each
+/// window_steps x #inputs): #windows x #outputs. What another program does with the file.
+Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
+                                       const std::vector<Eigen::MatrixXd>& windows);
+
+/// The window ending at each of the rows `rows` of `inputs` (window_steps x #inputs each).
+std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
+                                        const std::vector<Eigen::Index>& rows);
+
+/// libtorch's report of its threading backend and thread counts, for benchmark records.
+std::string parallel_info();
+
+}  // namespace tt::torchnet

@@ -1,0 +1,132 @@
+// The CNN-BiGRU-attention model kind (seed 004) on a short synthetic campaign: it learns a lagged
+// response better than a constant, gives the same weights and predictions twice for one seed,
+// round-trips through its TorchScript file, and is tried only with its own sensor sets.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/errors.hpp"
+#include "fitting/models.hpp"
+#include "fitting/selection.hpp"
+#include "fitting/torch/network.hpp"
+#include "tests/fitting/synthetic.hpp"
+
+using namespace tt::fitting;
+using tt::fitting::test::campaign;
+using tt::fitting::test::increment;
+
+namespace {
+
+constexpr double um = 1e-6;
+
+Eigen::VectorXd lagged_truth(const Group& g) {
+  return 1.5 * um * low_pass(g.time, increment(g, 0), 2400.0).array() +
+         0.5 * um * increment(g, 3).array();
+}
+
+/// A network small enough to train in seconds on 2 shared cores.
+ModelSpec small_network(const std::string& method = "") {
+  tt::torchnet::NetworkOptions o;
+  o.window_steps = 8;
+  o.conv_channels = 8;
+  o.gru_hidden = 8;
+  o.max_epochs = 40;
+  o.patience = 10;
+  o.batch_size = 32;
+  o.learning_rate = 5e-3;
+  o.seed = 7;
+  return network_spec(o, 3600.0, method);
+}
+
+/// S_M of predicting each group's mean error: what a model must beat to be worth anything.
+double constant_sm(const std::vector<Group>& groups) {
+  std::vector<double> s;
+  for (const Group& g : groups) {
+    const Eigen::VectorXd e = g.error.col(0);
+    s.push_back(residual_std((e.array() - e.mean()).matrix()));
+  }
+  return accuracy(s).sm;
+}
+
+class Network : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    groups_ = new std::vector<Group>(campaign(6, 91, lagged_truth, 0.1 * um, 4));
+    model_ = new FittedModel(
+        fitted_model(small_network(), group_subset(*groups_, {0, 1, 2, 3}), {0, 1, 2, 3}, 0));
+  }
+  static void TearDownTestSuite() {
+    delete model_;
+    delete groups_;
+  }
+  static std::vector<Group>* groups_;
+  static FittedModel* model_;
+};
+std::vector<Group>* Network::groups_ = nullptr;
+FittedModel* Network::model_ = nullptr;
+
+}  // namespace
+
+TEST_F(Network, BeatsAConstantOnHeldOutGroups) {
+  const auto held_out = group_subset(*groups_, {4, 5});
+  const Accuracy a = model_accuracy(*model_, held_out);
+  EXPECT_LT(a.sm, 0.5 * constant_sm(held_out))
+      << "network S_M " << a.sm / um << " um, constant " << constant_sm(held_out) / um << " um";
+}
+
+TEST_F(Network, SameSeedSameWeightsAndPredictions) {
+  const FittedModel again =
+      fitted_model(small_network(), group_subset(*groups_, {0, 1, 2, 3}), {0, 1, 2, 3}, 0);
+  const auto& a = std::get<tt::torchnet::Network>(model_->body);
+  const auto& b = std::get<tt::torchnet::Network>(again.body);
+  ASSERT_FALSE(a.flat_weights().empty());
+  EXPECT_EQ(a.flat_weights(), b.flat_weights());
+  EXPECT_EQ(a.report().epochs, b.report().epochs);
+  const Eigen::VectorXd pa = predicted_error(*model_, (*groups_)[5]);
+  const Eigen::VectorXd pb = predicted_error(again, (*groups_)[5]);
+  EXPECT_EQ(pa, pb);
+}
+
+TEST_F(Network, TorchScriptFileGivesTheSamePredictions) {
+  const auto& net = std::get<tt::torchnet::Network>(model_->body);
+  const auto file = std::filesystem::path(TT_BINARY_DIR) / "test_network_model.pt";
+  net.save_torchscript(file);
+  const Group& g = (*groups_)[5];
+  const Eigen::MatrixXd x = feature_matrix(model_->features, g);
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < x.rows(); i += 7) rows.push_back(i);
+  const auto windows =
+      tt::torchnet::windows_at(x, net.options().window_steps, net.options().window_stride, rows);
+  const Eigen::MatrixXd loaded = tt::torchnet::torchscript_prediction(file, windows);
+  const Eigen::VectorXd in_memory = predicted_error(*model_, g);
+  ASSERT_EQ(loaded.rows(), static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_NEAR(loaded(static_cast<Eigen::Index>(k), 0), in_memory(rows[k]), 1e-4 * um);
+    EXPECT_NEAR(net.window_prediction(windows[k])(0), in_memory(rows[k]), 1e-4 * um);
+  }
+  std::filesystem::remove(file);
+}
+
+TEST_F(Network, TriedOnlyWithItsSensorMethod) {
+  const std::vector<SensorSet> sets{{"correlation", {0, 3}}, {"grey_relational", {0, 1, 3}}};
+  const Selection s =
+      selection_on_validation(group_subset(*groups_, {0, 1, 2}), group_subset(*groups_, {3}), 0,
+                              sets, {ModelSpec{}, small_network("grey_relational")});
+  ASSERT_EQ(s.candidates.size(), 4u);
+  EXPECT_FALSE(s.candidates[1].model.has_value());  // network x correlation
+  EXPECT_NE(s.candidates[1].failure.find("not tried"), std::string::npos);
+  ASSERT_TRUE(s.candidates[3].model.has_value()) << s.candidates[3].failure;
+  EXPECT_EQ(s.candidates[3].model->features.sensors, (std::vector<int>{0, 1, 3}));
+}
+
+TEST(NetworkOptions, BadSettingsNameTheKey) {
+  const auto groups = campaign(3, 5, lagged_truth, 0.1 * um, 4);
+  ModelSpec spec = small_network();
+  spec.network.options.kernel_size = 4;
+  try {
+    fitted_model(spec, groups, {0, 1}, 0);
+    FAIL() << "an even kernel was accepted";
+  } catch (const tt::core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("kernel_size = 4"), std::string::npos) << e.what();
+  }
+}
