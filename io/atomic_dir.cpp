@@ -166,11 +166,13 @@ int locked_file(const fs::path& lock_file, const fs::path& dir) {
 
 // ---- Clean-up on SIGINT/SIGTERM/SIGHUP: only async-signal-safe calls below. ----
 
-/// The DIR.partial and DIR.lock of a live OutputDir, as C strings a signal handler can read.
+/// The DIR.partial, DIR.lock and DIR.checkpoint.tmp (a checkpoint being saved) of a live
+/// OutputDir, as C strings a signal handler can read.
 struct SignalSlot {
   volatile sig_atomic_t used = 0;
   char partial[PATH_MAX] = {};
   char lock[PATH_MAX] = {};
+  char checkpoint_tmp[PATH_MAX] = {};
 };
 SignalSlot g_slots[4];
 
@@ -214,19 +216,23 @@ extern "C" void remove_outputs_and_end(int sig) {
   for (auto& s : g_slots) {
     if (!s.used) continue;
     remove_tree(AT_FDCWD, s.partial, 0);
+    ::unlink(s.checkpoint_tmp);
     ::unlink(s.lock);
   }
   ::signal(sig, SIG_DFL);
   ::raise(sig);  // delivered when the handler returns: the process ends as the signal would
 }
 
-int register_for_signals(const fs::path& partial, const fs::path& lock) {
-  const std::string p = partial.string(), l = lock.string();
-  if (p.size() >= PATH_MAX || l.size() >= PATH_MAX) return -1;
+int register_for_signals(const fs::path& final_dir) {
+  const std::string p = sibling_path(final_dir, ".partial").string();
+  const std::string l = sibling_path(final_dir, ".lock").string();
+  const std::string c = sibling_path(final_dir, ".checkpoint.tmp").string();
+  if (c.size() >= PATH_MAX) return -1;
   for (int k = 0; k < static_cast<int>(std::size(g_slots)); ++k) {
     if (g_slots[k].used) continue;
     std::memcpy(g_slots[k].partial, p.c_str(), p.size() + 1);
     std::memcpy(g_slots[k].lock, l.c_str(), l.size() + 1);
+    std::memcpy(g_slots[k].checkpoint_tmp, c.c_str(), c.size() + 1);
     g_slots[k].used = 1;
     return k;
   }
@@ -255,6 +261,11 @@ OutputDir::OutputDir(const fs::path& final_dir, const std::vector<fs::path>& inp
       partial_(sibling_path(final_, ".partial")),
       old_(sibling_path(final_, ".old")),
       lock_(sibling_path(final_, ".lock")) {
+  for (const char* kept : {".partial", ".old", ".lock", ".checkpoint"})
+    if (final_.extension() == kept)
+      throw core::IoError("output " + final_dir.string() + ": a name ending in " + kept +
+                          " is kept for what thermotwin puts beside an output (DIR.partial, "
+                          "DIR.old, DIR.lock, DIR.checkpoint). Hint: choose another name");
   require_apart({final_, partial_, old_, lock_}, final_dir, inputs);
   std::error_code ec;
   fs::create_directories(final_.parent_path(), ec);
@@ -282,7 +293,7 @@ OutputDir::OutputDir(const fs::path& final_dir, const std::vector<fs::path>& inp
                           ", and thermotwin writes its result there first. Hint: move " +
                           partial_.filename().string() + " away, or choose another --out");
     // From here DIR.partial is ours: a signal removes it, even before the marker is written.
-    signal_slot_ = register_for_signals(partial_, lock_);
+    signal_slot_ = register_for_signals(final_);
     fs::create_directory(partial_, ec);
     if (ec)
       throw core::IoError(partial_.string() + ": cannot create the output folder: " + ec.message());

@@ -17,6 +17,7 @@
 // - DIR.lock is locked (flock, advisory) from construction to destruction: a second command with
 //   the same DIR is refused at once, naming the process that writes it. The file is removed when
 //   the lock is released.
+// - DIR may not end in .partial, .old, .lock or .checkpoint (the names beside an output).
 // "DIR" is the absolute path without a trailing slash: `--out out/` is `--out out`.
 #pragma once
 
@@ -66,10 +67,10 @@ class OutputDir {
   bool committed_ = false;
 };
 
-/// For drivers, once at start: on SIGINT, SIGTERM or SIGHUP, remove the DIR.partial and DIR.lock
-/// of every live OutputDir, then end as the signal would have (exit status 128 + signal). DIR keeps
-/// the previous result; a run's DIR.checkpoint stays, for --resume. Signals the process ignores
-/// stay ignored.
+/// For drivers, once at start: on SIGINT, SIGTERM or SIGHUP, remove the DIR.partial, DIR.lock and
+/// DIR.checkpoint.tmp of every live OutputDir, then end as the signal would have (exit status
+/// 128 + signal). DIR keeps the previous result; a run's DIR.checkpoint stays, for --resume.
+/// Signals the process ignores stay ignored.
 void clean_up_outputs_on_signals();
 
 /// Writes `content` to path via path.tmp and a rename; when that fails, no path.tmp is left.

@@ -190,6 +190,8 @@ TEST(OutputDir, TrailingSlashNamesTheSameFolder) {
   EXPECT_EQ(read_text(dir / "res" / "a.txt"), "x");
   EXPECT_FALSE(fs::exists(dir / "res" / ".partial"));
   EXPECT_THROW(io::output_path("/"), core::IoError);
+  EXPECT_THROW(io::OutputDir(dir / "res.partial"), core::IoError);  // the names beside an output
+  EXPECT_THROW(io::OutputDir(dir / "res.old/"), core::IoError);
 }
 
 TEST(OutputDir, ASecondWriterIsRefusedAtOnceAndTheLockGoesWithTheFirst) {

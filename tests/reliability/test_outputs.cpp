@@ -325,16 +325,19 @@ TEST(Signals, InterruptWhileResultsAreWrittenLeavesThePreviousResultAndNoPartial
   }
 }
 
-TEST(Signals, InterruptDuringTheSolveLeavesNothing) {
+TEST(Signals, InterruptDuringTheSolveLeavesOnlyTheCheckpoint) {
   const fs::path dir = scratch("sigint_solve");
   const fs::path out = dir / "out";
-  const pid_t pid = start({"run", coarse_case(dir).string(), "--out", out.string(), "--quiet"});
-  ASSERT_TRUE(wait_for_path(with_suffix(out, ".partial") / ".thermotwin-partial", pid));
+  const fs::path checkpoint = with_suffix(out, ".checkpoint");
+  const pid_t pid = start({"run", coarse_case(dir).string(), "--out", out.string(), "--quiet",
+                           "--checkpoint-every-s", "0"});
+  ASSERT_TRUE(wait_for_path(checkpoint, pid)) << "the run ended before its first checkpoint";
   kill(pid, SIGINT);
   EXPECT_EQ(wait_for(pid), 128 + SIGINT);
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(with_suffix(out, ".partial")));
   EXPECT_FALSE(fs::exists(with_suffix(out, ".lock")));
+  EXPECT_TRUE(fs::is_regular_file(checkpoint)) << "--resume has nothing to continue from";
 }
 
 TEST(HostileRuns, MetaJsonThatIsAFolderIsADataErrorNamingIt) {
