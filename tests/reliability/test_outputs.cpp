@@ -366,6 +366,11 @@ TEST(HostileRuns, TheSameRunGivenTwiceIsRefusedNamingIt) {
                 {}, log),
             1);
   EXPECT_TRUE(contains(read_text(log), "given twice as --train")) << read_text(log);
+  // Held out and trained on at once: fit --data does not split a run.
+  EXPECT_EQ(run({"fit", "--data", runs.string(), "--test", again, "--out", (dir / "fit").string()},
+                {}, log),
+            1);
+  EXPECT_TRUE(contains(read_text(log), "given as --data and as --test")) << read_text(log);
   EXPECT_FALSE(fs::exists(dir / "fit"));
   EXPECT_FALSE(fs::exists(dir / "cal"));
 }
