@@ -519,7 +519,8 @@ void require_disjoint_runs(const std::vector<fs::path>& a, const std::vector<fs:
       if (same_run(x, y))
         throw core::DataError(x.string() + ": given as " + b_option + " and as " + a_option +
                               ": a run tested on what it was trained on gives a figure too good "
-                              "to be true; " + why);
+                              "to be true; " +
+                              why);
 }
 
 MeasuredRun read_measured_run(const fs::path& folder, const MeasuredReadLimits& limits) {

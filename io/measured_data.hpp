@@ -64,9 +64,8 @@ void require_distinct_runs(const std::vector<std::filesystem::path>& folders,
 /// Throws DataError naming the run when a folder of `a` (given as `a_option`) is also in `b`
 /// (given as `b_option`); `why` says how to proceed.
 void require_disjoint_runs(const std::vector<std::filesystem::path>& a,
-                           const std::vector<std::filesystem::path>& b,
-                           const std::string& a_option, const std::string& b_option,
-                           const std::string& why);
+                           const std::vector<std::filesystem::path>& b, const std::string& a_option,
+                           const std::string& b_option, const std::string& why);
 
 /// Writes a run in the same format (folder created; files via temporary names).
 void write_measured_run(const std::filesystem::path& folder, const MeasuredRun& run);
