@@ -7,13 +7,13 @@
 // and the figures residual_before_after.png and effect.png.
 #include <cctype>
 #include <chrono>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "app/commands.hpp"
 #include "calibration/calibrate.hpp"
+#include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/csv_out.hpp"
@@ -78,6 +78,16 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const auto t0 = Clock::now();
   // 1. The declared case and the measured runs.
   const core::CaseSpec declared = io::read_case(args.case_file);
+  io::require_distinct_runs(args.train, "--train");
+  io::require_distinct_runs(args.test, "--test");
+  io::require_disjoint_runs(args.test, args.train, "--test", "--train",
+                            "calibrate --case does not split a run in time (the data-driven "
+                            "calibrate, without --case, does: --split-s); hint: test on a run "
+                            "that was not trained on");
+  std::vector<std::filesystem::path> inputs = io::case_input_files(declared);
+  inputs.insert(inputs.end(), args.train.begin(), args.train.end());
+  inputs.insert(inputs.end(), args.test.begin(), args.test.end());
+  io::OutputDir out(args.out, inputs);  // refused at once, not after the calibration
   std::vector<io::MeasuredRun> train, test;
   for (const auto& f : args.train) train.push_back(io::read_measured_run(f));
   for (const auto& f : args.test) test.push_back(io::read_measured_run(f));
@@ -97,7 +107,6 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const calibration::CalibrationResult res =
       calibration::calibrate(mesh, declared, cat, test, options);
   // 4. Outputs, all or nothing.
-  io::OutputDir out(args.out);
   const auto& dir = out.path();
   std::vector<std::string> train_names;
   for (const auto& t : train) train_names.push_back(t.run);
@@ -139,11 +148,10 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
     }
   write_text(dir / "residuals.csv", csv.str());
   write_text(dir / "plot_residuals.py", kPlotScript);
-  const std::string cmd = "/usr/bin/python3 '" + (dir / "plot_residuals.py").string() + "' '" +
-                          (dir / "residuals.csv").string() + "' '" +
-                          (dir / "residual_before_after.png").string() + "' '" +
-                          (dir / "effect.png").string() + "' 2>/dev/null";
-  if (std::system(cmd.c_str()) != 0) std::cerr << "thermotwin: note: calibration figures skipped\n";
+  if (!run_python(dir / "plot_residuals.py",
+                  {(dir / "residuals.csv").string(), (dir / "residual_before_after.png").string(),
+                   (dir / "effect.png").string()}))
+    std::cerr << "thermotwin: note: calibration figures skipped\n";
 
   std::ostringstream md;
   md << "# Calibration of " << declared.name << "\n\n";

@@ -138,6 +138,11 @@ int calibrate_data_command(const CalibrateArgs& args) {
     throw core::DataError(
         "calibrate: give --train RUN... and --test RUN... (the same run in both splits it in "
         "time)");
+  io::require_distinct_runs(args.train, "--train");
+  io::require_distinct_runs(args.test, "--test");
+  std::vector<std::filesystem::path> inputs = args.train;
+  inputs.insert(inputs.end(), args.test.begin(), args.test.end());
+  io::OutputDir out(args.out, inputs);  // refused at once, not after the study
   std::vector<fitting::Segment> pieces, testing;
   bool has_speed = false;
   std::vector<io::MeasuredRun> runs;
@@ -319,7 +324,6 @@ int calibrate_data_command(const CalibrateArgs& args) {
       {"after_worse_than_before_on_test", worse}};
 
   // 4. Outputs, all or nothing.
-  io::OutputDir out(args.out);
   const auto& dir = out.path();
   io::write_json(dir / "calibration.json", doc);
   std::ostringstream md;
@@ -378,7 +382,7 @@ int calibrate_data_command(const CalibrateArgs& args) {
                     table);
       plot({"lines", csv.string(), (dir / ("residual_" + ch + ".png")).string(), "--x", "time_s",
             "--columns", "speed_krpm,measured_um,residual_before_um,residual_after_um", "--ylabel",
-            "um (speed: krpm)", "--title", "test segments, channel " + ch});
+            "um (speed: krpm)", "--title=test segments, channel " + ch});
     } else {
       Eigen::MatrixXd no_speed(table.rows(), 5);
       no_speed << table.col(0), table.rightCols(4);
@@ -388,7 +392,7 @@ int calibrate_data_command(const CalibrateArgs& args) {
                     no_speed);
       plot({"lines", csv.string(), (dir / ("residual_" + ch + ".png")).string(), "--x", "time_s",
             "--columns", "measured_um,residual_before_um,residual_after_um", "--ylabel", "um",
-            "--title", "test segments, channel " + ch});
+            "--title=test segments, channel " + ch});
     }
     md << "![" << ch << "](residual_" << ch << ".png)\n";
   }

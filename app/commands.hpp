@@ -69,7 +69,13 @@ int place_command(const PlaceArgs& args);
 int probes_command(const ProbesArgs& args);
 int run_command(const RunArgs& args);
 
-/// Runs app/plot.py with these arguments; a missing matplotlib only skips the figure.
+/// Runs `script` under /usr/bin/python3 with these arguments, from an argument vector (no shell);
+/// true when it exits 0. Its output is discarded.
+bool run_python(const std::filesystem::path& script, const std::vector<std::string>& args);
+
+/// Runs app/plot.py with these arguments; a missing matplotlib only skips the figure (a note on
+/// stderr). Values that come from the user (titles, labels, column names) are passed as
+/// "--option=value", so that one starting with '-' is not read as an option.
 void plot(const std::vector<std::string>& args);
 
 /// Progress on stderr, at most every 10 % of the simulated time.

@@ -112,6 +112,7 @@ double uncompensated_std(const std::vector<fitting::Group>& groups, const std::v
 int fit_command(const FitArgs& args) {
   // 1. The case and its mesh.
   const core::CaseSpec spec = io::read_case(args.case_file);
+  io::OutputDir out(args.out, io::case_input_files(spec));  // refused at once, not after the work
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   // 2. The virtual test campaign, with sensor noise on every reading.
   const auto runs = solvers::campaign_runs(spec, args.hours, spec.seed);
@@ -181,7 +182,6 @@ int fit_command(const FitArgs& args) {
     }
   }
   // 5. Outputs, all or nothing.
-  io::OutputDir out(args.out);
   const auto& dir = out.path();
   io::write_fit_json(dir / "fit.json", evals, tables);
   nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "fit.json"));
@@ -223,9 +223,9 @@ int fit_command(const FitArgs& args) {
     io::write_csv(dir / (stem + ".csv"), header, rows);
     std::string cols;
     for (size_t i = 1; i < header.size(); ++i) cols += (i > 1 ? "," : "") + header[i];
-    plot({"lines", (dir / (stem + ".csv")).string(), (dir / (stem + ".png")).string(), "--x", "m", "--columns",
-          cols, "--xlabel", "sensors m", "--ylabel", "test S_M [um]", "--title",
-          "test accuracy by number of sensors, target " + t.target_name});
+    plot({"lines", (dir / (stem + ".csv")).string(), (dir / (stem + ".png")).string(), "--x", "m",
+          "--columns=" + cols, "--xlabel", "sensors m", "--ylabel", "test S_M [um]",
+          "--title=test accuracy by number of sensors, target " + t.target_name});
   }
   out.commit();
   std::cerr << "thermotwin: fit: " << summary.dump() << "\n";

@@ -232,7 +232,16 @@ std::string um(double metres, int digits = 2) {
 }  // namespace
 
 int fit_data_command(const FitDataArgs& args) {
-  // 1. The runs; the held-out data; the training pieces as cross-validation blocks.
+  // 1. The runs; the held-out data; the training pieces as cross-validation blocks. The output
+  //    is claimed first: one that is refused fails before any work.
+  io::require_distinct_runs(args.runs, "--data");
+  io::require_distinct_runs(args.test_runs, "--test");
+  io::require_disjoint_runs(args.test_runs, args.runs, "--test", "--data",
+                            "fit --data does not split a run; hint: hold out a time window with "
+                            "--test-from-s/--test-to-s");
+  std::vector<std::filesystem::path> inputs = args.runs;
+  inputs.insert(inputs.end(), args.test_runs.begin(), args.test_runs.end());
+  io::OutputDir out(args.out, inputs);
   std::vector<io::MeasuredRun> runs;
   const auto read = [&](const std::filesystem::path& folder) {
     io::MeasuredReadLimits limits;
@@ -443,7 +452,6 @@ int fit_data_command(const FitDataArgs& args) {
   }
   {
     // 5. Outputs, all or nothing.
-    io::OutputDir out(args.out);
     const auto& dir = out.path();
     nlohmann::json doc = io::fit_json(evals);
     for (auto& t : doc["targets"])
@@ -570,8 +578,8 @@ int fit_data_command(const FitDataArgs& args) {
       const auto csv = dir / ("window_" + channel + ".csv");
       io::write_csv(csv, {"time_s", "measured_um", "predicted_continuous_um"}, table);
       plot({"lines", csv.string(), (dir / ("window_" + channel + ".png")).string(), "--x", "time_s",
-            "--columns", "measured_um,predicted_continuous_um", "--ylabel", channel + " [um]",
-            "--title", "test window, channel " + channel});
+            "--columns", "measured_um,predicted_continuous_um", "--ylabel=" + channel + " [um]",
+            "--title=test window, channel " + channel});
     }
     out.commit();
   }

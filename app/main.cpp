@@ -1,7 +1,8 @@
 // thermotwin: the command-line driver.
 //   thermotwin mesh CASE --out DIR   mesh a case: mesh.vtu, boundary.vtp, points.vtp, mesh_report.json
 //   thermotwin run CASE --out DIR    simulate it: fields.pvd, temperatures.csv, thermal_error.csv, summary.json
-// Errors print one line on stderr and exit non-zero; no partial output directory is left.
+// Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
+// replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "io/atomic_dir.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 
 int main(int argc, char** argv) {
@@ -115,6 +117,9 @@ int main(int argc, char** argv) {
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
 
   CLI11_PARSE(cli, argc, argv);
+  // Ctrl-C or a kill (SIGINT, SIGTERM, SIGHUP) while a command works removes its DIR.partial and
+  // DIR.lock; DIR keeps the previous result and DIR.checkpoint stays for --resume.
+  tt::io::clean_up_outputs_on_signals();
   // BLAS threads: TT_BLAS_THREADS, default 1 (see set_blas_threads).
   const char* blas = std::getenv("TT_BLAS_THREADS");
   tt::solvers::cholmod::set_blas_threads(blas ? std::max(1, std::atoi(blas)) : 1);

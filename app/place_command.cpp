@@ -6,6 +6,7 @@
 // Writes placement.json, mi_ranking.csv, candidates_mi.vtp and mi_bars_<target>.png.
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include "app/commands.hpp"
 #include "app/study.hpp"
@@ -68,14 +69,18 @@ placement::PlacementInput placement_input(const Histories& h) {
 }
 
 int place_command(const PlaceArgs& args) {
-  // 1. Candidate histories: simulate the case, or read a finished run.
+  // 1. Candidate histories: simulate the case, or read a finished run. The output is claimed
+  //    first: one that is refused fails before any work.
   core::CaseSpec spec;
   Histories h;
+  std::optional<io::OutputDir> out;
   if (!args.from_run.empty()) {
+    out.emplace(args.out, std::vector<std::filesystem::path>{args.from_run});
     h = histories_from_run(args.from_run);
     spec = io::read_case(args.from_run / "case.resolved.toml");
   } else {
     spec = io::read_case(args.case_file);
+    out.emplace(args.out, io::case_input_files(spec));
     h = simulated_histories(spec, args.quiet);
   }
   // Simulated histories are exact, and a thermal field driven by a few sources lies in a
@@ -95,8 +100,7 @@ int place_command(const PlaceArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_place).count();
 
   // 3. Outputs, all or nothing.
-  io::OutputDir out(args.out);
-  const auto& dir = out.path();
+  const auto& dir = out->path();
   nlohmann::json doc = io::placement_json(result);
   doc["sensor_noise"] = args.sensor_noise;
   doc["candidates"] = nlohmann::json::array();
@@ -125,16 +129,14 @@ int place_command(const PlaceArgs& args) {
                                   (dir / ("mi_bars_" + t.target + ".png")).string(),
                                   "--label",
                                   "id",
-                                  "--value",
-                                  "mi_bits_" + t.target,
-                                  "--title",
-                                  std::string(many ? "best 50 candidates: " : "") +
+                                  "--value=mi_bits_" + t.target,
+                                  "--title=" + std::string(many ? "best 50 candidates: " : "") +
                                       "single-sensor mutual information with " + t.target +
                                       " (formula 1)"};
     if (many) bars.insert(bars.end(), {"--sort", "--top", "50"});
     plot(bars);
   }
-  out.commit();
+  out->commit();
   std::cerr << "thermotwin: place: " << h.names.size() << " candidates x "
             << result.sample_times_s.size() << " samples, placement " << place_s << " s -> "
             << args.out.string() << "\n";

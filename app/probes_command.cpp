@@ -3,10 +3,10 @@
 //   thermotwin probes --from-run RUNDIR --out DIR       the same on a virtual signal made from a
 //                                                       finished run's probe points
 #include <iostream>
-#include <random>
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "io/atomic_dir.hpp"
 #include "io/csv_out.hpp"
 #include "probes/command.hpp"
 
@@ -18,7 +18,9 @@ int probes_command(const ProbesArgs& args) {
   options.constants.sample_rate_hz = args.sample_rate_hz;
   options.constants.probe_distance_mm = args.probe_distance_mm;
   if (!args.truth.empty()) options.truth_csv = args.truth;
-  std::filesystem::path raw = args.in, scratch;
+  // The output is claimed first: one that is refused fails before any work.
+  io::OutputDir out(args.out, {args.in, args.from_run, args.truth});
+  std::filesystem::path raw = args.in;
 
   if (!args.from_run.empty()) {
     // 1. The drift history at the run's two axial probe points (thermal_error.csv, um -> m).
@@ -43,31 +45,16 @@ int probes_command(const ProbesArgs& args) {
     setup.runout_plane2 = probes::spindle_runout(5e-6, 1.1);
     setup.runout_axial = probes::spindle_runout(1e-6, 0.0);
     setup.axial_probe = true;
-    // The virtual readings are inputs of the command: made in a scratch folder, kept in DIR.
-    scratch = std::filesystem::temp_directory_path() /
-              ("thermotwin-probes-" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(scratch);
-    raw = scratch / "virtual_raw.csv";
-    const std::filesystem::path truth = scratch / "virtual_truth.csv";
+    // The virtual readings are inputs of the command and part of its result.
+    raw = out.path() / "virtual_raw.csv";
+    const std::filesystem::path truth = out.path() / "virtual_truth.csv";
     probes::write_virtual_raw_csv(raw, setup, history, truth);
     options.truth_csv = truth;
     options.constants = {};  // the raw file's header carries them
   }
-  // 3. Align, recover drift and tilt, compare with the other alignments; write DIR atomically.
-  const probes::ProbeRunSummary summary = [&] {
-    try {
-      return probes::run_probes_command(raw, args.out, options);
-    } catch (...) {
-      if (!scratch.empty()) std::filesystem::remove_all(scratch);
-      throw;
-    }
-  }();
-  if (!scratch.empty()) {
-    for (const char* name : {"virtual_raw.csv", "virtual_truth.csv"})
-      std::filesystem::copy_file(scratch / name, args.out / name,
-                                 std::filesystem::copy_options::overwrite_existing);
-    std::filesystem::remove_all(scratch);
-  }
+  // 3. Align, recover drift and tilt, compare with the other alignments; publish DIR whole.
+  const probes::ProbeRunSummary summary = probes::run_probes_command(raw, out.path(), options);
+  out.commit();
   std::cerr << "thermotwin: probes: " << summary.readings << " readings -> " << args.out.string() << "\n";
   return 0;
 }

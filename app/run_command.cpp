@@ -8,6 +8,7 @@
 
 #include "app/commands.hpp"
 #include "app/study.hpp"
+#include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/axis_out.hpp"
 #include "io/candidates_csv.hpp"
@@ -122,13 +123,6 @@ void write_dump(const solvers::VirtualRun& run, const std::filesystem::path& pat
 
 }  // namespace
 
-void plot(const std::vector<std::string>& args) {
-  std::string cmd = "/usr/bin/python3 " TT_SOURCE_DIR "/app/plot.py";
-  for (const auto& a : args) cmd += " '" + a + "'";
-  cmd += " 2>/dev/null";
-  if (std::system(cmd.c_str()) != 0) std::cerr << "thermotwin: note: plot skipped (" << args[0] << ")\n";
-}
-
 void report_progress(const std::string& stage, double done, double total) {
   static int last_decile = -1;
   const int decile = static_cast<int>(std::floor(10 * done / total + 1e-9));
@@ -138,12 +132,12 @@ void report_progress(const std::string& stage, double done, double total) {
 }
 
 int mesh_command(const MeshArgs& args) {
-  // 1. Read and validate the case.
+  // 1. Read and validate the case; claim the output (refused at once when it is not ours).
   const core::CaseSpec spec = io::read_case(args.case_file);
+  io::OutputDir out(args.out, io::case_input_files(spec));
   // 2. Mesh all bodies into one conforming mesh.
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   // 3. Write the mesh, its boundary, the named points and the report, all or nothing.
-  io::OutputDir out(args.out);
   write_mesh_files(mesh, spec, out.path());
   out.commit();
   std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets -> "
@@ -153,8 +147,15 @@ int mesh_command(const MeshArgs& args) {
 
 int run_command(const RunArgs& args) {
   const auto t_start = Clock::now();
-  // 1. Read and validate the case.
+  // 1. Read and validate the case; claim the output and the checkpoint beside it before any
+  //    work, so that a refused or unwritable --out fails at once, not after the solve.
   const core::CaseSpec spec = io::read_case(args.case_file);
+  const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
+  std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
+  inputs.push_back(checkpoint);
+  io::OutputDir out(args.out, inputs);
+  const bool checkpoints = args.stop_after_steps > 0 || args.checkpoint_every_s >= 0;
+  if (checkpoints) io::require_writable_checkpoint(checkpoint);
   // 2. Mesh.
   const auto t_mesh = Clock::now();
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
@@ -167,8 +168,8 @@ int run_command(const RunArgs& args) {
   if (spec.placement.candidates == core::PlacementSpec::Candidates::surface)
     candidates = candidate_set(spec, mesh);
   // 3. Simulate: heat transfer, then thermo-elasticity. The time loop saves its state beside
-  //    DIR (DIR.checkpoint) so that --resume continues a run that was killed.
-  const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
+  //    DIR (DIR.checkpoint) so that --resume continues a run that was killed; a save that fails
+  //    (disk full) costs only the resume point: warned once, the run goes on.
   const io::CheckpointKey key = io::checkpoint_key(spec, mesh);
   std::optional<solvers::ThermalCheckpoint> resumed;
   if (args.resume && std::filesystem::exists(checkpoint)) {
@@ -180,10 +181,19 @@ int run_command(const RunArgs& args) {
   solvers::Checkpointing checkpointing;
   checkpointing.interval_s = args.stop_after_steps > 0 ? 0 : args.checkpoint_every_s;
   checkpointing.resume = resumed ? &*resumed : nullptr;
-  if (checkpointing.interval_s >= 0)
+  bool save_failed = false;
+  if (checkpoints)
     checkpointing.save = [&](const solvers::ThermalCheckpoint& state) {
-      io::write_checkpoint(checkpoint, key, state);
-      if (args.stop_after_steps > 0 && state.steps >= args.stop_after_steps) std::_Exit(3);  // as if killed
+      try {
+        io::write_checkpoint(checkpoint, key, state);
+      } catch (const core::IoError& e) {
+        if (!save_failed)
+          std::cerr << "thermotwin: warning: checkpoint not saved: " << e.what()
+                    << "; the run goes on (--resume would start from an earlier state)\n";
+        save_failed = true;
+      }
+      if (args.stop_after_steps > 0 && state.steps >= args.stop_after_steps)
+        std::_Exit(3);  // as if killed
     };
   const auto t_sim = Clock::now();
   const solvers::VirtualRun run = solvers::simulate(
@@ -192,7 +202,6 @@ int run_command(const RunArgs& args) {
   const double sim_s = seconds_since(t_sim);
   if (!args.dump.empty()) write_dump(run, args.dump);
   // 4. Write everything into DIR.partial, then publish it as DIR.
-  io::OutputDir out(args.out);
   const auto& dir = out.path();
   const auto t_write = Clock::now();
   write_mesh_files(mesh, spec, dir);
@@ -251,12 +260,14 @@ int run_command(const RunArgs& args) {
   if (!spec.outputs.plot_points.empty()) {
     std::string cols;
     for (const auto& id : spec.outputs.plot_points) cols += (cols.empty() ? "" : ",") + id + "_degC";
-    plot({"temperatures", (dir / "temperatures.csv").string(), (dir / "temperature_rise.png").string(),
-          "--columns", cols, "--rise-from-first", "--title", spec.name + ": temperature rise"});
+    plot({"temperatures", (dir / "temperatures.csv").string(),
+          (dir / "temperature_rise.png").string(), "--columns=" + cols, "--rise-from-first",
+          "--title=" + spec.name + ": temperature rise"});
   }
   if (run.error)
-    plot({"thermal_error", (dir / "thermal_error.csv").string(), (dir / "thermal_error.png").string(),
-          "--columns", "dx_um,dy_um,dz_um", "--title", spec.name + ": thermal error at the TCP"});
+    plot({"thermal_error", (dir / "thermal_error.csv").string(),
+          (dir / "thermal_error.png").string(), "--columns=dx_um,dy_um,dz_um",
+          "--title=" + spec.name + ": thermal error at the TCP"});
   out.commit();
   std::error_code no_checkpoint;
   std::filesystem::remove(checkpoint, no_checkpoint);

@@ -98,6 +98,7 @@ struct DutyCycle {
   };
   std::vector<Segment> segments;  /// start times ascending, first at 0
   double end = 0;                 /// [s]
+  std::filesystem::path csv;      /// the CSV the segments were read from; empty when listed
 };
 
 /// A feed axis's motion over time: piecewise segments, each standing at `from` or reciprocating

@@ -798,6 +798,7 @@ void read_duty_cycle(const Tab& root, CaseSpec& spec) {
          "...] or csv = \"file.csv\"");
   if (csv) {
     spec.duty_cycle.segments = csv_segments(c, *csv, d.at("csv"));
+    spec.duty_cycle.csv = fs::absolute(c.dir / *csv->value<std::string>()).lexically_normal();
   } else {
     each_table(d, "segments", [&](const Tab& s, std::size_t i) {
       s.allow({"start_s", "speed_rpm"});
@@ -1375,6 +1376,16 @@ CaseSpec read_case(const fs::path& file) {
                     core::limits::bytes_text(kCaseFileBytes) +
                     ", the limit for a case file; is it the case file (a TOML text)?");
   return case_from_toml(*text, file);
+}
+
+std::vector<fs::path> case_input_files(const CaseSpec& spec) {
+  std::vector<fs::path> files{spec.source};
+  for (const auto& body : spec.bodies)
+    for (const auto* prims : {&body.add, &body.subtract})
+      for (const auto& p : *prims)
+        if (p.kind == core::Primitive::Kind::surface_file) files.push_back(p.file);
+  if (!spec.duty_cycle.csv.empty()) files.push_back(spec.duty_cycle.csv);
+  return files;
 }
 
 std::string resolved_case_toml(const CaseSpec& spec) {

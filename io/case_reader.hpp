@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/case_spec.hpp"
 
@@ -16,6 +17,10 @@ namespace tt::io {
 /// Throws core::IoError when the file cannot be read, and core::CaseError for anything wrong in
 /// it, as "file:line: key.path = value: what was expected; hint".
 core::CaseSpec read_case(const std::filesystem::path& file);
+
+/// The case file and every file it names (surface meshes, a duty-cycle CSV): the inputs an
+/// output folder must stay apart from.
+std::vector<std::filesystem::path> case_input_files(const core::CaseSpec& spec);
 
 /// read_case on text already in memory; `file` names it in messages and anchors relative paths.
 core::CaseSpec case_from_toml(std::string_view text, const std::filesystem::path& file);

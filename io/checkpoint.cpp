@@ -1,5 +1,9 @@
 #include "io/checkpoint.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -84,10 +88,34 @@ CheckpointKey checkpoint_key(const core::CaseSpec& spec, const mesh::TetMesh& me
 }
 
 fs::path checkpoint_path(const fs::path& out_dir) {
-  fs::path p = out_dir.lexically_normal();
-  if (!p.has_filename()) p = p.parent_path();  // "out/run/" -> "out/run"
-  p += ".checkpoint";
-  return p;
+  return sibling_path(output_path(out_dir),
+                      ".checkpoint");  // "out/run/" -> "/.../out/run.checkpoint"
+}
+
+void require_writable_checkpoint(const fs::path& file) {
+  const std::string hint =
+      ". Hint: make it writable, move it away, or run without checkpoints (--checkpoint-every-s "
+      "-1)";
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(file, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_regular_file(st))
+      throw core::IoError(file.string() +
+                          ": the run's checkpoint cannot be saved here: it exists "
+                          "and is not a regular file" +
+                          hint);
+    const bool no_write_bit = (st.permissions() & (fs::perms::owner_write | fs::perms::group_write |
+                                                   fs::perms::others_write)) == fs::perms::none;
+    if (no_write_bit || ::access(file.c_str(), W_OK) != 0)
+      throw core::IoError(file.string() + ": the run's checkpoint is read-only" + hint);
+  }
+  const fs::path probe = sibling_path(file, ".tmp");
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw core::IoError(probe.string() +
+                        ": cannot write the run's checkpoint: " + std::strerror(errno) + hint);
+  ::close(fd);
+  fs::remove(probe, ec);
 }
 
 void write_checkpoint(const fs::path& file, const CheckpointKey& key,

@@ -27,7 +27,13 @@ CheckpointKey checkpoint_key(const core::CaseSpec& spec, const mesh::TetMesh& me
 /// DIR.checkpoint for the output directory DIR.
 std::filesystem::path checkpoint_path(const std::filesystem::path& out_dir);
 
-/// Writes via a temporary name and a rename: a kill leaves the previous checkpoint or this one.
+/// Throws IoError, before a run starts, when `file` could not be saved: it is not a regular file,
+/// it is read-only (no write permission bit set, or not writable by this user), or a file cannot
+/// be created beside it. The message says how to proceed.
+void require_writable_checkpoint(const std::filesystem::path& file);
+
+/// Writes via a temporary name and a rename: a kill leaves the previous checkpoint or this one;
+/// a failure (IoError) leaves the previous checkpoint and no temporary file.
 void write_checkpoint(const std::filesystem::path& file, const CheckpointKey& key,
                       const solvers::ThermalCheckpoint& state);
 

@@ -479,9 +479,53 @@ void require_shape(const MeasuredRun& run) {
                             " s: times must be finite and strictly increasing");
 }
 
+/// A run's file must be a regular file: a folder of that name would fail deep in the stream
+/// library with a message that names no file.
+void require_regular_file(const fs::path& file) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(file, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st))
+    throw core::DataError(
+        file.string() + ": " + (fs::is_directory(st) ? "a folder" : "not a regular file") +
+        ": expected the run's " + file.filename().string() + " file (docs/measured-data.md)");
+}
+
 }  // namespace
 
+bool same_run(const fs::path& a, const fs::path& b) {
+  std::error_code ea, eb;
+  const fs::path ra = fs::weakly_canonical(fs::absolute(a), ea);
+  const fs::path rb = fs::weakly_canonical(fs::absolute(b), eb);
+  if (ea || eb) return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
+  return (ra / "").lexically_normal() == (rb / "").lexically_normal();
+}
+
+void require_distinct_runs(const std::vector<fs::path>& folders, const std::string& option) {
+  for (std::size_t i = 0; i < folders.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_run(folders[i], folders[j]))
+        throw core::DataError(
+            folders[i].string() + ": given twice as " + option +
+            (folders[i] == folders[j] ? "" : " (also as " + folders[j].string() + ")") +
+            ": a run counted twice would weigh double in the fit and its "
+            "figures. Hint: give each run once");
+}
+
+void require_disjoint_runs(const std::vector<fs::path>& a, const std::vector<fs::path>& b,
+                           const std::string& a_option, const std::string& b_option,
+                           const std::string& why) {
+  for (const auto& x : a)
+    for (const auto& y : b)
+      if (same_run(x, y))
+        throw core::DataError(x.string() + ": given as " + b_option + " and as " + a_option +
+                              ": a run tested on what it was trained on gives a figure too good "
+                              "to be true; " +
+                              why);
+}
+
 MeasuredRun read_measured_run(const fs::path& folder, const MeasuredReadLimits& limits) {
+  require_regular_file(folder / "meta.json");
+  require_regular_file(folder / "data.csv");
   MeasuredRun run = run_from_meta(folder / "meta.json", limits);
   run.folder = folder;
   read_samples(folder / "data.csv", limits, run);

@@ -49,8 +49,23 @@ struct MeasuredReadLimits {
 /// Reads folder/meta.json and folder/data.csv. Throws DataError naming the file, the line and the
 /// column (or the JSON key) for: a missing, duplicated or unknown column, a time that does not
 /// increase, text or a non-finite number in a number cell, a position outside the machine's box,
-/// an unknown unit or format; IoError when a file cannot be read. Empty cells stay NaN.
+/// an unknown unit or format, meta.json or data.csv that is a folder; IoError when a file cannot be
+/// read. Empty cells stay NaN.
 MeasuredRun read_measured_run(const std::filesystem::path& folder, const MeasuredReadLimits& limits = {});
+
+/// True when `a` and `b` name one run folder (relative paths and symbolic links resolved).
+bool same_run(const std::filesystem::path& a, const std::filesystem::path& b);
+
+/// Throws DataError naming the run when one folder appears twice in `folders`, given on the
+/// command line as `option` ("--data", "--train", ...).
+void require_distinct_runs(const std::vector<std::filesystem::path>& folders,
+                           const std::string& option);
+
+/// Throws DataError naming the run when a folder of `a` (given as `a_option`) is also in `b`
+/// (given as `b_option`); `why` says how to proceed.
+void require_disjoint_runs(const std::vector<std::filesystem::path>& a,
+                           const std::vector<std::filesystem::path>& b, const std::string& a_option,
+                           const std::string& b_option, const std::string& why);
 
 /// Writes a run in the same format (folder created; files via temporary names).
 void write_measured_run(const std::filesystem::path& folder, const MeasuredRun& run);

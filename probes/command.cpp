@@ -88,32 +88,10 @@ std::string summary_json_text(const std::filesystem::path& in, const ProbeRunSum
   return out;
 }
 
-void replace_directory(const std::filesystem::path& partial, const std::filesystem::path& out_dir) {
-  std::error_code ec;
-  if (std::filesystem::exists(out_dir)) {
-    const bool ours =
-        std::filesystem::is_directory(out_dir) &&
-        (std::filesystem::is_empty(out_dir) || std::filesystem::exists(out_dir / "drift.csv"));
-    if (!ours)
-      throw core::IoError(
-          core::located(out_dir.string(), 0,
-                        "exists and is not a previous probes result (no drift.csv): "
-                        "choose another --out or remove it"));
-    std::filesystem::remove_all(out_dir, ec);
-    if (ec)
-      throw core::IoError(core::located(out_dir.string(), 0, "cannot replace: " + ec.message()));
-  }
-  std::filesystem::rename(partial, out_dir, ec);
-  if (ec)
-    throw core::IoError(core::located(out_dir.string(), 0,
-                                      "cannot rename " + partial.string() + ": " + ec.message()));
-}
-
 }  // namespace
 
 ProbeRunSummary run_probes_command(const std::filesystem::path& in,
-                                   const std::filesystem::path& out_dir,
-                                   const ProbeOptions& options) {
+                                   const std::filesystem::path& dir, const ProbeOptions& options) {
   const ProbeRecord record = read_raw_csv(in, options.constants);
   std::optional<DriftSeries> truth;
   if (options.truth_csv) truth = truth_series(*options.truth_csv, record);
@@ -146,20 +124,10 @@ ProbeRunSummary run_probes_command(const std::filesystem::path& in,
     summary.methods.push_back(m);
   }
 
-  std::filesystem::path partial = out_dir;
-  partial += ".partial";
-  std::error_code ec;
-  std::filesystem::remove_all(partial, ec);
-  std::filesystem::create_directories(partial, ec);
-  if (ec)
-    throw core::IoError(
-        core::located(partial.string(), 0, "cannot create the output directory: " + ec.message()));
   for (std::size_t k = 0; k < methods.size(); ++k)
-    write_text_atomically(partial / methods[k].second, drift_csv_text(results[k].drift));
-  write_text_atomically(partial / "alignment.csv",
-                        alignment_csv_text(record, results[0], results[1]));
-  write_text_atomically(partial / "summary.json", summary_json_text(in, summary));
-  replace_directory(partial, out_dir);
+    write_text_atomically(dir / methods[k].second, drift_csv_text(results[k].drift));
+  write_text_atomically(dir / "alignment.csv", alignment_csv_text(record, results[0], results[1]));
+  write_text_atomically(dir / "summary.json", summary_json_text(in, summary));
   return summary;
 }
 

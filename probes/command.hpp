@@ -42,13 +42,12 @@ struct ProbeRunSummary {
 
 /// Reads `in`, recovers drift and tilt with the information-distance alignment and, for
 /// comparison, with cross-correlation, without alignment and with revolution means, and writes
-/// into `out_dir`: drift.csv (the method's result), drift_xcorr.csv, drift_noalign.csv,
-/// drift_revmean.csv, alignment.csv and summary.json. Everything is written to out_dir.partial
-/// first and renamed at the end; an existing out_dir is replaced only if it holds a drift.csv
-/// (a previous result). Throws DataError (file:line: column ...) or IoError.
+/// into the existing folder `dir`: drift.csv (the method's result), drift_xcorr.csv,
+/// drift_noalign.csv, drift_revmean.csv, alignment.csv and summary.json, nothing before the input
+/// is read whole. Publishing `dir` all or nothing is the caller's (the CLI's io::OutputDir).
+/// Throws DataError (file:line: column ...) or IoError.
 ProbeRunSummary run_probes_command(const std::filesystem::path& in,
-                                   const std::filesystem::path& out_dir,
-                                   const ProbeOptions& options);
+                                   const std::filesystem::path& dir, const ProbeOptions& options);
 
 /// Simulates readings of `history` (virtual_record), writes them as a raw CSV to `raw_csv`
 /// (atomically) and, if `truth_csv` is given, the true drift relative to the first reading

@@ -1,15 +1,14 @@
 // Bad input to the mesher: each is a typed error whose message names the file and the thing that
 // is wrong; through the CLI, a non-zero exit and no output directory.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
 
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
+#include "io/child_process.hpp"
 #include "mesh/mesher.hpp"
 #include "mesh/tetgen/tetgen_adapter.hpp"
 #include "mesh_fixtures.hpp"
@@ -170,12 +169,10 @@ TEST(BadInput, ImpossibleQualityBoundsAreAMeshErrorBeforeTetgenRuns) {
 }
 
 #ifdef TT_CLI
-/// Exit status of `thermotwin mesh CASE --out OUT`, its stderr in `log`.
+/// Exit status of `thermotwin mesh CASE --out OUT`, its output (only this run's) in `log`.
 int mesh_cli(const fs::path& case_file, const fs::path& out, const fs::path& log) {
-  const std::string cmd = std::string("'") + TT_CLI + "' mesh '" + case_file.string() +
-                          "' --out '" + out.string() + "' 2> '" + log.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  fs::remove(log);
+  return io::run_program({TT_CLI, "mesh", case_file.string(), "--out", out.string()}, {}, log);
 }
 
 std::string text_of(const fs::path& p) {

@@ -2,16 +2,16 @@
 // vertices as candidates records their histories (candidates.csv, candidate_temperatures.csv),
 // and `place --from` the run chooses among them with every method, for dy and dz, m = 1..6.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <vector>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "io/child_process.hpp"
 
 namespace {
 
@@ -27,11 +27,11 @@ std::string text_of(const fs::path& p) {
   return s.str();
 }
 
-/// Runs thermotwin with `args`, output into `log`; its exit status.
-int thermotwin(const std::string& args, const fs::path& log) {
-  const std::string cmd = kThermotwin.string() + " " + args + " > '" + log.string() + "' 2>&1";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+/// Runs thermotwin with `args`, output (only this run's) into `log`; its exit status.
+int thermotwin(std::vector<std::string> args, const fs::path& log) {
+  args.insert(args.begin(), kThermotwin.string());
+  fs::remove(log);
+  return tt::io::run_program(args, {}, log);
 }
 
 int data_lines(const fs::path& csv) {
@@ -53,18 +53,18 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
   text += "\n[placement]\ncandidates = \"surface\"\nbodies = [\"housing\"]\n";
   std::ofstream(dir / "case.toml") << text;
 
-  ASSERT_EQ(thermotwin("run '" + (dir / "case.toml").string() + "' --out '" +
-                           (dir / "run").string() + "' --quiet",
-                       dir / "run.log"),
-            0)
+  ASSERT_EQ(
+      thermotwin({"run", (dir / "case.toml").string(), "--out", (dir / "run").string(), "--quiet"},
+                 dir / "run.log"),
+      0)
       << text_of(dir / "run.log");
   const int n = data_lines(dir / "run" / "candidates.csv");
   EXPECT_GT(n, 1000) << "the housing of the coarse mesh has some 2000 surface vertices";
   EXPECT_EQ(data_lines(dir / "run" / "candidate_temperatures.csv"),
             data_lines(dir / "run" / "temperatures.csv"));
 
-  ASSERT_EQ(thermotwin("place --from '" + (dir / "run").string() + "' --out '" +
-                           (dir / "place").string() + "' --quiet",
+  ASSERT_EQ(thermotwin({"place", "--from", (dir / "run").string(), "--out",
+                        (dir / "place").string(), "--quiet"},
                        dir / "place.log"),
             0)
       << text_of(dir / "place.log");
@@ -99,8 +99,8 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
   // same seed.
   std::vector<nlohmann::json> noisy;
   for (const char* out : {"place_noisy_1", "place_noisy_2"}) {
-    ASSERT_EQ(thermotwin("place --from '" + (dir / "run").string() + "' --out '" +
-                             (dir / out).string() + "' --sensor-noise --quiet",
+    ASSERT_EQ(thermotwin({"place", "--from", (dir / "run").string(), "--out", (dir / out).string(),
+                          "--sensor-noise", "--quiet"},
                          dir / "place.log"),
               0)
         << text_of(dir / "place.log");

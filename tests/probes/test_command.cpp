@@ -19,6 +19,12 @@ std::string first_line(const fs::path& file) {
   return line;
 }
 
+/// A fresh output folder: run_probes_command writes into it (the CLI publishes it whole).
+fs::path out_dir(const fs::path& dir) {
+  fs::create_directories(dir / "out");
+  return dir / "out";
+}
+
 const MethodSummary& method(const ProbeRunSummary& s, AlignmentMethod m) {
   for (const MethodSummary& x : s.methods)
     if (x.method == m) return x;
@@ -33,11 +39,10 @@ TEST(ProbesCommand, RunsOnAVirtualRawFileAndShowsTheGainOfAlignment) {
   write_virtual_raw_csv(dir / "raw.csv", fixtures::runout_setup(51), h, dir / "truth.csv");
   ProbeOptions options;
   options.truth_csv = dir / "truth.csv";
-  const ProbeRunSummary s = run_probes_command(dir / "raw.csv", dir / "out", options);
+  const ProbeRunSummary s = run_probes_command(dir / "raw.csv", out_dir(dir), options);
 
   EXPECT_EQ(s.readings, h.size());
   EXPECT_EQ(s.plan.window_samples, 200);
-  EXPECT_FALSE(fs::exists(dir / "out.partial"));
   for (const char* f : {"drift.csv", "drift_xcorr.csv", "drift_noalign.csv", "drift_revmean.csv",
                         "alignment.csv", "summary.json"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
@@ -66,7 +71,7 @@ TEST(ProbesCommand, RunsOnAVirtualRawFileAndShowsTheGainOfAlignment) {
       << text.str();
   EXPECT_NE(text.str().find("max_drift_error_um"), std::string::npos);
 
-  // A second run replaces the previous result.
+  // A second run over the same folder rewrites every file.
   EXPECT_NO_THROW(run_probes_command(dir / "raw.csv", dir / "out", {}));
 }
 
@@ -77,31 +82,25 @@ TEST(ProbesCommand, AxialProbeAddsZ) {
   write_virtual_raw_csv(dir / "raw.csv", setup, fixtures::warm_up_history(4), dir / "truth.csv");
   ProbeOptions options;
   options.truth_csv = dir / "truth.csv";
-  const ProbeRunSummary s = run_probes_command(dir / "raw.csv", dir / "out", options);
+  const ProbeRunSummary s = run_probes_command(dir / "raw.csv", out_dir(dir), options);
   EXPECT_TRUE(s.has_axial);
   EXPECT_EQ(first_line(dir / "out" / "drift.csv"),
             "time_s,x1_um,y1_um,x2_um,y2_um,tilt_x_urad,tilt_y_urad,z_um");
   EXPECT_LT(method(s, AlignmentMethod::information_distance).error_vs_truth->max_drift_m, 0.3e-6);
 }
 
-TEST(ProbesCommand, BadInputLeavesNoOutputAndForeignDirectoriesAreKept) {
+// Which output folders the CLI replaces is io::OutputDir's rule (tests/reliability).
+TEST(ProbesCommand, BadInputWritesNothing) {
   const fs::path dir = fixtures::scratch_dir("command_bad");
   std::ofstream(dir / "raw.csv")
       << "# speed_rpm=6000 sample_rate_hz=1000 probe_distance_mm=150\n"
          "reading,time_s,sample,s1_um,s2_um,s3_um,s4_um\n1,0,0,1,2,3,oops\n";
   try {
-    run_probes_command(dir / "raw.csv", dir / "out", {});
+    run_probes_command(dir / "raw.csv", out_dir(dir), {});
     FAIL() << "malformed input accepted";
   } catch (const tt::core::DataError& e) {
     EXPECT_NE(std::string(e.what()).find("raw.csv:3: column 7 (s4_um)"), std::string::npos)
         << e.what();
   }
-  EXPECT_FALSE(fs::exists(dir / "out"));
-  EXPECT_FALSE(fs::exists(dir / "out.partial"));
-
-  write_virtual_raw_csv(dir / "good.csv", fixtures::runout_setup(53), fixtures::warm_up_history(3));
-  fs::create_directories(dir / "foreign");
-  std::ofstream(dir / "foreign" / "notes.txt") << "keep me\n";
-  EXPECT_THROW(run_probes_command(dir / "good.csv", dir / "foreign", {}), tt::core::IoError);
-  EXPECT_TRUE(fs::exists(dir / "foreign" / "notes.txt"));
+  EXPECT_TRUE(fs::is_empty(dir / "out"));
 }

@@ -1,9 +1,7 @@
 // Runs build/thermotwin as a child process, as a user or a crash would: to the end, or killed.
 #pragma once
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,8 +19,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-
-extern char** environ;
+#include "io/child_process.hpp"
 
 namespace tt::reliability_test {
 
@@ -39,42 +36,18 @@ inline fs::path scratch(const std::string& name) {
   return d;
 }
 
-/// Starts thermotwin with `args`; `env` entries ("K=V") are added to (or override) the
-/// environment. stdout and stderr go to `log`.
+/// Starts thermotwin with `args` (an argument vector: no shell); `env` entries ("K=V") are added
+/// to (or override) the environment. stdout and stderr are appended to `log`.
 inline pid_t start(const std::vector<std::string>& args, const std::vector<std::string>& env = {},
                    const fs::path& log = "/dev/null") {
-  std::vector<std::string> envs;
-  for (char** e = environ; *e; ++e) {
-    const std::string s(*e);
-    bool overridden = false;
-    for (const auto& o : env) overridden |= s.substr(0, s.find('=')) == o.substr(0, o.find('='));
-    if (!overridden) envs.push_back(s);
-  }
-  envs.insert(envs.end(), env.begin(), env.end());
   std::vector<std::string> argv{kThermotwin.string()};
   argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> cargv, cenv;
-  for (auto& a : argv) cargv.push_back(a.data());
-  cargv.push_back(nullptr);
-  for (auto& e : envs) cenv.push_back(e.data());
-  cenv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, cargv[0], &actions, nullptr, cargv.data(), cenv.data());
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
-  return pid;
+  return io::start_program(argv, env, log);
 }
 
 /// Exit code of a child, or 128 + signal when a signal ended it.
 inline int wait_for(pid_t pid) {
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return io::wait_program(pid);
 }
 
 inline int run(const std::vector<std::string>& args, const std::vector<std::string>& env = {},

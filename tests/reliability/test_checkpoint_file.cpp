@@ -83,8 +83,43 @@ TEST(CheckpointFile, TruncatedCorruptedOrForeignFilesAreRefused) {
 }
 
 TEST(CheckpointFile, PathSitsBesideTheOutputDirectory) {
-  EXPECT_EQ(io::checkpoint_path("out/sb1"), fs::path("out/sb1.checkpoint"));
-  EXPECT_EQ(io::checkpoint_path("out/sb1/"), fs::path("out/sb1.checkpoint"));
+  EXPECT_EQ(io::checkpoint_path("out/sb1"), fs::absolute("out/sb1.checkpoint"));
+  EXPECT_EQ(io::checkpoint_path("out/sb1/"), fs::absolute("out/sb1.checkpoint"));
+}
+
+TEST(CheckpointFile, OneThatCannotBeSavedIsFoundBeforeTheRun) {
+  const fs::path dir = scratch("ckpt_writable");
+  EXPECT_NO_THROW(io::require_writable_checkpoint(dir / "new.checkpoint"));
+  EXPECT_TRUE(fs::is_empty(dir)) << "the check left a file";
+
+  std::ofstream(dir / "ro.checkpoint") << "x";
+  fs::permissions(dir / "ro.checkpoint", fs::perms::owner_read);
+  try {
+    io::require_writable_checkpoint(dir / "ro.checkpoint");
+    ADD_FAILURE() << "a read-only checkpoint was accepted";
+  } catch (const core::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("read-only"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--checkpoint-every-s -1"), std::string::npos);
+  }
+  fs::create_directories(dir / "folder.checkpoint");
+  EXPECT_THROW(io::require_writable_checkpoint(dir / "folder.checkpoint"), core::IoError);
+  std::ofstream(dir / "file") << "x";
+  EXPECT_THROW(io::require_writable_checkpoint(dir / "file" / "out.checkpoint"), core::IoError);
+}
+
+TEST(CheckpointFile, ASaveThatFailsLeavesNoTemporaryFile) {
+  const fs::path dir = scratch("ckpt_save_fails");
+  // The rename fails: a non-empty folder holds the checkpoint's name.
+  fs::create_directories(dir / "out.checkpoint" / "x");
+  EXPECT_THROW(io::write_checkpoint(dir / "out.checkpoint", sample_key(50), sample_state(50, 3)),
+               core::IoError);
+  EXPECT_FALSE(fs::exists(dir / "out.checkpoint.tmp"));
+  // The write fails: the temporary name leads to a full device.
+  fs::create_symlink("/dev/full", dir / "b.checkpoint.tmp");
+  EXPECT_THROW(io::write_checkpoint(dir / "b.checkpoint", sample_key(50), sample_state(50, 3)),
+               core::IoError);
+  EXPECT_FALSE(fs::exists(fs::symlink_status(dir / "b.checkpoint.tmp")));
+  EXPECT_FALSE(fs::exists(dir / "b.checkpoint"));
 }
 
 }  // namespace

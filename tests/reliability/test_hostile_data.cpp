@@ -145,6 +145,34 @@ TEST(HostileData, CsvBeyondTheRowLimitIsRefusedAtThatRow) {
   EXPECT_EQ(io::read_measured_run(f.dir, limits).time.size(), 2000);
 }
 
+TEST(HostileData, MetaJsonOrDataCsvThatIsAFolderIsADataErrorNamingIt) {
+  const Folder f("hostile_folder_files");
+  fs::create_directories(f.dir / "meta.json");
+  f.write("data.csv", "time_s,speed_rpm,T0\n0,0,20\n");
+  std::string msg = data_error(f);
+  EXPECT_NE(msg.find((f.dir / "meta.json").string() + ": a folder"), std::string::npos) << msg;
+  fs::remove(f.dir / "meta.json");
+  f.write("meta.json", meta_with_sensors(1));
+  fs::remove(f.dir / "data.csv");
+  fs::create_directories(f.dir / "data.csv");
+  msg = data_error(f);
+  EXPECT_NE(msg.find((f.dir / "data.csv").string() + ": a folder"), std::string::npos) << msg;
+}
+
+TEST(HostileData, TheSameRunTwiceIsRefusedNamingIt) {
+  const Folder a("hostile_twice_a"), b("hostile_twice_b");
+  EXPECT_NO_THROW(io::require_distinct_runs({a.dir, b.dir}, "--data"));
+  EXPECT_TRUE(io::same_run(a.dir, a.dir / "." / ""));
+  EXPECT_FALSE(io::same_run(a.dir, b.dir));
+  try {
+    io::require_distinct_runs({a.dir, b.dir, a.dir / ".." / a.dir.filename()}, "--train");
+    ADD_FAILURE() << "a run given twice was accepted";
+  } catch (const core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("given twice as --train"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(a.dir.string()), std::string::npos) << e.what();
+  }
+}
+
 TEST(FuzzRegressions, MeasuredDataReader) {
   const auto files = fuzz_regressions("measured");
   EXPECT_FALSE(files.empty());

@@ -9,13 +9,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Waits until a regular file appears in `dir` (or the child ends); true when one did.
+/// Waits until a result file appears in `dir` (or the child ends); true when one did. The marker
+/// .thermotwin-partial, there from the start, does not count.
 bool wait_for_first_file(const fs::path& dir, pid_t pid) {
   for (;;) {
     std::error_code ec;
     if (fs::is_directory(dir, ec))
       for (const auto& e : fs::directory_iterator(dir, ec))
-        if (e.is_regular_file(ec)) return true;
+        if (e.is_regular_file(ec) && e.path().filename() != ".thermotwin-partial") return true;
     int status = 0;
     if (waitpid(pid, &status, WNOHANG) == pid) return false;
     std::this_thread::sleep_for(std::chrono::microseconds(200));

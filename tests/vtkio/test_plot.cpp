@@ -1,12 +1,11 @@
 // app/plot.py draws every kind of plot from CSV files written by write_csv, and fails cleanly on
 // a missing column. Skipped when /usr/bin/python3 has no matplotlib.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 
+#include "io/child_process.hpp"
 #include "io/csv_out.hpp"
 #include "tiny_mesh.hpp"
 
@@ -17,17 +16,16 @@ namespace fs = std::filesystem;
 
 bool matplotlib_available() {
   return fs::exists("/usr/bin/python3") &&
-         std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0;
+         run_program({"/usr/bin/python3", "-c", "import matplotlib"}, {}, "/dev/null") == 0;
 }
 
-/// Exit status of plot.py run with `arguments`; its output goes to `log`.
-int run_plot(const std::string& arguments, const fs::path& log) {
-  const fs::path script = fs::path(TT_SOURCE_DIR) / "app" / "plot.py";
-  const std::string command = "MPLBACKEND=Agg MPLCONFIGDIR='" + log.parent_path().string() +
-                              "' /usr/bin/python3 '" + script.string() + "' " + arguments + " >'" +
-                              log.string() + "' 2>&1";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+/// Exit status of plot.py run with `arguments`; its output (only this run's) goes to `log`.
+int run_plot(const std::vector<std::string>& arguments, const fs::path& log) {
+  std::vector<std::string> argv{"/usr/bin/python3",
+                                (fs::path(TT_SOURCE_DIR) / "app" / "plot.py").string()};
+  argv.insert(argv.end(), arguments.begin(), arguments.end());
+  fs::remove(log);
+  return run_program(argv, {"MPLBACKEND=Agg", "MPLCONFIGDIR=" + log.parent_path().string()}, log);
 }
 
 bool is_png(const fs::path& path) {
@@ -35,14 +33,6 @@ bool is_png(const fs::path& path) {
   char signature[8] = {};
   in.read(signature, 8);
   return in && std::string(signature, 8) == "\x89PNG\r\n\x1a\n" && fs::file_size(path) > 1000;
-}
-
-/// `path` in single quotes for the shell (test paths hold no quote).
-std::string quoted(const fs::path& path) {
-  std::string text(1, '\'');
-  text += path.string();
-  text += '\'';
-  return text;
 }
 
 TEST(PlotScript, WritesEveryKindOfPlot) {
@@ -61,25 +51,25 @@ TEST(PlotScript, WritesEveryKindOfPlot) {
     std::ofstream bars(dir / "scores.csv");
     bars << "id,mi_bits_dy\nT02,1.5\nT10,0.75\nT18,2.25\n";
   }
-  const auto csv = quoted(dir / "history.csv");
+  const auto csv = (dir / "history.csv").string();
   const auto log = dir / "plot.log";
 
-  EXPECT_EQ(run_plot("temperatures " + csv + " " + quoted(dir / "t.png") +
-                         " --columns T02_degC,T10_degC --rise-from-first --title 'Warm-up'",
+  EXPECT_EQ(run_plot({"temperatures", csv, (dir / "t.png").string(), "--columns",
+                      "T02_degC,T10_degC", "--rise-from-first", "--title", "Warm-up"},
                      log),
             0);
   EXPECT_TRUE(is_png(dir / "t.png"));
   EXPECT_EQ(
-      run_plot("thermal_error " + csv + " " + quoted(dir / "e.png") + " --columns dy_um,dz_um",
-               log),
+      run_plot({"thermal_error", csv, (dir / "e.png").string(), "--columns", "dy_um,dz_um"}, log),
       0);
   EXPECT_TRUE(is_png(dir / "e.png"));
   EXPECT_EQ(
-      run_plot("lines " + csv + " " + quoted(dir / "l.png") + " --x time_s --columns dy_um", log),
+      run_plot({"lines", csv, (dir / "l.png").string(), "--x", "time_s", "--columns", "dy_um"},
+               log),
       0);
   EXPECT_TRUE(is_png(dir / "l.png"));
-  EXPECT_EQ(run_plot("bars " + quoted(dir / "scores.csv") + " " + quoted(dir / "b.png") +
-                         " --label id --value mi_bits_dy --sort",
+  EXPECT_EQ(run_plot({"bars", (dir / "scores.csv").string(), (dir / "b.png").string(), "--label",
+                      "id", "--value", "mi_bits_dy", "--sort"},
                      log),
             0);
   EXPECT_TRUE(is_png(dir / "b.png"));
@@ -90,8 +80,8 @@ TEST(PlotScript, MissingColumnFailsWithoutWritingAnImage) {
   const auto dir = test::scratch_dir("plot_bad");
   write_csv(dir / "h.csv", {"time_s", "T02_degC"}, Eigen::MatrixXd::Ones(3, 2));
   const auto log = dir / "plot.log";
-  EXPECT_EQ(run_plot("temperatures " + quoted(dir / "h.csv") + " " + quoted(dir / "t.png") +
-                         " --columns T02_degC,T99_degC",
+  EXPECT_EQ(run_plot({"temperatures", (dir / "h.csv").string(), (dir / "t.png").string(),
+                      "--columns", "T02_degC,T99_degC"},
                      log),
             2);
   EXPECT_FALSE(fs::exists(dir / "t.png"));
