@@ -55,7 +55,15 @@ struct CalibrateArgs {
   bool quiet = false;
 };
 
+/// reduce CASE --out DIR: the reduced-order twin and its validation (app/reduce_command.cpp).
+struct ReduceArgs {
+  std::filesystem::path case_file, out;
+  bool quick_validation = false;  /// validate on the case's own duty cycle only
+  bool quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int reduce_command(const ReduceArgs& args);
 int fit_data_command(const FitDataArgs& args);
 int calibrate_data_command(const CalibrateArgs& args);
 /// calibrate --case CASE (implemented in calibration's driver; a stub until it is wired).

@@ -1,6 +1,8 @@
 // thermotwin: the command-line driver.
 //   thermotwin mesh CASE --out DIR   mesh a case: mesh.vtu, boundary.vtp, points.vtp, mesh_report.json
 //   thermotwin run CASE --out DIR    simulate it: fields.pvd, temperatures.csv, thermal_error.csv, summary.json
+//   thermotwin reduce CASE --out DIR its reduced-order twin, validated against the full model
+//   thermotwin place / fit / calibrate / probes: sensor placement, error models, the loop, probes
 // Errors print one line on stderr and exit non-zero; no partial output directory is left.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -32,6 +34,17 @@ int main(int argc, char** argv) {
   // Hidden (empty group): for the reliability tests.
   run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
   run->add_option("--dump", run_args.dump)->group("");
+
+  ReduceArgs reduce_args;
+  auto* reduce = cli.add_subcommand(
+      "reduce", "Build the reduced-order twin of a case and validate it against the full model");
+  reduce->add_option("case", reduce_args.case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  reduce->add_option("--out", reduce_args.out, "output directory")->required();
+  reduce->add_flag("--quick-validation", reduce_args.quick_validation,
+                   "validate on the case's own duty cycle only (default: three more cycles)");
+  reduce->add_flag("--quiet", reduce_args.quiet, "no progress on stderr");
 
   ProbesArgs probes_args;
   auto* probes = cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
@@ -94,6 +107,7 @@ int main(int argc, char** argv) {
   try {
     if (*mesh) return mesh_command(mesh_args);
     if (*run) return run_command(run_args);
+    if (*reduce) return reduce_command(reduce_args);
     if (*place) {
       if (place_args.case_file.empty() && place_args.from_run.empty())
         throw tt::core::CaseError("place: give a case file or --from RUNDIR");
