@@ -298,7 +298,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
   Catalogue cat;
   cat.readout = r;
   const auto& conv = declared.thermal.convection;
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, declared);
+  const solvers::FullThermalSystem ops = solvers::thermal_system(m, declared);
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
   if (ref_speed <= 0) {
@@ -437,7 +437,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       core::CaseSpec doubled = declared;
       doubled.materials[mi].conductivity *= 2;
       doubled.materials[mi].density *= 2;
-      const solvers::ThermalOperators dops = solvers::thermal_operators(m, doubled);
+      const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
       const auto km =
           std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
       const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);

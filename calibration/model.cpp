@@ -199,7 +199,7 @@ Responses march(const mesh::TetMesh& m, const core::CaseSpec& spec, const Readou
                 const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
                 const std::vector<LoadColumn>& loads,
                 const std::vector<Eigen::MatrixXd>& extra_displacement) {
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, spec);
+  const solvers::FullThermalSystem ops = solvers::thermal_system(m, spec);
   const Eigen::Index n = m.nodes.rows();
   const Eigen::Index ns = static_cast<Eigen::Index>(separable.size());
   const Eigen::Index nc = ns + static_cast<Eigen::Index>(loads.size());
@@ -308,7 +308,7 @@ Eigen::MatrixXd simulated_channels(const mesh::TetMesh& m, const core::CaseSpec&
                                    const Readout& r, const Eigen::VectorXd& times) {
   core::CaseSpec s = spec;
   s.thermal.output_interval = std::min(s.thermal.output_interval, s.thermal.step);
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, s);
+  const solvers::FullThermalSystem ops = solvers::thermal_system(m, s);
   const solvers::ThermalHistory th = solvers::thermal_history(m, s, ops);
   std::vector<Eigen::VectorXd> hist;
   const Eigen::VectorXd t0 = th.temperature.col(0);

@@ -64,6 +64,18 @@ std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
   return out;
 }
 
+Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, Eigen::Index nodes) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(shape.weight.size()));
+  for (Eigen::Index p = 0; p < shape.nodes.rows(); ++p)
+    for (Eigen::Index a = 0; a < shape.nodes.cols(); ++a)
+      entries.emplace_back(shape.nodes(p, a), p, shape.weight(p, a) / shape.volume(p));
+  Eigen::SparseMatrix<double> load(nodes, shape.nodes.rows());
+  load.setFromTriplets(entries.begin(), entries.end());
+  load.makeCompressed();
+  return load;
+}
+
 Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
                                        double t0, double t1) {
   const auto& src = spec.thermal.sources[shape.source];

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <vector>
 
 #include "core/case_spec.hpp"
@@ -26,6 +27,10 @@ struct MovingSourceShape {
 /// a moving source on a body without elements.
 std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
                                                     const core::CaseSpec& spec);
+
+/// Nodal load of the source per watt in each piece: #nodes x #pieces, column p spreads piece p's
+/// unit power over its nodes by int N dV / V_piece (each column sums to 1) [-].
+Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, Eigen::Index nodes);
 
 /// Per piece, the fraction of the source's power it receives averaged over [t0, t1] [-] (sums to
 /// 1): at each of a set of sub-instants the pieces in the window share the power by volume (the

@@ -65,13 +65,13 @@ Eigen::SparseMatrix<double> to_sparse(int n, const std::vector<Triplets>& chunks
 }
 
 template <int N>
-ThermalOperators assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
+FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
   constexpr int F = N == 4 ? 3 : 6;
   check_elements<N>(m);
   const int n = static_cast<int>(m.nodes.rows());
   const int nt = static_cast<int>(m.tets.rows());
   constexpr std::ptrdiff_t chunk = 4096;
-  ThermalOperators ops;
+  FullThermalSystem ops;
   const bool lumped = spec.thermal.lumped_mass;
   auto pairs = core::parallel_chunks<std::pair<Triplets, Triplets>>(
       nt, chunk, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
@@ -148,7 +148,12 @@ ThermalOperators assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
                               "' has no elements, so its heat cannot go anywhere");
     ops.source_shape.push_back(w / volume);
   }
-  ops.moving = moving_source_shapes(m, spec);
+  ops.moving_pieces = moving_source_shapes(m, spec);
+  for (const auto& shape : ops.moving_pieces) {
+    ops.moving.push_back(moving_load_matrix(shape, n));
+    ops.moving_source.push_back(shape.source);
+  }
+  ops.uniform = Eigen::VectorXd::Ones(n);
   return ops;
 }
 
@@ -174,7 +179,7 @@ double stored_heat_total(const mesh::TetMesh& m, const core::CaseSpec& spec, con
 
 /// Heat rate leaving through every convection entry [W]: h (int T dA - T_sink int dA), with
 /// int T dA from the face-quadrature weights (exact for the element's T).
-double convected_rate(const ThermalOperators& ops, const Eigen::VectorXd& t_k, const std::vector<double>& h,
+double convected_rate(const FullThermalSystem& ops, const Eigen::VectorXd& t_k, const std::vector<double>& h,
                       const std::vector<double>& sink_k) {
   double rate = 0;
   for (size_t c = 0; c < h.size(); ++c)
@@ -188,7 +193,7 @@ struct LoadState {
   std::vector<double> h, sink_k, power;
 };
 
-LoadState load_state(const core::CaseSpec& spec, const ThermalOperators& ops, double t_load,
+LoadState load_state(const core::CaseSpec& spec, const FullThermalSystem& ops, double t_load,
                      double t_sink, const Eigen::VectorXd& temperature, double t0_k) {
   LoadState s;
   s.speed = speed_at(spec.duty_cycle, t_load);
@@ -208,7 +213,7 @@ LoadState load_state(const core::CaseSpec& spec, const ThermalOperators& ops, do
   return s;
 }
 
-Eigen::VectorXd load_vector(const core::CaseSpec& spec, const ThermalOperators& ops, const LoadState& s) {
+Eigen::VectorXd load_vector(const core::CaseSpec& spec, const FullThermalSystem& ops, const LoadState& s) {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(ops.conduction.rows());
   for (size_t c = 0; c < s.h.size(); ++c) f += (s.h[c] * s.sink_k[c]) * ops.film_area[c];
   for (size_t i = 0; i < s.power.size(); ++i) f += s.power[i] * ops.source_shape[i];
@@ -236,7 +241,7 @@ void check_resume(const ThermalCheckpoint& c, int nodes, const std::vector<doubl
 }
 
 template <int N>
-ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, const ThermalOperators& ops,
+ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, const FullThermalSystem& ops,
                          const Progress& progress, const Checkpointing& checkpointing) {
   using Scheme = core::TimeScheme;
   const Scheme scheme = spec.thermal.scheme;
@@ -310,7 +315,7 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
     const bool cn = scheme == Scheme::crank_nicolson && !restart;
     const Eigen::SparseMatrix<double>& kk = stiffness_at(s_new);
     // Heat moving with the feed axis: averaged over the step, the same for both ends of CN.
-    const Eigen::VectorXd f_moving = moving_heat_load(spec, ops.moving, n, t_prev, t);
+    const Eigen::VectorXd f_moving = moving_heat_load(spec, ops.moving_pieces, n, t_prev, t);
     f_new = load_vector(spec, ops, s_new) + f_moving;
     if (cn) {
       const LoadState s_old = load_state(spec, ops, mid, t_prev, temp, t0_k);
@@ -374,12 +379,12 @@ ThermalHistory integrate(const mesh::TetMesh& m, const core::CaseSpec& spec, con
 
 }  // namespace
 
-ThermalOperators thermal_operators(const mesh::TetMesh& mesh, const core::CaseSpec& spec) {
+FullThermalSystem thermal_system(const mesh::TetMesh& mesh, const core::CaseSpec& spec) {
   return mesh.order == 1 ? assemble<4>(mesh, spec) : assemble<10>(mesh, spec);
 }
 
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-                               const ThermalOperators& ops, const Progress& progress,
+                               const FullThermalSystem& ops, const Progress& progress,
                                const Checkpointing& checkpointing) {
   return mesh.order == 1 ? integrate<4>(mesh, spec, ops, progress, checkpointing)
                          : integrate<10>(mesh, spec, ops, progress, checkpointing);

@@ -127,7 +127,7 @@ TEST(FeedAxis, EnergyClosesWithMovingSources) {
   for (const char* scheme : {"backward_euler", "crank_nicolson"}) {
     const core::CaseSpec s = bar_spec(1, scheme);
     const mesh::TetMesh m = mesh::mesh_case(s);
-    const auto ops = solvers::thermal_operators(m, s);
+    const auto ops = solvers::thermal_system(m, s);
     const auto h = solvers::thermal_history(m, s, ops);
     EXPECT_NEAR(h.energy.heat_in, h.energy.heat_in_law, 1e-9 * h.energy.heat_in_law) << scheme;
     EXPECT_NEAR(h.energy.heat_in_law, (18.0 + 2.88) * 300.0, 1e-6);

@@ -55,7 +55,7 @@ MmsResult mms_error(double max_edge) {
   const auto spec = case_of(cube.toml());
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   EXPECT_EQ(mesh.nodes_per_tet(), N);
-  const Eigen::SparseMatrix<double> k = solvers::thermal_operators(mesh, spec).conduction;
+  const Eigen::SparseMatrix<double> k = solvers::thermal_system(mesh, spec).conduction;
   const int n = static_cast<int>(mesh.nodes.rows()), nt = static_cast<int>(mesh.tets.rows());
   const auto& rule = kn::tet_rule_degree5();
   auto coords = [&](int t) {
