@@ -113,24 +113,4 @@ Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingS
   return fraction;
 }
 
-Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
-                                 const std::vector<MovingSourceShape>& shapes, Eigen::Index nodes,
-                                 double t0, double t1) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(nodes);
-  const double mid = 0.5 * (t0 + t1);
-  const double speed = speed_at(spec.duty_cycle, mid), feed = feed_speed_at(spec.feed_axis, mid);
-  for (const auto& shape : shapes) {
-    const double power = source_power(spec.thermal.sources[shape.source], speed, feed);
-    if (power == 0) continue;
-    const Eigen::VectorXd fraction = moving_piece_fractions(spec, shape, t0, t1);
-    for (Eigen::Index i = 0; i < fraction.size(); ++i) {
-      if (fraction(i) == 0) continue;
-      const double q = power * fraction(i) / shape.volume(i);  // [W/m^3] in this piece
-      for (Eigen::Index a = 0; a < shape.nodes.cols(); ++a)
-        f(shape.nodes(i, a)) += q * shape.weight(i, a);
-    }
-  }
-  return f;
-}
-
 }  // namespace tt::solvers

@@ -38,10 +38,4 @@ Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, E
 Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
                                        double t0, double t1);
 
-/// Nodal heat load [W] of every moving source averaged over the step [t0, t1]: sums to the sources'
-/// total power (spindle and feed speeds are constant within a step of the time grid).
-Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
-                                 const std::vector<MovingSourceShape>& shapes, Eigen::Index nodes,
-                                 double t0, double t1);
-
 }  // namespace tt::solvers

@@ -69,6 +69,11 @@ ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
                                const FullThermalSystem& system, const Progress& progress = {},
                                const Checkpointing& checkpointing = {});
 
+/// Heat stored in the mesh at `temperature` relative to the uniform initial temperature [J]:
+/// quadrature of rho c (T - T0) over the elements.
+double stored_heat(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                   const Eigen::VectorXd& temperature);
+
 /// The history at some nodes, as a sensor there would record it: #times x nodes.size() [K].
 /// Throws SolverError for a node the history does not have.
 Eigen::MatrixXd nodal_history(const ThermalHistory& history, const std::vector<int>& nodes);

@@ -21,7 +21,7 @@
 #include "solvers/loads.hpp"
 #include "solvers/reduction.hpp"
 #include "solvers/thermal.hpp"
-#include "tests/common/bar_case.hpp"
+#include "tests/common/gantry_bar.hpp"
 #include "tests/common/case_toml.hpp"
 
 namespace tt::reduction_test {
@@ -323,7 +323,7 @@ TEST(ErrorIndicator, IsSmallOnAGoodBasisAndLargeOnATruncatedOne) {
 }
 
 TEST(ReducedRun, FollowsHeatMovingWithTheFeedAxis) {
-  const core::CaseSpec spec = spec_of(test_toml::bar_case(1));
+  const core::CaseSpec spec = spec_of(test_toml::gantry_bar(1));
   const mesh::TetMesh m = mesh::mesh_case(spec);
   const solvers::FullThermalSystem full = solvers::thermal_system(m, spec);
   const solvers::ReducedModel model = solvers::reduced_model(full, spec);

@@ -1,6 +1,6 @@
 // Spatial order of the conduction operator with a manufactured steady solution
 //   u = sin(2x + y) exp(z / 2) + x^2 on the unit cube, k = 1 W/(m K), q = -k lap u,
-// from the assembled K of thermal_operators, a load vector built here from the kernels' shape
+// from the assembled K of thermal_system, a load vector built here from the kernels' shape
 // functions and degree-5 quadrature, and u prescribed at every boundary node by elimination. The
 // L2 error, by the same quadrature, should fall as h^2 on 4-node and h^3 on 10-node tets, with
 // h = (volume / #tets)^(1/3) measured on the meshes TetGen makes for four max_edge levels.

@@ -1,5 +1,5 @@
-// The small feed-axis case that the gantry and reduction tests share: a bar with heat that moves
-// with the axis and a fixed feed-speed source.
+// The small gantry-like case of the feed-axis tests: a bar with heat that moves with the axis and
+// a fixed source whose heat follows the feed speed (a feed_power law).
 #pragma once
 
 #include <string>
@@ -10,7 +10,7 @@ namespace tt::test_toml {
 
 /// A steel bar 1 m along x on [0, 1] with a moving source in it (window 0.2 m) and a fixed
 /// feed-speed source in a pad; the axis reciprocates over [0.2, 0.8] at 6 m/min, then stands.
-inline std::string bar_case(int order, const std::string& scheme = "backward_euler") {
+inline std::string gantry_bar(int order, const std::string& scheme = "backward_euler") {
   std::string t = header("bar") + steel();
   t += box_body("bar", "steel", "0.04", "[0.0, 0.0, 0.0]", "[1.0, 0.05, 0.05]");
   t += box_body("pad", "steel", "0.04", "[-0.05, 0.0, 0.0]", "[0.0, 0.05, 0.05]");
