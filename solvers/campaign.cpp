@@ -126,7 +126,7 @@ std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const c
                                               const std::vector<CampaignRun>& runs,
                                               const Progress& progress,
                                               const std::vector<int>& sampled_nodes) {
-  const ThermalOperators ops = thermal_operators(mesh, base);
+  const FullThermalSystem ops = thermal_system(mesh, base);
   const ElasticModel elastic(mesh, base);
   const auto nodes = error_nodes(mesh, base);
   // 9 influence vectors: (tcp, z1, z2) x (x, y, z).

@@ -8,7 +8,7 @@ VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const
                     const Checkpointing& checkpointing) {
   VirtualRun run;
   const auto t0 = std::chrono::steady_clock::now();
-  run.operators = thermal_operators(mesh, spec);
+  run.operators = thermal_system(mesh, spec);
   run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run.thermal = thermal_history(mesh, spec, run.operators, progress, checkpointing);
   run.thermal.timings.assemble_s = run.operators_s;

@@ -10,7 +10,7 @@
 namespace tt::solvers {
 
 struct VirtualRun {
-  ThermalOperators operators;
+  FullThermalSystem operators;
   ThermalHistory thermal;
   std::optional<ElasticHistory> elastic;  /// when mechanical.enabled
   std::optional<ThermalError> error;      /// when mechanical.enabled and a TCP is named
