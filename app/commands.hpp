@@ -19,6 +19,8 @@ struct RunArgs {
   double checkpoint_every_s = 600;  /// wall time between checkpoints; < 0: none
   int stop_after_steps = 0;       /// tests: save a checkpoint after this many steps and exit 3
   std::filesystem::path dump;     /// tests: temperatures and displacements as raw doubles
+  std::filesystem::path rom;      /// a reduced model (reduce --out DIR): thermal transient from it
+  bool verify = false;            /// with rom: recompute the output times in full and compare
 };
 
 struct ProbesArgs {

@@ -31,6 +31,12 @@ int main(int argc, char** argv) {
   run->add_flag("--resume", run_args.resume, "continue from OUT.checkpoint, left by an interrupted run");
   run->add_option("--checkpoint-every-s", run_args.checkpoint_every_s,
                   "wall time between checkpoints of the time loop (default 600; negative: none)");
+  run->add_option("--rom", run_args.rom,
+                  "a reduced model (thermotwin reduce CASE --out DIR): the thermal transient from it")
+      ->check(CLI::ExistingDirectory);
+  run->add_flag("--verify", run_args.verify,
+                "with --rom: recompute the output times with the full model and report the "
+                "difference in summary.json");
   // Hidden (empty group): for the reliability tests.
   run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
   run->add_option("--dump", run_args.dump)->group("");

@@ -168,7 +168,8 @@ double stored_heat_total(const mesh::TetMesh& m, const core::CaseSpec& spec, con
   return total;
 }
 
-/// Heat delivered from the laws over the duty cycle: the sources' and the surface fluxes' [J].
+}  // namespace
+
 double heat_in_law(const core::CaseSpec& spec, const FullThermalSystem& sys) {
   double total = heat_delivered(spec);
   const double end = spec.duty_cycle.end;
@@ -187,8 +188,6 @@ double heat_in_law(const core::CaseSpec& spec, const FullThermalSystem& sys) {
   }
   return total;
 }
-
-}  // namespace
 
 FullThermalSystem thermal_system(const mesh::TetMesh& mesh, const core::CaseSpec& spec) {
   return mesh.order == 1 ? assemble<4>(mesh, spec) : assemble<10>(mesh, spec);

@@ -74,6 +74,10 @@ ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
 double stored_heat(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                    const Eigen::VectorXd& temperature);
 
+/// Heat delivered from the laws over the duty cycle, the sources' and the surface fluxes' [J]: the
+/// energy balance's independent path (no solver).
+double heat_in_law(const core::CaseSpec& spec, const FullThermalSystem& system);
+
 /// The history at some nodes, as a sensor there would record it: #times x nodes.size() [K].
 /// Throws SolverError for a node the history does not have.
 Eigen::MatrixXd nodal_history(const ThermalHistory& history, const std::vector<int>& nodes);

@@ -103,6 +103,8 @@ TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& p
   run.states = h.states;
   run.outputs = output_history(twin.outputs, twin.outputs.rows * h.states, twin.model.system.uniform);
   run.timings = h.timings;
+  run.heat_in = h.heat_in;
+  run.lost = h.lost;
   return run;
 }
 

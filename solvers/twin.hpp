@@ -59,6 +59,7 @@ struct TwinRun {
   std::vector<double> times;  /// t = 0, then the case's output times [s]
   Eigen::MatrixXd states;     /// #states x #times
   Eigen::MatrixXd outputs;    /// #times x #outputs, as output_history gives
+  double heat_in = 0, lost = 0;  /// from the step loads and through the films [J]
   ThermalTimings timings;
 };
 TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& progress = {});
