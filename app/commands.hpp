@@ -30,6 +30,8 @@ struct ProbesArgs {
 
 struct PlaceArgs {
   std::filesystem::path case_file, from_run, out;
+  std::filesystem::path rom;  /// a reduced model (reduce --out DIR) to simulate the case on
+  bool full = false;          /// simulate in full order (default: a reduced model built on the fly)
   int samples = 100, bins = 20, m_max = 6;
   bool sensor_noise = false;  /// place on readings with the campaign's sensor noise
   bool quiet = false;
@@ -37,6 +39,8 @@ struct PlaceArgs {
 
 struct FitArgs {
   std::filesystem::path case_file, out;
+  std::filesystem::path rom;  /// a reduced model (reduce --out DIR) to run the campaign on
+  bool full = false;          /// the campaign in full order (default: a reduced model on the fly)
   double hours = 5, required_sm_um = 1.0;
   bool quick = false, quiet = false;
 };

@@ -80,6 +80,11 @@ int main(int argc, char** argv) {
                   "place on readings as real sensors give them: the campaign's noise (0.05 K, "
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
+  place->add_option("--rom", place_args.rom,
+                    "a reduced model (thermotwin reduce CASE --out DIR) to simulate the case on")
+      ->check(CLI::ExistingDirectory);
+  place->add_flag("--full", place_args.full,
+                  "simulate in full order (default: a reduced model built on the fly)");
 
   FitArgs fit_args;
   auto* fit = cli.add_subcommand("fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
@@ -95,6 +100,11 @@ int main(int argc, char** argv) {
   fit->add_option("--required-sm-um", fit_args.required_sm_um, "accuracy asked for: smallest m with test S_M below it");
   fit->add_flag("--quick", fit_args.quick, "least squares only (no model search)");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
+  fit->add_option("--rom", fit_args.rom,
+                  "a reduced model (thermotwin reduce CASE --out DIR) to run the campaign on")
+      ->check(CLI::ExistingDirectory);
+  fit->add_flag("--full", fit_args.full,
+                "the campaign in full order (default: a reduced model built on the fly)");
 
   CalibrateArgs calibrate_args;
   auto* calibrate = cli.add_subcommand("calibrate", "Close the loop on measured runs: what the model lacks, before/after");

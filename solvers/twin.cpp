@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "solvers/thermal.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal_error.hpp"
 
@@ -93,6 +94,19 @@ Twin build_twin(const FullThermalSystem& full, const core::CaseSpec& spec,
   return twin;
 }
 
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+               const ReductionOptions& options) {
+  const FullThermalSystem full = thermal_system(mesh, spec);
+  TwinOutputs outputs;
+  if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) {
+    const ElasticModel elastic(mesh, spec);
+    outputs = full_outputs(mesh, spec, &elastic);
+  } else {
+    outputs = full_outputs(mesh, spec, nullptr);
+  }
+  return build_twin(full, spec, outputs, options);
+}
+
 TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& progress) {
   StepperRequest request;
   request.record_times = output_times(spec);
@@ -149,6 +163,40 @@ TwinComparison compare_outputs(const TwinOutputs& out, const Eigen::MatrixXd& fu
     c.drift_names.push_back(out.names[static_cast<std::size_t>(row)]);
   }
   return c;
+}
+
+std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<CampaignRun>& runs,
+                                          const Progress& progress,
+                                          const std::vector<int>& sampled_nodes) {
+  const TwinOutputs& out = twin.outputs;
+  if (!out.tcp)
+    throw core::SolverError("the reduced model has no TCP rows: a campaign needs the thermal error at the "
+                      "tool (mechanical.enabled and mechanical.tcp_point in the case it was built "
+                      "from)");
+  Eigen::MatrixXd node_rows(static_cast<Eigen::Index>(sampled_nodes.size()), twin.model.states());
+  for (std::size_t i = 0; i < sampled_nodes.size(); ++i) {
+    if (sampled_nodes[i] < 0 || sampled_nodes[i] >= twin.model.basis.rows())
+      throw core::SolverError("node " + std::to_string(sampled_nodes[i]) + " asked for a history: the " +
+                        "reduced model has " + std::to_string(twin.model.basis.rows()) + " nodes");
+    node_rows.row(static_cast<Eigen::Index>(i)) = twin.model.basis.row(sampled_nodes[i]);
+  }
+  double total = 0, done = 0;
+  for (const auto& r : runs) total += r.spec.duty_cycle.end;
+  std::vector<CampaignResult> results;
+  for (const auto& r : runs) {
+    const TwinRun run = twin_run(twin, r.spec, [&](double t, double) {
+      if (progress) progress(done + t, total);
+    });
+    done += r.spec.duty_cycle.end;
+    CampaignResult c{r.name, r.shape, run.times, {}, {}, {}};
+    c.point_temperature = run.outputs.leftCols(out.temperatures);
+    c.node_temperature = (node_rows * run.states).transpose();
+    c.error = thermal_error_of(run.outputs.middleCols(out.temperatures, 9).transpose(),
+                               out.probe_distance)
+                  .values;
+    results.push_back(std::move(c));
+  }
+  return results;
 }
 
 std::vector<TwinComparison> validate_twin(const FullThermalSystem& full,

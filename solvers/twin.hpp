@@ -54,6 +54,11 @@ struct Twin {
 Twin build_twin(const FullThermalSystem& full, const core::CaseSpec& spec,
                 const TwinOutputs& outputs, const ReductionOptions& options = {});
 
+/// The twin of a meshed case in one call: its full system, the stiffness factored once for the
+/// TCP's influence rows (when the case has a TCP), the reduced model and the projected outputs.
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+               const ReductionOptions& options = {});
+
 /// A run of the twin: the case's duty cycle stepped on the reduced states by the one stepper.
 struct TwinRun {
   std::vector<double> times;  /// t = 0, then the case's output times [s]
@@ -83,6 +88,14 @@ struct TwinComparison {
 /// Compares output histories of the same run (#times x #names each, as output_history gives).
 TwinComparison compare_outputs(const TwinOutputs& out, const Eigen::MatrixXd& full,
                                const Eigen::MatrixXd& reduced);
+
+/// The virtual campaign from the twin: each run stepped on the reduced states and read as
+/// simulate_campaign reads the full model (named points, `sampled_nodes` through the basis rows,
+/// the TCP's thermal error through the projected influence rows). Throws SolverError when the
+/// twin has no TCP rows.
+std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<CampaignRun>& runs,
+                                          const Progress& progress = {},
+                                          const std::vector<int>& sampled_nodes = {});
 
 /// The twin against the full model on each run (full_outputs gives `full_out` on the full mesh;
 /// the twin's outputs are the same rows projected): one comparison per run. Progress goes over all
