@@ -1,6 +1,5 @@
 #include "solvers/reduction.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -301,8 +300,10 @@ void check_reducible(const ReducedModel& model, const FullThermalSystem& full,
          std::to_string(moving.size()) + " in the case)");
 }
 
-double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
-                           const ReducedStep& step) {
+namespace {
+
+void check_step(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                const ReducedStep& step) {
   const Eigen::Index n = full.states();
   if (basis.rows() != n || step.state_old.size() != basis.cols() ||
       step.state_new.size() != basis.cols() || step.load.size() != n ||
@@ -313,30 +314,68 @@ double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd&
         std::to_string(step.state_old.size()) + " and " + std::to_string(step.state_new.size()) +
         ", load " + std::to_string(step.load.size()) + ", " + std::to_string(step.film.size()) +
         " film coefficients, dt = " + std::to_string(step.dt) + " s)");
-  const Sparse k = film_stiffness(full, step.film);
+}
+
+/// The step's full-order residual [W].
+Eigen::VectorXd step_residual(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                              const Sparse& k, const ReducedStep& step) {
   const Eigen::VectorXd t_old = basis * step.state_old, t_new = basis * step.state_new;
   const Eigen::VectorXd mid = step.theta * t_new + (1 - step.theta) * t_old;
-  const Eigen::VectorXd residual =
-      full.capacity * ((t_new - t_old) / step.dt) + k * mid - step.load;
+  return full.capacity * ((t_new - t_old) / step.dt) + k * mid - step.load;
+}
+
+/// The horizon rounded to a power of sqrt(2) (at least dt) [s], so that samples share factors.
+double rounded_horizon(const ReducedStep& step) {
   const double tau = std::max(step.dt, step.horizon);
+  return std::pow(std::sqrt(2.0), std::round(std::log(tau) / std::log(std::sqrt(2.0))));
+}
+
+/// max |e| of the residuals [K], e = (K(h) + C/tau)^{-1} r, one factor for all of them.
+Eigen::VectorXd estimates(const FullThermalSystem& full, const Sparse& k, double tau,
+                          const Eigen::MatrixXd& residuals) {
   Sparse a = k + (1.0 / tau) * full.capacity;
   a.makeCompressed();
-  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper> cg;
-  cg.setTolerance(1e-6);
-  cg.setMaxIterations(static_cast<Eigen::Index>(std::max<Eigen::Index>(1000, n)));
-  cg.compute(a);
-  const Eigen::VectorXd e = cg.solve(residual);
-  return e.cwiseAbs().maxCoeff();
+  std::ostringstream what;
+  what << "reduction error indicator: K(h) + C/tau at tau = " << tau << " s";
+  const cholmod::Factor factor(a, what.str());
+  return factor.solve(residuals).cwiseAbs().colwise().maxCoeff().transpose();
+}
+
+}  // namespace
+
+double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                           const ReducedStep& step) {
+  check_step(full, basis, step);
+  const Sparse k = film_stiffness(full, step.film);
+  return estimates(full, k, rounded_horizon(step), step_residual(full, basis, k, step))(0);
 }
 
 ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel& model,
                                const std::vector<ReducedStep>& steps, double tolerance_k) {
   ErrorIndicator out;
   out.tolerance_k = tolerance_k;
-  for (const auto& s : steps) {
-    out.samples_k.push_back(step_error_estimate(full, model.basis, s));
-    out.max_k = std::max(out.max_k, out.samples_k.back());
+  out.samples_k.assign(steps.size(), 0.0);
+  for (const auto& s : steps) check_step(full, model.basis, s);
+  // Samples grouped by (film state, rounded horizon): one factor and one block solve per group.
+  std::vector<bool> done(steps.size(), false);
+  for (size_t i = 0; i < steps.size(); ++i) {
+    if (done[i]) continue;
+    const double tau = rounded_horizon(steps[i]);
+    std::vector<size_t> group;
+    for (size_t j = i; j < steps.size(); ++j)
+      if (!done[j] && steps[j].film == steps[i].film && rounded_horizon(steps[j]) == tau)
+        group.push_back(j);
+    const Sparse k = film_stiffness(full, steps[i].film);
+    Eigen::MatrixXd r(full.states(), static_cast<Eigen::Index>(group.size()));
+    for (size_t g = 0; g < group.size(); ++g)
+      r.col(static_cast<Eigen::Index>(g)) = step_residual(full, model.basis, k, steps[group[g]]);
+    const Eigen::VectorXd e = estimates(full, k, tau, r);
+    for (size_t g = 0; g < group.size(); ++g) {
+      out.samples_k[group[g]] = e(static_cast<Eigen::Index>(g));
+      done[group[g]] = true;
+    }
   }
+  for (double e : out.samples_k) out.max_k = std::max(out.max_k, e);
   return out;
 }
 

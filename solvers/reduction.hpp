@@ -111,12 +111,12 @@ struct ReducedStep {
 /// Estimated full-order error of a reduced step's end state [K]: the step's full-order residual
 /// r = C (T_{n+1} - T_n)/dt + K(h) (theta T_{n+1} + (1 - theta) T_n) - f, T = V z (zero in the
 /// span of V, by Galerkin), turned into temperature by the full system over the horizon,
-/// e = (K(h) + C/tau)^{-1} r with tau = max(dt, horizon): the one-step correction just after a
-/// switch, and the error that a residual persisting since the switch has built up later
-/// (conjugate gradients, Jacobi preconditioner, relative tolerance 1e-6). Returns max |e| over
-/// the nodes. An estimate, not a bound: docs/reduced-order.md gives its measured ratio to the
-/// true error. Sample steps that end at output times: just after a switch, the reduced model's
-/// error between output times can be larger and decays within a minute.
+/// e = (K(h) + C/tau)^{-1} r with tau = max(dt, horizon) rounded to a power of sqrt(2): the
+/// one-step correction just after a switch, and the error that a residual persisting since the
+/// switch has built up later. One sparse factor per (film state, tau). Returns max |e| over the
+/// nodes. An estimate, not a bound: docs/reduced-order.md gives its measured ratio to the true
+/// error. Sample steps that end at output times: just after a switch, the reduced model's error
+/// between output times can be larger and decays within a minute.
 double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
                            const ReducedStep& step);
 
@@ -128,7 +128,8 @@ struct ErrorIndicator {
 };
 
 /// The indicator over sampled steps (steps that end at output times: all, or the first after each
-/// switch and the last).
+/// switch, the last before each and the last): samples with the same film state and rounded
+/// horizon share one factor and one block solve.
 ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel& model,
                                const std::vector<ReducedStep>& steps,
                                double tolerance_k = kReducedToleranceK);
