@@ -316,6 +316,7 @@ TEST(ErrorIndicator, IsSmallOnAGoodBasisAndLargeOnATruncatedOne) {
   solvers::ReductionOptions poor;
   poor.speeds_rpm = {3000.0};
   poor.shifts_per_s = {0.0};
+  poor.second_moment = false;
   const solvers::ReducedModel truncated = solvers::reduced_model(b.full, b.spec, poor);
   const ReducedRun good = reduced_run(b.full, b.model, spec);
   const ReducedRun bad = reduced_run(b.full, truncated, spec);
