@@ -24,7 +24,7 @@
 namespace tt::solvers {
 
 /// Default tolerance of the error indicator [K]: half the accuracy the reduced model is built for
-/// (0.01 K), since the indicator is an estimate that has read up to 1.6 times low in the tests.
+/// (0.01 K), since the indicator is an estimate that has read down to 0.85 of the true error.
 constexpr double kReducedToleranceK = 0.005;
 
 struct ReductionOptions {
@@ -93,8 +93,8 @@ Eigen::MatrixXd reconstructed(const ReducedModel& model, const Eigen::MatrixXd& 
 
 /// Throws SolverError, naming what differs, when `spec` asks for something the reduced model
 /// cannot answer exactly: another number of convection entries, sources, fluxes or moving
-/// sources than it was built with (another case), a moving source whose window changed, or the
-/// full system it is checked against has another number of nodes.
+/// sources than it was built with (another case), or the full system it is checked against has
+/// another number of nodes (another mesh).
 void check_reducible(const ReducedModel& model, const FullThermalSystem& full,
                      const core::CaseSpec& spec);
 
