@@ -5,6 +5,7 @@
 // weighs).
 //
 // Run:   bench_solvers_reduction [case=cases/sb1_coarse.toml] [top_speed_rpm=6000]
+//                                [compression=0 (> 0: add the default basis compressed)] [only]
 // Prints the mesh size, then per basis and duty cycle: states r, build time, the largest
 // |reduced - full| over every node and output time and over the named points, the error
 // indicator at the output times, and the run times. The duty cycles: the case's own (P-1 for
@@ -163,6 +164,9 @@ int main(int argc, char** argv) {
     const std::string case_file =
         argc > 1 ? argv[1] : std::string(TT_SOURCE_DIR) + "/cases/sb1_coarse.toml";
     const double top_speed = argc > 2 ? std::atof(argv[2]) : 6000.0;
+    // A compression tolerance > 0 adds the default basis compressed; "only" skips the others.
+    const double compression = argc > 3 ? std::atof(argv[3]) : 0.0;
+    const bool only = argc > 4 && std::string(argv[4]) == "only";
     // 1. The case, its mesh and the full system.
     tt::core::CaseSpec spec = tt::io::read_case(case_file);
     auto t = Clock::now();
@@ -179,8 +183,10 @@ int main(int argc, char** argv) {
 
     // 2. The bases.
     std::vector<Variant> variants;
-    const auto krylov = [&](const std::string& name, std::vector<double> shifts, bool second) {
+    const auto krylov = [&](const std::string& name, std::vector<double> shifts, bool second,
+                            double compress = 0) {
       s::ReductionOptions o;
+      o.compression_tolerance = compress;
       o.speeds_rpm = {0.0, top_speed};
       o.shifts_per_s = std::move(shifts);
       o.second_moment = second;
@@ -194,10 +200,14 @@ int main(int argc, char** argv) {
       return v;
     };
     krylov("krylov 0+5 shifts, 2 moments (default)", {}, true);
-    krylov("krylov 0+5 shifts, 1 moment", logspace(5), false);
-    krylov("krylov 0+2 shifts, 1 moment", logspace(2), false);
-    krylov("krylov 0+8 shifts, 1 moment", logspace(8), false);
-    {
+    if (compression > 0)
+      krylov("  compressed " + std::to_string(compression), {}, true, compression);
+    if (!only) {
+      krylov("krylov 0+5 shifts, 1 moment", logspace(5), false);
+      krylov("krylov 0+2 shifts, 1 moment", logspace(2), false);
+      krylov("krylov 0+8 shifts, 1 moment", logspace(8), false);
+    }
+    if (!only) {
       // POD from the full run of the case's own cycle: its states at every output time.
       t = Clock::now();
       s::StepperRequest q;

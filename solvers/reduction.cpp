@@ -1,5 +1,6 @@
 #include "solvers/reduction.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -43,6 +44,9 @@ void check_options(const ReductionOptions& o) {
       fail("speed " + std::to_string(n) + " rpm: must be finite and >= 0");
   if (!(o.deflation_tolerance > 0 && o.deflation_tolerance < 1))
     fail("deflation_tolerance = " + std::to_string(o.deflation_tolerance) + ": must be in (0, 1)");
+  if (!(o.compression_tolerance >= 0 && o.compression_tolerance < 1))
+    fail("compression_tolerance = " + std::to_string(o.compression_tolerance) +
+         ": must be in [0, 1)");
   if (!(o.moving_slice_fraction > 0 && o.moving_slice_fraction <= 1))
     fail("moving_slice_fraction = " + std::to_string(o.moving_slice_fraction) +
          ": must be in (0, 1]");
@@ -96,19 +100,24 @@ Eigen::MatrixXd slice_weights(const MovingSourceShape& shape, double width) {
 /// Orthonormal basis under construction, in the capacity inner product.
 class CapacityOrthonormalBasis {
  public:
-  CapacityOrthonormalBasis(const Sparse& capacity, double tolerance)
-      : c_(capacity), tol_(tolerance), v_(capacity.rows(), 0) {}
+  CapacityOrthonormalBasis(const Sparse& capacity, double tolerance, double compression)
+      : c_(capacity), tol_(tolerance), compression_(compression), v_(capacity.rows(), 0) {}
 
   /// Appends what each column adds to the span (block Gram-Schmidt against the basis twice, then
   /// column by column twice: "twice is enough"); returns the number of columns dropped.
   int append(Eigen::MatrixXd x) {
-    const Eigen::VectorXd norm0 = c_norms(x);
+    Eigen::VectorXd norm0 = c_norms(x);
     for (int pass = 0; pass < 2 && v_.cols() > 0; ++pass) {
       const Eigen::MatrixXd cx = c_ * x;
       x -= v_ * (v_.transpose() * cx);
     }
+    const Eigen::Index offered = x.cols();
+    if (compression_ > 0) {
+      x = compressed(std::move(x), norm0);
+      norm0 = Eigen::VectorXd::Ones(x.cols());
+    }
     const Eigen::Index first = v_.cols();
-    int dropped = 0;
+    int dropped = static_cast<int>(offered - x.cols());
     for (Eigen::Index j = 0; j < x.cols(); ++j) {
       Eigen::VectorXd col = x.col(j);
       for (int pass = 0; pass < 2 && v_.cols() > first; ++pass) {
@@ -128,12 +137,30 @@ class CapacityOrthonormalBasis {
   const Eigen::MatrixXd& basis() const { return v_; }
 
  private:
+  /// The block's principal directions in the C inner product, each column scaled by its norm
+  /// before orthogonalisation (every input counts alike): those whose singular value exceeds
+  /// the compression tolerance, C-orthonormal.
+  Eigen::MatrixXd compressed(Eigen::MatrixXd x, const Eigen::VectorXd& norm0) const {
+    for (Eigen::Index j = 0; j < x.cols(); ++j)
+      x.col(j) =
+          norm0(j) > 0 ? Eigen::VectorXd(x.col(j) / norm0(j)) : Eigen::VectorXd::Zero(x.rows());
+    const Eigen::MatrixXd g = x.transpose() * (c_ * x);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = g.rows() - 1; i >= 0; --i)
+      if (eig.eigenvalues()(i) > compression_ * compression_) keep.push_back(i);
+    Eigen::MatrixXd out(x.rows(), static_cast<Eigen::Index>(keep.size()));
+    for (size_t k = 0; k < keep.size(); ++k)
+      out.col(static_cast<Eigen::Index>(k)) =
+          x * eig.eigenvectors().col(keep[k]) / std::sqrt(eig.eigenvalues()(keep[k]));
+    return out;
+  }
   Eigen::VectorXd c_norms(const Eigen::MatrixXd& x) const {
     const Eigen::MatrixXd cx = c_ * x;
     return (x.cwiseProduct(cx)).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
   }
   const Sparse& c_;
-  double tol_;
+  double tol_, compression_;
   Eigen::MatrixXd v_;
 };
 
@@ -180,7 +207,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   ReductionStats st;
   const Eigen::MatrixXd b = input_columns(full, spec, options);
   st.input_columns = static_cast<int>(b.cols());
-  CapacityOrthonormalBasis v(full.capacity, options.deflation_tolerance);
+  CapacityOrthonormalBasis v(full.capacity, options.deflation_tolerance,
+                             options.compression_tolerance);
   // The uniform field first: every run starts from it, exactly.
   v.append(Eigen::VectorXd::Ones(full.states()));
   // The remaining input columns: the load shapes themselves (the response at s -> infinity).

@@ -40,6 +40,11 @@ struct ReductionOptions {
   /// A new column is dropped when orthogonalisation leaves less than this fraction of its
   /// capacity norm [-].
   double deflation_tolerance = 1e-9;
+  /// 0: keep every column that is not dependent. > 0: per block (one film state, shift and
+  /// moment), with each column scaled to unit C-norm, keep only the principal directions whose
+  /// singular value exceeds this [-] (fewer states where many inputs act alike, as the slices of
+  /// a moving source do).
+  double compression_tolerance = 0;
   /// Width of the slices along the axis into which a moving source's pieces are grouped, as a
   /// fraction of its window [-].
   double moving_slice_fraction = 0.25;
