@@ -1,7 +1,8 @@
 // The declared model under a measured run's inputs, read where the run was measured: the run's
 // speed column becomes the duty cycle, its sensors become interpolation weights, its displacement
 // probes become adjoint influence vectors, and the response of every channel to the declared
-// loads and to unit candidate effects comes out of one backward-Euler march per run.
+// loads and to unit candidate effects comes out of one march per run: the thermal solver's own
+// stepper (solvers::step_thermal) with the candidates as extra right-hand-side columns.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,6 +1,6 @@
 #include "solvers/reduction.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -44,6 +44,9 @@ void check_options(const ReductionOptions& o) {
       fail("speed " + std::to_string(n) + " rpm: must be finite and >= 0");
   if (!(o.deflation_tolerance > 0 && o.deflation_tolerance < 1))
     fail("deflation_tolerance = " + std::to_string(o.deflation_tolerance) + ": must be in (0, 1)");
+  if (!(o.compression_tolerance >= 0 && o.compression_tolerance < 1))
+    fail("compression_tolerance = " + std::to_string(o.compression_tolerance) +
+         ": must be in [0, 1)");
   if (!(o.moving_slice_fraction > 0 && o.moving_slice_fraction <= 1))
     fail("moving_slice_fraction = " + std::to_string(o.moving_slice_fraction) +
          ": must be in (0, 1]");
@@ -97,19 +100,24 @@ Eigen::MatrixXd slice_weights(const MovingSourceShape& shape, double width) {
 /// Orthonormal basis under construction, in the capacity inner product.
 class CapacityOrthonormalBasis {
  public:
-  CapacityOrthonormalBasis(const Sparse& capacity, double tolerance)
-      : c_(capacity), tol_(tolerance), v_(capacity.rows(), 0) {}
+  CapacityOrthonormalBasis(const Sparse& capacity, double tolerance, double compression)
+      : c_(capacity), tol_(tolerance), compression_(compression), v_(capacity.rows(), 0) {}
 
   /// Appends what each column adds to the span (block Gram-Schmidt against the basis twice, then
   /// column by column twice: "twice is enough"); returns the number of columns dropped.
   int append(Eigen::MatrixXd x) {
-    const Eigen::VectorXd norm0 = c_norms(x);
+    Eigen::VectorXd norm0 = c_norms(x);
     for (int pass = 0; pass < 2 && v_.cols() > 0; ++pass) {
       const Eigen::MatrixXd cx = c_ * x;
       x -= v_ * (v_.transpose() * cx);
     }
+    const Eigen::Index offered = x.cols();
+    if (compression_ > 0) {
+      x = compressed(std::move(x), norm0);
+      norm0 = Eigen::VectorXd::Ones(x.cols());
+    }
     const Eigen::Index first = v_.cols();
-    int dropped = 0;
+    int dropped = static_cast<int>(offered - x.cols());
     for (Eigen::Index j = 0; j < x.cols(); ++j) {
       Eigen::VectorXd col = x.col(j);
       for (int pass = 0; pass < 2 && v_.cols() > first; ++pass) {
@@ -129,12 +137,30 @@ class CapacityOrthonormalBasis {
   const Eigen::MatrixXd& basis() const { return v_; }
 
  private:
+  /// The block's principal directions in the C inner product, each column scaled by its norm
+  /// before orthogonalisation (every input counts alike): those whose singular value exceeds
+  /// the compression tolerance, C-orthonormal.
+  Eigen::MatrixXd compressed(Eigen::MatrixXd x, const Eigen::VectorXd& norm0) const {
+    for (Eigen::Index j = 0; j < x.cols(); ++j)
+      x.col(j) =
+          norm0(j) > 0 ? Eigen::VectorXd(x.col(j) / norm0(j)) : Eigen::VectorXd::Zero(x.rows());
+    const Eigen::MatrixXd g = x.transpose() * (c_ * x);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = g.rows() - 1; i >= 0; --i)
+      if (eig.eigenvalues()(i) > compression_ * compression_) keep.push_back(i);
+    Eigen::MatrixXd out(x.rows(), static_cast<Eigen::Index>(keep.size()));
+    for (size_t k = 0; k < keep.size(); ++k)
+      out.col(static_cast<Eigen::Index>(k)) =
+          x * eig.eigenvectors().col(keep[k]) / std::sqrt(eig.eigenvalues()(keep[k]));
+    return out;
+  }
   Eigen::VectorXd c_norms(const Eigen::MatrixXd& x) const {
     const Eigen::MatrixXd cx = c_ * x;
     return (x.cwiseProduct(cx)).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
   }
   const Sparse& c_;
-  double tol_;
+  double tol_, compression_;
   Eigen::MatrixXd v_;
 };
 
@@ -181,7 +207,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   ReductionStats st;
   const Eigen::MatrixXd b = input_columns(full, spec, options);
   st.input_columns = static_cast<int>(b.cols());
-  CapacityOrthonormalBasis v(full.capacity, options.deflation_tolerance);
+  CapacityOrthonormalBasis v(full.capacity, options.deflation_tolerance,
+                             options.compression_tolerance);
   // The uniform field first: every run starts from it, exactly.
   v.append(Eigen::VectorXd::Ones(full.states()));
   // The remaining input columns: the load shapes themselves (the response at s -> infinity).
@@ -301,8 +328,10 @@ void check_reducible(const ReducedModel& model, const FullThermalSystem& full,
          std::to_string(moving.size()) + " in the case)");
 }
 
-double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
-                           const ReducedStep& step) {
+namespace {
+
+void check_step(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                const ReducedStep& step) {
   const Eigen::Index n = full.states();
   if (basis.rows() != n || step.state_old.size() != basis.cols() ||
       step.state_new.size() != basis.cols() || step.load.size() != n ||
@@ -313,30 +342,68 @@ double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd&
         std::to_string(step.state_old.size()) + " and " + std::to_string(step.state_new.size()) +
         ", load " + std::to_string(step.load.size()) + ", " + std::to_string(step.film.size()) +
         " film coefficients, dt = " + std::to_string(step.dt) + " s)");
-  const Sparse k = film_stiffness(full, step.film);
+}
+
+/// The step's full-order residual [W].
+Eigen::VectorXd step_residual(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                              const Sparse& k, const ReducedStep& step) {
   const Eigen::VectorXd t_old = basis * step.state_old, t_new = basis * step.state_new;
   const Eigen::VectorXd mid = step.theta * t_new + (1 - step.theta) * t_old;
-  const Eigen::VectorXd residual =
-      full.capacity * ((t_new - t_old) / step.dt) + k * mid - step.load;
+  return full.capacity * ((t_new - t_old) / step.dt) + k * mid - step.load;
+}
+
+/// The horizon rounded to a power of sqrt(2) (at least dt) [s], so that samples share factors.
+double rounded_horizon(const ReducedStep& step) {
   const double tau = std::max(step.dt, step.horizon);
+  return std::pow(std::sqrt(2.0), std::round(std::log(tau) / std::log(std::sqrt(2.0))));
+}
+
+/// max |e| of the residuals [K], e = (K(h) + C/tau)^{-1} r, one factor for all of them.
+Eigen::VectorXd estimates(const FullThermalSystem& full, const Sparse& k, double tau,
+                          const Eigen::MatrixXd& residuals) {
   Sparse a = k + (1.0 / tau) * full.capacity;
   a.makeCompressed();
-  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper> cg;
-  cg.setTolerance(1e-6);
-  cg.setMaxIterations(static_cast<Eigen::Index>(std::max<Eigen::Index>(1000, n)));
-  cg.compute(a);
-  const Eigen::VectorXd e = cg.solve(residual);
-  return e.cwiseAbs().maxCoeff();
+  std::ostringstream what;
+  what << "reduction error indicator: K(h) + C/tau at tau = " << tau << " s";
+  const cholmod::Factor factor(a, what.str());
+  return factor.solve(residuals).cwiseAbs().colwise().maxCoeff().transpose();
+}
+
+}  // namespace
+
+double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                           const ReducedStep& step) {
+  check_step(full, basis, step);
+  const Sparse k = film_stiffness(full, step.film);
+  return estimates(full, k, rounded_horizon(step), step_residual(full, basis, k, step))(0);
 }
 
 ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel& model,
                                const std::vector<ReducedStep>& steps, double tolerance_k) {
   ErrorIndicator out;
   out.tolerance_k = tolerance_k;
-  for (const auto& s : steps) {
-    out.samples_k.push_back(step_error_estimate(full, model.basis, s));
-    out.max_k = std::max(out.max_k, out.samples_k.back());
+  out.samples_k.assign(steps.size(), 0.0);
+  for (const auto& s : steps) check_step(full, model.basis, s);
+  // Samples grouped by (film state, rounded horizon): one factor and one block solve per group.
+  std::vector<bool> done(steps.size(), false);
+  for (size_t i = 0; i < steps.size(); ++i) {
+    if (done[i]) continue;
+    const double tau = rounded_horizon(steps[i]);
+    std::vector<size_t> group;
+    for (size_t j = i; j < steps.size(); ++j)
+      if (!done[j] && steps[j].film == steps[i].film && rounded_horizon(steps[j]) == tau)
+        group.push_back(j);
+    const Sparse k = film_stiffness(full, steps[i].film);
+    Eigen::MatrixXd r(full.states(), static_cast<Eigen::Index>(group.size()));
+    for (size_t g = 0; g < group.size(); ++g)
+      r.col(static_cast<Eigen::Index>(g)) = step_residual(full, model.basis, k, steps[group[g]]);
+    const Eigen::VectorXd e = estimates(full, k, tau, r);
+    for (size_t g = 0; g < group.size(); ++g) {
+      out.samples_k[group[g]] = e(static_cast<Eigen::Index>(g));
+      done[group[g]] = true;
+    }
   }
+  for (double e : out.samples_k) out.max_k = std::max(out.max_k, e);
   return out;
 }
 

@@ -4,7 +4,8 @@
 //
 // Method (docs/reduced-order.md says why, with the measured alternatives): block rational Krylov
 // (moment matching). For each film state h (the film coefficients at the speeds asked for) and
-// each shift s, V takes X = (K(h) + s C)^{-1} B, B the input columns; s = 0 is the steady state.
+// each shift s, V takes X = (K(h) + s C)^{-1} B and (K(h) + s C)^{-1} C X, B the input columns;
+// s = 0 is the steady state.
 // V is orthonormal in the capacity inner product (V^T C V = I) and holds the uniform field, so
 // the model starts exactly from the uniform initial temperature. The Galerkin projection keeps
 // every operator separately (capacity, conduction, each film), so a film that follows the speed
@@ -23,7 +24,7 @@
 namespace tt::solvers {
 
 /// Default tolerance of the error indicator [K]: half the accuracy the reduced model is built for
-/// (0.01 K), since the indicator is an estimate that has read up to 1.6 times low in the tests.
+/// (0.01 K), since the indicator is an estimate that has read down to 0.85 of the true error.
 constexpr double kReducedToleranceK = 0.005;
 
 struct ReductionOptions {
@@ -33,11 +34,17 @@ struct ReductionOptions {
   /// Spindle speeds whose film coefficients are sampled [rpm]; empty: 0 and the duty cycle's
   /// highest speed. States with the same coefficients are sampled once.
   std::vector<double> speeds_rpm;
-  /// A second moment (K + sC)^{-1} C X per shift as well.
-  bool second_moment = false;
+  /// A second moment (K + sC)^{-1} C X per shift as well (20 to 30 times more accurate on SB-1
+  /// coarse for 1.7 times the states, no more factors: docs/reduced-order.md).
+  bool second_moment = true;
   /// A new column is dropped when orthogonalisation leaves less than this fraction of its
   /// capacity norm [-].
   double deflation_tolerance = 1e-9;
+  /// 0: keep every column that is not dependent. > 0: per block (one film state, shift and
+  /// moment), with each column scaled to unit C-norm, keep only the principal directions whose
+  /// singular value exceeds this [-] (fewer states where many inputs act alike, as the slices of
+  /// a moving source do).
+  double compression_tolerance = 0;
   /// Width of the slices along the axis into which a moving source's pieces are grouped, as a
   /// fraction of its window [-].
   double moving_slice_fraction = 0.25;
@@ -91,8 +98,8 @@ Eigen::MatrixXd reconstructed(const ReducedModel& model, const Eigen::MatrixXd& 
 
 /// Throws SolverError, naming what differs, when `spec` asks for something the reduced model
 /// cannot answer exactly: another number of convection entries, sources, fluxes or moving
-/// sources than it was built with (another case), a moving source whose window changed, or the
-/// full system it is checked against has another number of nodes.
+/// sources than it was built with (another case), or the full system it is checked against has
+/// another number of nodes (another mesh).
 void check_reducible(const ReducedModel& model, const FullThermalSystem& full,
                      const core::CaseSpec& spec);
 
@@ -111,12 +118,12 @@ struct ReducedStep {
 /// Estimated full-order error of a reduced step's end state [K]: the step's full-order residual
 /// r = C (T_{n+1} - T_n)/dt + K(h) (theta T_{n+1} + (1 - theta) T_n) - f, T = V z (zero in the
 /// span of V, by Galerkin), turned into temperature by the full system over the horizon,
-/// e = (K(h) + C/tau)^{-1} r with tau = max(dt, horizon): the one-step correction just after a
-/// switch, and the error that a residual persisting since the switch has built up later
-/// (conjugate gradients, Jacobi preconditioner, relative tolerance 1e-6). Returns max |e| over
-/// the nodes. An estimate, not a bound: docs/reduced-order.md gives its measured ratio to the
-/// true error. Sample steps that end at output times: just after a switch, the reduced model's
-/// error between output times can be larger and decays within a minute.
+/// e = (K(h) + C/tau)^{-1} r with tau = max(dt, horizon) rounded to a power of sqrt(2): the
+/// one-step correction just after a switch, and the error that a residual persisting since the
+/// switch has built up later. One sparse factor per (film state, tau). Returns max |e| over the
+/// nodes. An estimate, not a bound: docs/reduced-order.md gives its measured ratio to the true
+/// error. Sample steps that end at output times: just after a switch, the reduced model's error
+/// between output times can be larger and decays within a minute.
 double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
                            const ReducedStep& step);
 
@@ -128,7 +135,8 @@ struct ErrorIndicator {
 };
 
 /// The indicator over sampled steps (steps that end at output times: all, or the first after each
-/// switch and the last).
+/// switch, the last before each and the last): samples with the same film state and rounded
+/// horizon share one factor and one block solve.
 ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel& model,
                                const std::vector<ReducedStep>& steps,
                                double tolerance_k = kReducedToleranceK);

@@ -1,6 +1,7 @@
-// Transient heat conduction: operators assembled once from the mesh and the case, then a time
-// history under the duty cycle with one CHOLMOD factor per distinct (step, speed) and a
-// back-substitution per step.
+// Transient heat conduction: the system assembled once from the mesh and the case
+// (solvers/thermal_system.hpp), then a time history under the duty cycle from the one stepper
+// (solvers/thermal_stepper.hpp: a CHOLMOD factor per distinct (step, speed, scheme weight) and a
+// back-substitution per step).
 #pragma once
 
 #include <Eigen/Core>

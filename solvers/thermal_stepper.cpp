@@ -176,6 +176,67 @@ void check_columns(const LinearThermalSystem<Matrix>& sys, const StepperRequest&
                               std::to_string(n) + ") or no law");
 }
 
+/// Stiffness K + sum h_c F_c per speed and factors of C + theta dt A per (step, speed, theta),
+/// built on first use; factorisations are counted in `timings`.
+template <class Matrix>
+class StepOperators {
+ public:
+  StepOperators(const LinearThermalSystem<Matrix>& sys, ThermalTimings& timings)
+      : sys_(sys), timings_(timings) {}
+
+  const Matrix& stiffness(const LoadState& s) {
+    auto it = stiffness_.find(s.speed);
+    if (it != stiffness_.end()) return it->second;
+    Matrix kk = sys_.conduction;
+    for (size_t c = 0; c < s.h.size(); ++c) kk += s.h[c] * sys_.film[c];
+    if constexpr (std::is_same_v<Matrix, Sparse>) kk.makeCompressed();
+    return stiffness_.emplace(s.speed, std::move(kk)).first->second;
+  }
+
+  const StepFactor<Matrix>& factor(double dt, double theta, const LoadState& s) {
+    const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, s.speed, theta);
+    auto it = factors_.find(key);
+    if (it != factors_.end()) return *it->second;
+    const auto t_f = Clock::now();
+    Matrix a = sys_.capacity + (theta * dt) * stiffness(s);
+    if constexpr (std::is_same_v<Matrix, Sparse>) a.makeCompressed();
+    std::ostringstream what;
+    what << "thermal system (dt = " << dt << " s, speed = " << s.speed << " rpm)";
+    auto f = std::make_unique<StepFactor<Matrix>>(a, what.str());
+    timings_.factor_s += seconds_since(t_f);
+    timings_.factorizations += 1;
+    timings_.factor_entries = std::max(timings_.factor_entries, f->entries());
+    return *factors_.emplace(key, std::move(f)).first->second;
+  }
+
+ private:
+  const LinearThermalSystem<Matrix>& sys_;
+  ThermalTimings& timings_;
+  std::map<double, Matrix> stiffness_;
+  std::map<std::tuple<double, double, double>, std::unique_ptr<StepFactor<Matrix>>> factors_;
+};
+
+/// The caller columns' responses after the step `view` from `x` (#states x #columns), with the
+/// base's stiffness and factor: (C + theta dt A) x1 = (C - (1 - theta) dt A) x + dt b.
+template <class Matrix>
+Dense stepped_responses(const LinearThermalSystem<Matrix>& sys, const StepperRequest& q,
+                        const StepView& view, const Matrix& kk, const StepFactor<Matrix>& factor,
+                        const Dense& x) {
+  const double dt = view.dt(), t = view.t1, speed = view.speed;
+  const bool cn = view.theta != 1;
+  Dense b = sys.capacity * x;
+  if (cn) b -= (0.5 * dt) * (kk * x);
+  const auto ns = static_cast<Eigen::Index>(q.shape_columns.size());
+  for (Eigen::Index j = 0; j < ns; ++j) {
+    const auto& col = q.shape_columns[static_cast<size_t>(j)];
+    const double law = cn ? 0.5 * (col.law(t, speed) + col.law(view.t0, speed)) : col.law(t, speed);
+    b.col(j) += (dt * law) * col.shape;
+  }
+  for (size_t j = 0; j < q.load_columns.size(); ++j)
+    b.col(ns + static_cast<Eigen::Index>(j)) += dt * q.load_columns[j](view);
+  return factor.solve(b);
+}
+
 }  // namespace
 
 template <class Matrix>
@@ -235,32 +296,7 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
   for (Eigen::Index j = 0; j < nc; ++j) hist.responses[j].col(0) = block_prev.col(j);
   size_t next_out = 1;
 
-  // Stiffness per speed and factors per (step, speed, scheme weight): built on first use.
-  std::map<double, Matrix> stiffness;
-  std::map<std::tuple<double, double, double>, std::unique_ptr<StepFactor<Matrix>>> factors;
-  auto stiffness_at = [&](const LoadState& s) -> const Matrix& {
-    auto it = stiffness.find(s.speed);
-    if (it != stiffness.end()) return it->second;
-    Matrix kk = sys.conduction;
-    for (size_t c = 0; c < s.h.size(); ++c) kk += s.h[c] * sys.film[c];
-    if constexpr (std::is_same_v<Matrix, Sparse>) kk.makeCompressed();
-    return stiffness.emplace(s.speed, std::move(kk)).first->second;
-  };
-  auto factor_for = [&](double dt, double theta, const LoadState& s) -> const StepFactor<Matrix>& {
-    const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, s.speed, theta);
-    auto it = factors.find(key);
-    if (it != factors.end()) return *it->second;
-    const auto t_f = Clock::now();
-    Matrix a = sys.capacity + (theta * dt) * stiffness_at(s);
-    if constexpr (std::is_same_v<Matrix, Sparse>) a.makeCompressed();
-    std::ostringstream what;
-    what << "thermal system (dt = " << dt << " s, speed = " << s.speed << " rpm)";
-    auto f = std::make_unique<StepFactor<Matrix>>(a, what.str());
-    hist.timings.factor_s += seconds_since(t_f);
-    hist.timings.factorizations += 1;
-    hist.timings.factor_entries = std::max(hist.timings.factor_entries, f->entries());
-    return *factors.emplace(key, std::move(f)).first->second;
-  };
+  StepOperators<Matrix> ops(sys, hist.timings);
 
   const auto t_solve = Clock::now();
   double t_prev = 0, prev_speed = std::nan("");
@@ -288,7 +324,7 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     const bool restart = i == 0 || s_new.speed != prev_speed;
     const bool cn = scheme == Scheme::crank_nicolson && !restart;
     const double theta = cn ? 0.5 : 1.0;
-    const Matrix& kk = stiffness_at(s_new);
+    const Matrix& kk = ops.stiffness(s_new);
     // Heat moving with the feed axis: averaged over the step, the same for both ends of CN.
     const Eigen::VectorXd f_moving = moving_heat_load(spec, sys, t_prev, t);
     f_new = load_vector(spec, sys, s_new) + f_moving;
@@ -300,24 +336,12 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     } else {
       rhs = sys.capacity * temp + dt * f_new;
     }
-    const StepFactor<Matrix>& factor = factor_for(dt, theta, s_new);
+    const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
     Eigen::VectorXd next = rhs;
     factor.solve_in_place(next);
 
-    if (nc > 0) {
-      Dense b = sys.capacity * x;
-      if (cn) b -= (0.5 * dt) * (kk * x);
-      const StepView view{t_prev, t, s_new.speed, theta, &temp, &next};
-      for (Eigen::Index j = 0; j < ns; ++j) {
-        const auto& col = q.shape_columns[static_cast<size_t>(j)];
-        const double law = cn ? 0.5 * (col.law(t, s_new.speed) + col.law(t_prev, s_new.speed))
-                              : col.law(t, s_new.speed);
-        b.col(j) += (dt * law) * col.shape;
-      }
-      for (size_t j = 0; j < q.load_columns.size(); ++j)
-        b.col(ns + static_cast<Eigen::Index>(j)) += dt * q.load_columns[j](view);
-      x = factor.solve(b);
-    }
+    if (nc > 0)
+      x = stepped_responses(sys, q, {t_prev, t, s_new.speed, theta, &temp, &next}, kk, factor, x);
 
     double power = 0;
     for (double p : s_new.power) power += p;

@@ -21,8 +21,9 @@
 #include "solvers/loads.hpp"
 #include "solvers/reduction.hpp"
 #include "solvers/thermal.hpp"
-#include "tests/common/gantry_bar.hpp"
+#include "solvers/thermal_stepper.hpp"
 #include "tests/common/case_toml.hpp"
+#include "tests/common/gantry_bar.hpp"
 
 namespace tt::reduction_test {
 namespace {
@@ -71,17 +72,21 @@ const char* kStaircase =
     "{ start_s = 3600.0, speed_rpm = 3000.0 }, { start_s = 4500.0, speed_rpm = 0.0 } ]";
 const char* kSwingingSink = "[[0.0, 20.0], [1500.0, 24.0], [3000.0, 18.0], [5400.0, 21.0]]";
 
-// --- A minimal backward-Euler march, confined to this file until the one stepper lands --------
-// (solvers' templated stepper replaces it). Loads exactly as solvers/thermal.cpp forms them.
+// --- The full-order load of a step, for the error indicator's samples ------------------------
+// The stepper forms this load privately; until it offers it, this backward-Euler copy (the same
+// formulas as solvers/thermal_stepper.cpp's load_state, load_vector and moving_heat_load) gives
+// the indicator the full load at a sampled step.
 
-/// Load of one step [t_prev, t] on a system with state vector z (T = V z) [W].
-template <class System>
-Eigen::VectorXd step_load(const System& sys, const core::CaseSpec& spec, double t_prev, double t,
-                          const Eigen::VectorXd& z, double t0_k, std::vector<double>* film) {
+/// Load of the backward-Euler step [t_prev, t] in the full space from the state T_prev [W], and
+/// the step's film coefficients.
+Eigen::VectorXd full_step_load(const solvers::FullThermalSystem& sys, const core::CaseSpec& spec,
+                               double t_prev, double t, const Eigen::VectorXd& t_prev_k,
+                               std::vector<double>* film) {
+  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
   const double mid = 0.5 * (t_prev + t);
   const double speed = solvers::speed_at(spec.duty_cycle, mid);
   const double feed = solvers::feed_speed_at(spec.feed_axis, mid);
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(sys.states());
+  Eigen::VectorXd f = solvers::moving_heat_load(spec, sys, t_prev, t);
   film->clear();
   for (size_t c = 0; c < spec.thermal.convection.size(); ++c) {
     const auto& cv = spec.thermal.convection[c];
@@ -93,72 +98,66 @@ Eigen::VectorXd step_load(const System& sys, const core::CaseSpec& spec, double 
     if (src.window > 0) continue;
     double p = solvers::source_power(src, speed, feed);
     if (src.temperature_coefficient != 0)
-      p *= 1 + src.temperature_coefficient * (sys.source_shape[i].dot(z) - t0_k);
+      p *= 1 + src.temperature_coefficient * (sys.source_shape[i].dot(t_prev_k) - t0_k);
     f += p * sys.source_shape[i];
-  }
-  for (size_t k = 0; k < sys.moving.size(); ++k) {
-    const auto& src = spec.thermal.sources[sys.moving_source[k]];
-    const double p = solvers::source_power(src, speed, feed);
-    if (p != 0)
-      f += sys.moving[k] *
-           (p * solvers::moving_piece_fractions(spec, sys.moving_pieces[k], t_prev, t));
   }
   return f;
 }
+// ------------------------------------------------------------------------------------------------
 
 struct ReducedRun {
   Eigen::MatrixXd temperature;                /// #nodes x #output times (t = 0 first) [K]
   std::vector<solvers::ReducedStep> samples;  /// the steps that end at an output time
 };
 
-/// Backward Euler on the reduced system (dense Cholesky per step), outputs interpolated as
-/// solvers/thermal.cpp does, and every step that ends at an output time sampled.
+/// The reduced system stepped by the one stepper (backward Euler), its states recorded at the
+/// output times and at the step end before each, and every step that ends at an output time
+/// sampled for the indicator.
 ReducedRun reduced_run(const solvers::FullThermalSystem& full, const solvers::ReducedModel& model,
                        const core::CaseSpec& spec) {
-  const auto& sys = model.system;
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
   const std::vector<double> grid = solvers::time_grid(spec, spec.thermal.step);
   const std::vector<double> outs = solvers::output_times(spec);
   const std::vector<double> switches = solvers::switch_times(spec);
+  solvers::StepperRequest q;
+  std::vector<size_t> sampled;  // grid indices of the steps that end at an output time
+  for (size_t i = 0; i < grid.size(); ++i) {
+    if (std::find(outs.begin(), outs.end(), grid[i]) == outs.end()) continue;
+    sampled.push_back(i);
+    if (i > 0) q.record_times.push_back(grid[i - 1]);
+    q.record_times.push_back(grid[i]);
+  }
+  for (double t : outs) q.record_times.push_back(t);
+  std::sort(q.record_times.begin(), q.record_times.end());
+  q.record_times.erase(std::unique(q.record_times.begin(), q.record_times.end()),
+                       q.record_times.end());
+  const solvers::SteppedHistory h = solvers::step_thermal(model.system, spec, q);
+  const auto state_at = [&](double t) -> Eigen::VectorXd {
+    if (t == 0) return h.states.col(0);
+    const auto it = std::find(h.times.begin(), h.times.end(), t);
+    EXPECT_NE(it, h.times.end()) << "no recorded state at t = " << t;
+    return h.states.col(it - h.times.begin());
+  };
   ReducedRun run;
   Eigen::MatrixXd z_out(model.states(), static_cast<Eigen::Index>(outs.size() + 1));
-  Eigen::VectorXd z = t0_k * sys.uniform;
-  z_out.col(0) = z;
-  size_t next_out = 1;
-  double t_prev = 0, segment_start = 0;
-  std::vector<double> h;
-  for (double t : grid) {
-    const double dt = t - t_prev;
-    const Eigen::VectorXd f = step_load(sys, spec, t_prev, t, z, t0_k, &h);
-    Eigen::MatrixXd k = sys.conduction;
-    for (size_t c = 0; c < h.size(); ++c) k += h[c] * sys.film[c];
-    const Eigen::MatrixXd a = sys.capacity + dt * k;
-    const Eigen::VectorXd next = a.llt().solve(sys.capacity * z + dt * f);
-    const bool before_switch = std::find(switches.begin(), switches.end(), t) != switches.end();
-    if (std::find(outs.begin(), outs.end(), t) != outs.end()) {
-      solvers::ReducedStep s;
-      s.dt = dt;
-      s.film = h;
-      s.state_old = z;
-      s.state_new = next;
-      std::vector<double> h_full;
-      s.load = step_load(full, spec, t_prev, t, model.basis * z, t0_k, &h_full);
-      s.horizon = t - segment_start;
-      run.samples.push_back(std::move(s));
-    }
-    while (next_out <= outs.size() && outs[next_out - 1] <= t + 1e-9 * spec.duty_cycle.end) {
-      const double w = (outs[next_out - 1] - t_prev) / dt;
-      z_out.col(static_cast<Eigen::Index>(next_out)) = (1 - w) * z + w * next;
-      ++next_out;
-    }
-    z = next;
-    t_prev = t;
-    if (before_switch) segment_start = t;
-  }
+  z_out.col(0) = h.states.col(0);
+  for (size_t j = 0; j < outs.size(); ++j)
+    z_out.col(static_cast<Eigen::Index>(j + 1)) = state_at(outs[j]);
   run.temperature = model.basis * z_out;
+  for (size_t i : sampled) {
+    solvers::ReducedStep s;
+    const double t_prev = i > 0 ? grid[i - 1] : 0.0, t = grid[i];
+    s.dt = t - t_prev;
+    s.state_old = state_at(t_prev);
+    s.state_new = state_at(t);
+    s.load = full_step_load(full, spec, t_prev, t, model.basis * s.state_old, &s.film);
+    double last_switch = 0;
+    for (double w : switches)
+      if (w < t) last_switch = w;
+    s.horizon = t - last_switch;
+    run.samples.push_back(std::move(s));
+  }
   return run;
 }
-// --- end of the minimal march ------------------------------------------------------------------
 
 /// Largest |reduced - full| over every node and output time [K].
 double max_difference(const Eigen::MatrixXd& reduced, const solvers::ThermalHistory& full) {
@@ -265,6 +264,20 @@ TEST(ReducedRun, FollowsTheFullModelOnAStaircaseItWasNotBuiltFrom) {
   EXPECT_LT(ind.max_k, diff * 3);
 }
 
+/// The same staircase with Crank-Nicolson: the stepper's reduced steps follow the full ones too.
+TEST(ReducedRun, FollowsTheFullModelWithCrankNicolson) {
+  const Block& b = block();
+  core::CaseSpec spec = spec_of(block_case(kStaircase, 5400.0, kSwingingSink));
+  spec.thermal.scheme = core::TimeScheme::crank_nicolson;
+  const solvers::ThermalHistory full = solvers::thermal_history(b.mesh, spec, b.full);
+  solvers::StepperRequest q;
+  q.record_times = solvers::output_times(spec);
+  const solvers::SteppedHistory red = solvers::step_thermal(b.model.system, spec, q);
+  const double diff = max_difference(b.model.basis * red.states, full);
+  std::printf("[reduction] staircase CN: max |reduced - full| %.2e K\n", diff);
+  EXPECT_LT(diff, 0.01);
+}
+
 /// Only the sink moves (no speed, no heat): the sink input's response alone.
 TEST(ReducedRun, FollowsATimeVaryingSink) {
   const Block& b = block();
@@ -303,6 +316,7 @@ TEST(ErrorIndicator, IsSmallOnAGoodBasisAndLargeOnATruncatedOne) {
   solvers::ReductionOptions poor;
   poor.speeds_rpm = {3000.0};
   poor.shifts_per_s = {0.0};
+  poor.second_moment = false;
   const solvers::ReducedModel truncated = solvers::reduced_model(b.full, b.spec, poor);
   const ReducedRun good = reduced_run(b.full, b.model, spec);
   const ReducedRun bad = reduced_run(b.full, truncated, spec);
@@ -341,6 +355,15 @@ TEST(ReducedRun, FollowsHeatMovingWithTheFeedAxis) {
       static_cast<int>(full.states()), model.states(), max_rise(ref), diff, ind.max_k);
   EXPECT_GT(max_rise(ref), 0.5);
   EXPECT_LT(diff, 0.01);
+  // The slices act alike: compressing each block to its principal directions keeps fewer states.
+  solvers::ReductionOptions o;
+  o.compression_tolerance = 1e-4;
+  const solvers::ReducedModel small = solvers::reduced_model(full, spec, o);
+  const double small_diff = max_difference(reduced_run(full, small, other).temperature, ref);
+  std::printf("[reduction] moving, compressed 1e-4: %d states, max |reduced - full| %.2e K\n",
+              small.states(), small_diff);
+  EXPECT_LT(small.states(), model.states());
+  EXPECT_LT(small_diff, 0.01);
 }
 
 TEST(ReducedModel, ProjectsOutputRowsAndRefusesAnotherCase) {
