@@ -159,7 +159,7 @@ Dense read_block(const StateReadout& r, const Dense& x) {
 }
 
 template <class Matrix>
-void check_columns(const LinearThermalSystem<Matrix>& sys, const StepperRequest& q) {
+void check_request(const LinearThermalSystem<Matrix>& sys, const StepperRequest& q, double end) {
   const Eigen::Index n = sys.states();
   const auto fits = [n](const StateReadout& r) {
     return (r.sparse.rows() == 0 || r.sparse.cols() == n) &&
@@ -169,6 +169,12 @@ void check_columns(const LinearThermalSystem<Matrix>& sys, const StepperRequest&
   if (!fits(q.base_readout) || !fits(q.column_readout))
     throw core::SolverError("thermal stepper: a readout's rows do not have " + std::to_string(n) +
                             " columns (the system's states)");
+  for (size_t k = 0; k < q.record_times.size(); ++k)
+    if (!(q.record_times[k] > (k ? q.record_times[k - 1] : 0.0)) ||
+        q.record_times[k] > end * (1 + 1e-9))
+      throw core::SolverError("thermal stepper: record time " + std::to_string(q.record_times[k]) +
+                              " s is not after the one before it or beyond the end (" +
+                              std::to_string(end) + " s): expected ascending times in (0, end]");
   for (const auto& c : q.shape_columns)
     if (c.shape.size() != n || !c.law)
       throw core::SolverError("thermal stepper: a shape column has " +
@@ -263,10 +269,10 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     throw core::SolverError(
         "thermal.scheme = \"bdf2\" is not implemented: use \"backward_euler\" "
         "or \"crank_nicolson\"");
-  check_columns(sys, q);
   const Eigen::Index n = sys.states();
   const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
   const double end = spec.duty_cycle.end;
+  check_request(sys, q, end);
   const std::vector<double> grid = time_grid(spec, spec.thermal.step);
   const Eigen::Index ns = static_cast<Eigen::Index>(q.shape_columns.size());
   const Eigen::Index nc = ns + static_cast<Eigen::Index>(q.load_columns.size());

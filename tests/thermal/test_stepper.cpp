@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/errors.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/loads.hpp"
@@ -84,6 +85,23 @@ TEST(Stepper, DenseEqualsSparseOnASmallSystem) {
     EXPECT_GT(a.responses[0].cwiseAbs().maxCoeff(), 0.005) << scheme;
     EXPECT_GT(a.timings.factorizations, 0);
   }
+}
+
+TEST(Stepper, RefusesRecordTimesOutOfOrderAndColumnsOfAnotherSize) {
+  core::CaseSpec spec = io::case_from_toml(test_toml::gantry_bar(1), "bar.toml");
+  for (auto& b : spec.bodies) b.max_edge = 0.06;
+  const mesh::TetMesh m = mesh::mesh_case(spec);
+  const FullThermalSystem sys = thermal_system(m, spec);
+  StepperRequest q;
+  q.record_times = {60.0, 30.0};
+  EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
+  q.record_times = {60.0, spec.duty_cycle.end + 60};
+  EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
+  q.record_times = {60.0};
+  q.shape_columns.push_back({Eigen::VectorXd::Ones(3), [](double, double) { return 1.0; }});
+  EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
+  q.shape_columns.clear();
+  EXPECT_EQ(step_thermal(sys, spec, q).times, (std::vector<double>{0.0, 60.0}));
 }
 
 }  // namespace
