@@ -225,6 +225,15 @@ int run_command(const RunArgs& args) {
   const solvers::VirtualRun run = rom ? solvers::simulate_reduced(mesh, spec, rom->twin, progress)
                                       : solvers::simulate(mesh, spec, progress, checkpointing);
   const double sim_s = seconds_since(t_sim);
+  // The reduced run's own error indicator: the full-order residual at sampled output steps.
+  std::optional<solvers::ErrorIndicator> indicator;
+  if (rom && spec.thermal.scheme == core::TimeScheme::backward_euler) {
+    indicator = solvers::twin_indicator(run.operators, rom->twin, spec);
+    if (indicator->above_tolerance())
+      std::cerr << "thermotwin: warning: the reduced model's error indicator is "
+                << indicator->max_k << " K, above its tolerance of " << indicator->tolerance_k
+                << " K: check with --verify, or rebuild the model (reduce) for this duty cycle\n";
+  }
   std::optional<solvers::ReducedCheck> check;
   if (args.verify) {
     if (!args.quiet) std::cerr << "thermotwin: --verify: recomputing the output times in full\n";
@@ -259,6 +268,16 @@ int run_command(const RunArgs& args) {
   summary["order"] = mesh.order;
   summary["thermal_dofs"] = mesh.nodes.rows();
   summary["model"] = model_json(args, rom ? &*rom : nullptr, check ? &*check : nullptr);
+  if (rom) {
+    if (indicator)
+      summary["model"]["indicator"] = {{"max_K", indicator->max_k},
+                                       {"samples_K", indicator->samples_k},
+                                       {"tolerance_K", indicator->tolerance_k},
+                                       {"above_tolerance", indicator->above_tolerance()}};
+    else
+      summary["model"]["indicator"] = "not computed for this scheme (backward Euler only): see "
+                                      "verify";
+  }
   summary["steps"] = run.thermal.timings.steps;
   summary["factorizations"] = run.thermal.timings.factorizations;
   summary["peak_temperature_degC"] = run.thermal.temperature.maxCoeff() - solvers::kCelsiusOffset;

@@ -42,24 +42,25 @@ class StepFactor<Sparse> {
   cholmod::Factor f_;
 };
 
+/// A reduced system's step matrix is small and dense: its inverse, formed once from the Cholesky
+/// factor, makes each step one matrix-vector product instead of two triangular solves.
 template <>
 class StepFactor<Dense> {
  public:
-  StepFactor(const Dense& a, const std::string& what) : llt_(a) {
-    if (llt_.info() != Eigen::Success)
+  StepFactor(const Dense& a, const std::string& what) {
+    const Eigen::LLT<Dense> llt(a);
+    if (llt.info() != Eigen::Success)
       throw core::SolverError(what +
                               ": the dense Cholesky factorisation failed (the matrix is "
                               "not positive definite). Hint: check the reduced basis");
+    inverse_ = llt.solve(Dense::Identity(a.rows(), a.cols()));
   }
-  void solve_in_place(Eigen::VectorXd& x) const { llt_.solveInPlace(x); }
-  Dense solve(const Dense& b) const { return llt_.solve(b); }
-  double entries() const {
-    const double n = static_cast<double>(llt_.rows());
-    return 0.5 * n * (n + 1);
-  }
+  void solve_in_place(Eigen::VectorXd& x) const { x = inverse_ * x; }
+  Dense solve(const Dense& b) const { return inverse_ * b; }
+  double entries() const { return static_cast<double>(inverse_.size()); }
 
  private:
-  Eigen::LLT<Dense> llt_;
+  Dense inverse_;
 };
 
 /// The loads at one instant: matrix key (speed), film coefficients, sinks, source powers.
@@ -254,9 +255,20 @@ Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec, const LinearThermal
   for (size_t k = 0; k < sys.moving.size(); ++k) {
     const double power = source_power(spec.thermal.sources[sys.moving_source[k]], speed, feed);
     if (power == 0) continue;
-    f += sys.moving[k] * (moving_piece_fractions(spec, sys.moving_pieces[k], t0, t1) * power);
+    // Only the pieces under the window take heat: a reduced system's moving matrix is dense.
+    const Eigen::VectorXd share = moving_piece_fractions(spec, sys.moving_pieces[k], t0, t1);
+    for (Eigen::Index p = 0; p < share.size(); ++p)
+      if (share(p) != 0) f += (share(p) * power) * sys.moving[k].col(p);
   }
   return f;
+}
+
+template <class Matrix>
+StepLoad step_load(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec, double t0,
+                   double t1, const Eigen::VectorXd& state0) {
+  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const LoadState s = load_state(spec, sys, 0.5 * (t0 + t1), t1, state0, t0_k);
+  return {load_vector(spec, sys, s) + moving_heat_load(spec, sys, t0, t1), s.h};
 }
 
 template <class Matrix>
@@ -412,5 +424,10 @@ template Eigen::VectorXd moving_heat_load<Sparse>(const core::CaseSpec&, const F
                                                   double, double);
 template Eigen::VectorXd moving_heat_load<Dense>(const core::CaseSpec&, const ReducedThermalSystem&,
                                                  double, double);
+
+template StepLoad step_load<Sparse>(const FullThermalSystem&, const core::CaseSpec&, double,
+                                    double, const Eigen::VectorXd&);
+template StepLoad step_load<Dense>(const ReducedThermalSystem&, const core::CaseSpec&, double,
+                                   double, const Eigen::VectorXd&);
 
 }  // namespace tt::solvers

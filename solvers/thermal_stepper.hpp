@@ -88,4 +88,17 @@ template <class Matrix>
 Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
                                  const LinearThermalSystem<Matrix>& system, double t0, double t1);
 
+/// The load of one backward-Euler step [t0, t1] exactly as step_thermal forms it, in the system's
+/// space: films at the step's speed with their sinks at t1, sources at the step's middle (the
+/// temperature-dependent part from `state0`), fluxes, and the heat moving with the feed axis [W];
+/// with the film coefficients over the step [W/(m^2 K)]. For the full-order residual of a reduced
+/// step (the error indicator).
+struct StepLoad {
+  Eigen::VectorXd load;
+  std::vector<double> film;
+};
+template <class Matrix>
+StepLoad step_load(const LinearThermalSystem<Matrix>& system, const core::CaseSpec& spec, double t0,
+                   double t1, const Eigen::VectorXd& state0);
+
 }  // namespace tt::solvers

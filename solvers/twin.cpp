@@ -122,6 +122,57 @@ TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& p
   return run;
 }
 
+ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
+                              const core::CaseSpec& spec, int samples) {
+  if (spec.thermal.scheme != core::TimeScheme::backward_euler)
+    throw core::SolverError("the reduced model's error indicator samples backward-Euler steps; "
+                            "this case uses another scheme: check it with run --rom --verify");
+  const std::vector<double> grid = time_grid(spec, spec.thermal.step);
+  const std::vector<double> outs = output_times(spec);
+  const std::vector<double> switches = switch_times(spec);
+  // The grid steps that end at an output time, thinned to `samples` spread evenly.
+  std::vector<std::size_t> ends;
+  for (std::size_t i = 0, j = 0; i < grid.size() && j < outs.size(); ++i) {
+    while (j < outs.size() && outs[j] < grid[i]) ++j;
+    if (j < outs.size() && outs[j] == grid[i]) ends.push_back(i);
+  }
+  std::vector<std::size_t> chosen;
+  const std::size_t n = ends.size(), k = std::min<std::size_t>(n, std::max(1, samples));
+  for (std::size_t m = 0; m < k; ++m) chosen.push_back(ends[n - 1 - m * n / k]);
+  std::sort(chosen.begin(), chosen.end());
+  chosen.erase(std::unique(chosen.begin(), chosen.end()), chosen.end());
+  StepperRequest request;
+  for (std::size_t i : chosen) {
+    if (i > 0) request.record_times.push_back(grid[i - 1]);
+    request.record_times.push_back(grid[i]);
+  }
+  std::sort(request.record_times.begin(), request.record_times.end());
+  request.record_times.erase(std::unique(request.record_times.begin(), request.record_times.end()),
+                             request.record_times.end());
+  const SteppedHistory h = step_thermal(twin.model.system, spec, request);
+  const auto state_at = [&](double t) -> Eigen::VectorXd {
+    const auto it = std::find(h.times.begin(), h.times.end(), t);
+    return h.states.col(it - h.times.begin());
+  };
+  std::vector<ReducedStep> steps;
+  for (std::size_t i : chosen) {
+    ReducedStep s;
+    const double t0 = i > 0 ? grid[i - 1] : 0.0, t1 = grid[i];
+    s.dt = t1 - t0;
+    s.state_old = state_at(t0);
+    s.state_new = state_at(t1);
+    StepLoad load = step_load(full, spec, t0, t1, twin.model.basis * s.state_old);
+    s.load = std::move(load.load);
+    s.film = std::move(load.film);
+    double last_switch = 0;
+    for (double w : switches)
+      if (w < t1) last_switch = w;
+    s.horizon = t1 - last_switch;
+    steps.push_back(std::move(s));
+  }
+  return error_indicator(full, twin.model, steps);
+}
+
 Eigen::MatrixXd full_outputs_history(const FullThermalSystem& full, const TwinOutputs& outputs,
                                      const core::CaseSpec& spec, const Progress& progress) {
   StepperRequest request;
