@@ -19,6 +19,8 @@ struct RunArgs {
   double checkpoint_every_s = 600;  /// wall time between checkpoints; < 0: none
   int stop_after_steps = 0;       /// tests: save a checkpoint after this many steps and exit 3
   std::filesystem::path dump;     /// tests: temperatures and displacements as raw doubles
+  std::filesystem::path rom;      /// a reduced model (reduce --out DIR): thermal transient from it
+  bool verify = false;            /// with rom: recompute the output times in full and compare
 };
 
 struct ProbesArgs {
@@ -28,6 +30,8 @@ struct ProbesArgs {
 
 struct PlaceArgs {
   std::filesystem::path case_file, from_run, out;
+  std::filesystem::path rom;  /// a reduced model (reduce --out DIR) to simulate the case on
+  bool full = false;          /// simulate in full order (default: a reduced model built on the fly)
   int samples = 100, bins = 20, m_max = 6;
   bool sensor_noise = false;  /// place on readings with the campaign's sensor noise
   bool quiet = false;
@@ -35,6 +39,8 @@ struct PlaceArgs {
 
 struct FitArgs {
   std::filesystem::path case_file, out;
+  std::filesystem::path rom;  /// a reduced model (reduce --out DIR) to run the campaign on
+  bool full = false;          /// the campaign in full order (default: a reduced model on the fly)
   double hours = 5, required_sm_um = 1.0;
   bool quick = false, quiet = false;
   bool network = false;  /// also try the CNN-BiGRU-attention network (seed 004)
@@ -59,7 +65,15 @@ struct CalibrateArgs {
   bool quiet = false;
 };
 
+/// reduce CASE --out DIR: the reduced-order twin and its validation (app/reduce_command.cpp).
+struct ReduceArgs {
+  std::filesystem::path case_file, out;
+  bool quick_validation = false;  /// validate on the case's own duty cycle only
+  bool quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int reduce_command(const ReduceArgs& args);
 int fit_data_command(const FitDataArgs& args);
 int calibrate_data_command(const CalibrateArgs& args);
 /// calibrate --case CASE (implemented in calibration's driver; a stub until it is wired).

@@ -112,13 +112,15 @@ double uncompensated_std(const std::vector<fitting::Group>& groups, const std::v
 int fit_command(const FitArgs& args) {
   // 1. The case and its mesh.
   const core::CaseSpec spec = io::read_case(args.case_file);
-  io::OutputDir out(args.out, io::case_input_files(spec));  // refused at once, not after the work
+  std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
+  if (!args.rom.empty()) inputs.push_back(args.rom);
+  io::OutputDir out(args.out, inputs);  // refused at once, not after the work
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   // 2. The virtual test campaign, with sensor noise on every reading.
   const auto runs = solvers::campaign_runs(spec, args.hours, spec.seed);
-  const auto results = solvers::simulate_campaign(mesh, spec, runs, [&](double t, double end) {
-    if (!args.quiet) report_progress("campaign", t, end);
-  });
+  const CampaignOnModel campaign =
+      campaign_on_model(mesh, spec, runs, {args.rom, args.full}, {}, args.quiet);
+  const auto& results = campaign.results;
   std::vector<fitting::Group> groups;
   for (size_t i = 0; i < results.size(); ++i)
     groups.push_back(fitting::noisy_group(group_of(spec, results[i]), fitting::SensorNoise{}, spec.seed, i));
@@ -186,6 +188,7 @@ int fit_command(const FitArgs& args) {
   io::write_fit_json(dir / "fit.json", evals, tables);
   nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "fit.json"));
   doc["summary"] = summary;
+  doc["model"] = campaign.model;
   doc["campaign"] = nlohmann::json::array();
   for (const auto& r : runs)
     doc["campaign"].push_back({{"name", r.name}, {"shape", r.shape}, {"hours", r.spec.duty_cycle.end / 3600.0},

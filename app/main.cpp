@@ -1,6 +1,8 @@
 // thermotwin: the command-line driver.
 //   thermotwin mesh CASE --out DIR   mesh a case: mesh.vtu, boundary.vtp, points.vtp, mesh_report.json
 //   thermotwin run CASE --out DIR    simulate it: fields.pvd, temperatures.csv, thermal_error.csv, summary.json
+//   thermotwin reduce CASE --out DIR its reduced-order twin, validated against the full model
+//   thermotwin place / fit / calibrate / probes: sensor placement, error models, the loop, probes
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
 #include <CLI/CLI.hpp>
@@ -33,9 +35,26 @@ int main(int argc, char** argv) {
   run->add_option("--checkpoint-every-s", run_args.checkpoint_every_s,
                   "wall time between checkpoints of the time loop (default 600; negative: none)")
       ->check(finite_number());
+  run->add_option("--rom", run_args.rom,
+                  "a reduced model (thermotwin reduce CASE --out DIR): the thermal transient from it")
+      ->check(CLI::ExistingDirectory);
+  run->add_flag("--verify", run_args.verify,
+                "with --rom: recompute the output times with the full model and report the "
+                "difference in summary.json");
   // Hidden (empty group): for the reliability tests.
   run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
   run->add_option("--dump", run_args.dump)->group("");
+
+  ReduceArgs reduce_args;
+  auto* reduce = cli.add_subcommand(
+      "reduce", "Build the reduced-order twin of a case and validate it against the full model");
+  reduce->add_option("case", reduce_args.case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  reduce->add_option("--out", reduce_args.out, "output directory")->required();
+  reduce->add_flag("--quick-validation", reduce_args.quick_validation,
+                   "validate on the case's own duty cycle only (default: three more cycles)");
+  reduce->add_flag("--quiet", reduce_args.quiet, "no progress on stderr");
 
   ProbesArgs probes_args;
   auto* probes = cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
@@ -74,6 +93,11 @@ int main(int argc, char** argv) {
                   "place on readings as real sensors give them: the campaign's noise (0.05 K, "
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
+  place->add_option("--rom", place_args.rom,
+                    "a reduced model (thermotwin reduce CASE --out DIR) to simulate the case on")
+      ->check(CLI::ExistingDirectory);
+  place->add_flag("--full", place_args.full,
+                  "simulate in full order (default: a reduced model built on the fly)");
 
   FitArgs fit_args;
   auto* fit = cli.add_subcommand("fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
@@ -102,6 +126,11 @@ int main(int argc, char** argv) {
   fit->add_flag("--network", fit_args.network,
                 "also try the CNN-BiGRU-attention network (seed 004); writes network_<target>.pt");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
+  fit->add_option("--rom", fit_args.rom,
+                  "a reduced model (thermotwin reduce CASE --out DIR) to run the campaign on")
+      ->check(CLI::ExistingDirectory);
+  fit->add_flag("--full", fit_args.full,
+                "the campaign in full order (default: a reduced model built on the fly)");
 
   CalibrateArgs calibrate_args;
   auto* calibrate = cli.add_subcommand("calibrate", "Close the loop on measured runs: what the model lacks, before/after");
@@ -126,6 +155,7 @@ int main(int argc, char** argv) {
   try {
     if (*mesh) return mesh_command(mesh_args);
     if (*run) return run_command(run_args);
+    if (*reduce) return reduce_command(reduce_args);
     if (*place) {
       if (place_args.case_file.empty() && place_args.from_run.empty())
         throw tt::core::CaseError("place: give a case file or --from RUNDIR");

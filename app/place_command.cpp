@@ -22,16 +22,16 @@
 
 namespace tt::app {
 
-Histories simulated_histories(const core::CaseSpec& spec, bool quiet) {
+/// The case's candidate histories under its duty cycle, on the model `model` names; `used` gets
+/// which model that was.
+Histories simulated_histories(const core::CaseSpec& spec, const ModelChoice& model, bool quiet,
+                              nlohmann::json& used) {
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const CandidateSet candidates = candidate_set(spec, mesh);
   const std::vector<solvers::CampaignRun> runs{{"case", "the case's duty cycle", spec}};
-  const auto results = solvers::simulate_campaign(
-      mesh, spec, runs,
-      [&](double t, double end) {
-        if (!quiet) report_progress("thermal", t, end);
-      },
-      candidates.nodes);
+  CampaignOnModel campaign = campaign_on_model(mesh, spec, runs, model, candidates.nodes, quiet);
+  used = std::move(campaign.model);
+  const auto& results = campaign.results;
   return histories_from_nodes(spec, candidates, results[0].times, results[0].node_temperature,
                               results[0].error);
 }
@@ -74,14 +74,17 @@ int place_command(const PlaceArgs& args) {
   core::CaseSpec spec;
   Histories h;
   std::optional<io::OutputDir> out;
+  nlohmann::json model_used{{"kind", "a finished run's histories"}};
   if (!args.from_run.empty()) {
     out.emplace(args.out, std::vector<std::filesystem::path>{args.from_run});
     h = histories_from_run(args.from_run);
     spec = io::read_case(args.from_run / "case.resolved.toml");
   } else {
     spec = io::read_case(args.case_file);
-    out.emplace(args.out, io::case_input_files(spec));
-    h = simulated_histories(spec, args.quiet);
+    std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
+    if (!args.rom.empty()) inputs.push_back(args.rom);
+    out.emplace(args.out, inputs);
+    h = simulated_histories(spec, {args.rom, args.full}, args.quiet, model_used);
   }
   // Simulated histories are exact, and a thermal field driven by a few sources lies in a
   // subspace of few dimensions: beyond its rank no further sensor is admissible. Real readings
@@ -103,6 +106,7 @@ int place_command(const PlaceArgs& args) {
   const auto& dir = out->path();
   nlohmann::json doc = io::placement_json(result);
   doc["sensor_noise"] = args.sensor_noise;
+  doc["model"] = model_used;
   doc["candidates"] = nlohmann::json::array();
   for (size_t c = 0; c < h.names.size(); ++c) {
     nlohmann::json entry{{"id", c + 1},

@@ -15,6 +15,7 @@
 #include "io/case_reader.hpp"
 #include "io/checkpoint.hpp"
 #include "io/csv_out.hpp"
+#include "io/reduced_model_io.hpp"
 #include "io/reports.hpp"
 #include "io/vtk_out.hpp"
 #include "mesh/mesher.hpp"
@@ -121,6 +122,26 @@ void write_dump(const solvers::VirtualRun& run, const std::filesystem::path& pat
   io::write_file_atomically(path, bytes);
 }
 
+/// summary.json's "model": which thermal model ran, and for a reduced one its order, source and
+/// the full-order check when --verify asked for it.
+nlohmann::json model_json(const RunArgs& args, const io::ReducedModelFile* rom,
+                          const solvers::ReducedCheck* check) {
+  if (!rom) return {{"kind", "full"}};
+  nlohmann::json j{{"kind", "reduced"},
+                   {"order", rom->twin.model.states()},
+                   {"rom", std::filesystem::absolute(args.rom).string()},
+                   {"built_from", rom->case_name}};
+  if (check)
+    j["verify"] = {{"max_temperature_error_K", check->max_temperature_error_k},
+                   {"max_point_temperature_error_K", check->max_point_error_k},
+                   {"tcp_error_um", {check->tcp_error_m(0) * 1e6, check->tcp_error_m(1) * 1e6,
+                                     check->tcp_error_m(2) * 1e6}},
+                   {"tcp_peak_um", {check->tcp_peak_m(0) * 1e6, check->tcp_peak_m(1) * 1e6,
+                                    check->tcp_peak_m(2) * 1e6}},
+                   {"full_s", check->full_s}};
+  return j;
+}
+
 }  // namespace
 
 void report_progress(const std::string& stage, double done, double total) {
@@ -153,6 +174,7 @@ int run_command(const RunArgs& args) {
   const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
   std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
   inputs.push_back(checkpoint);
+  if (!args.rom.empty()) inputs.push_back(args.rom);
   io::OutputDir out(args.out, inputs);
   const bool checkpoints = args.stop_after_steps > 0 || args.checkpoint_every_s >= 0;
   if (checkpoints) io::require_writable_checkpoint(checkpoint);
@@ -163,6 +185,17 @@ int run_command(const RunArgs& args) {
   if (!args.quiet)
     std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets ("
               << mesh_s << " s)\n";
+  // A reduced model, when given, must have been built for this machine and mesh.
+  std::optional<io::ReducedModelFile> rom;
+  if (!args.rom.empty()) {
+    if (args.resume)
+      throw core::CaseError("run: --resume continues a full run; a run with --rom " +
+                            args.rom.string() + " takes seconds: run it again without --resume");
+    rom = io::read_reduced_model(args.rom);
+    io::check_reduced_model_fits(*rom, io::reduced_model_key(spec, mesh), args.rom);
+  } else if (args.verify) {
+    throw core::CaseError("run: --verify compares a reduced run with the full model: give --rom DIR");
+  }
   // Surface vertices that are candidate sensors: their histories go to candidate_temperatures.csv.
   std::optional<CandidateSet> candidates;
   if (spec.placement.candidates == core::PlacementSpec::Candidates::surface)
@@ -196,10 +229,26 @@ int run_command(const RunArgs& args) {
         std::_Exit(3);  // as if killed
     };
   const auto t_sim = Clock::now();
-  const solvers::VirtualRun run = solvers::simulate(
-      mesh, spec, [&](double t, double end) { if (!args.quiet) report_progress("thermal", t, end); },
-      checkpointing);
+  const solvers::Progress progress = [&](double t, double end) {
+    if (!args.quiet) report_progress(rom ? "thermal (reduced)" : "thermal", t, end);
+  };
+  const solvers::VirtualRun run = rom ? solvers::simulate_reduced(mesh, spec, rom->twin, progress)
+                                      : solvers::simulate(mesh, spec, progress, checkpointing);
   const double sim_s = seconds_since(t_sim);
+  // The reduced run's own error indicator: the full-order residual at sampled output steps.
+  std::optional<solvers::ErrorIndicator> indicator;
+  if (rom && spec.thermal.scheme == core::TimeScheme::backward_euler) {
+    indicator = solvers::twin_indicator(run.operators, rom->twin, spec);
+    if (indicator->above_tolerance())
+      std::cerr << "thermotwin: warning: the reduced model's error indicator is "
+                << indicator->max_k << " K, above its tolerance of " << indicator->tolerance_k
+                << " K: check with --verify, or rebuild the model (reduce) for this duty cycle\n";
+  }
+  std::optional<solvers::ReducedCheck> check;
+  if (args.verify) {
+    if (!args.quiet) std::cerr << "thermotwin: --verify: recomputing the output times in full\n";
+    check = solvers::verify_reduced(mesh, spec, run);
+  }
   if (!args.dump.empty()) write_dump(run, args.dump);
   // 4. Write everything into DIR.partial, then publish it as DIR.
   const auto& dir = out.path();
@@ -227,6 +276,17 @@ int run_command(const RunArgs& args) {
   summary["tets"] = mesh.tets.rows();
   summary["order"] = mesh.order;
   summary["thermal_dofs"] = mesh.nodes.rows();
+  summary["model"] = model_json(args, rom ? &*rom : nullptr, check ? &*check : nullptr);
+  if (rom) {
+    if (indicator)
+      summary["model"]["indicator"] = {{"max_K", indicator->max_k},
+                                       {"samples_K", indicator->samples_k},
+                                       {"tolerance_K", indicator->tolerance_k},
+                                       {"above_tolerance", indicator->above_tolerance()}};
+    else
+      summary["model"]["indicator"] = "not computed for this scheme (backward Euler only): see "
+                                      "verify";
+  }
   summary["steps"] = run.thermal.timings.steps;
   summary["factorizations"] = run.thermal.timings.factorizations;
   summary["peak_temperature_degC"] = run.thermal.temperature.maxCoeff() - solvers::kCelsiusOffset;

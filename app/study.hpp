@@ -10,6 +10,9 @@
 
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "solvers/campaign.hpp"
+
+#include <nlohmann/json.hpp>
 
 namespace tt::app {
 
@@ -64,5 +67,26 @@ Histories histories_from_nodes(const core::CaseSpec& spec, const CandidateSet& c
 /// From a simulated campaign run (point temperatures #times x #named points, error #times x 9).
 Histories histories_from_points(const core::CaseSpec& spec, const std::vector<double>& times,
                                 const Eigen::MatrixXd& point_temperature, const Eigen::MatrixXd& error);
+
+/// Which thermal model a study steps: a reduced model read from `rom`, the full model when
+/// `full`, else a reduced model built on the fly from the case.
+struct ModelChoice {
+  std::filesystem::path rom;
+  bool full = false;
+};
+
+/// A campaign's results on the chosen model, and what was used (for the report: "kind" full or
+/// reduced, its order and where it came from).
+struct CampaignOnModel {
+  std::vector<solvers::CampaignResult> results;
+  nlohmann::json model;
+};
+
+/// Runs the campaign on the model `choice` names (app/model_choice.cpp), saying on stderr which one (unless quiet).
+/// Throws DataError when a reduced model given was built for another machine or mesh.
+CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                                  const std::vector<solvers::CampaignRun>& runs,
+                                  const ModelChoice& choice,
+                                  const std::vector<int>& sampled_nodes, bool quiet);
 
 }  // namespace tt::app

@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
     const tt::mesh::TetMesh mesh = tt::mesh::mesh_case(spec);
     const double mesh_s = seconds_since(t0);
     t0 = Clock::now();
-    const ts::ThermalOperators ops = ts::thermal_operators(mesh, spec);
+    const ts::FullThermalSystem ops = ts::thermal_system(mesh, spec);
     const double assemble_s = seconds_since(t0);
 
     // 3. The step matrix M + dt (K + sum h F) at full speed, factored once.

@@ -23,6 +23,14 @@ double sink_k(const core::Convection& c, double t) {
   return solvers::table_value(c.sink, t) + kCelsius;
 }
 
+/// A load column's weighted load over a step from its load at one end, `at(base state, time)`:
+/// the end's for backward Euler, theta-weighted over both ends for Crank–Nicolson.
+template <class AtEnd>
+Eigen::VectorXd at_step_ends(const solvers::StepView& step, const AtEnd& at) {
+  if (step.theta == 1) return at(*step.state1, step.t1);
+  return step.theta * at(*step.state1, step.t1) + (1 - step.theta) * at(*step.state0, step.t0);
+}
+
 /// Whitened residual rows of one run: vec(#samples x #channels) / sigma, with the mask of rows.
 struct Whitened {
   Eigen::VectorXd y;               /// kept rows
@@ -298,7 +306,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
   Catalogue cat;
   cat.readout = r;
   const auto& conv = declared.thermal.convection;
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, declared);
+  const solvers::FullThermalSystem ops = solvers::thermal_system(m, declared);
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
   if (ref_speed <= 0) {
@@ -358,14 +366,15 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
       LoadColumn lc;
       lc.name = c.name + " knot " + std::to_string(k);
-      lc.rhs = [&ops, &conv, entries, tk, dk](const Eigen::VectorXd&, const Eigen::VectorXd&,
-                                              double t, double speed, double) {
-        const double hat = std::max(0.0, 1 - std::abs(t - tk) / dk);
-        Eigen::VectorXd f = Eigen::VectorXd::Zero(ops.conduction.rows());
-        if (hat == 0) return f;
-        for (int e : entries)
-          f += (hat * solvers::film_coefficient(conv[e], speed)) * ops.film_area[e];
-        return f;
+      lc.rhs = [&ops, &conv, entries, tk, dk](const solvers::StepView& step) {
+        return at_step_ends(step, [&](const Eigen::VectorXd&, double t) {
+          const double hat = std::max(0.0, 1 - std::abs(t - tk) / dk);
+          Eigen::VectorXd f = Eigen::VectorXd::Zero(ops.conduction.rows());
+          if (hat == 0) return f;
+          for (int e : entries)
+            f += (hat * solvers::film_coefficient(conv[e], step.speed)) * ops.film_area[e];
+          return f;
+        });
       };
       loads.push_back(std::move(lc));
     }
@@ -398,13 +407,14 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
                                   : "delta_h_W_m2K"};
         LoadColumn lc;
         lc.name = c.name;
-        lc.rhs = [&ops, &conv, e, speed_law, ref_speed](const Eigen::VectorXd& t_new,
-                                                        const Eigen::VectorXd&, double t,
-                                                        double speed, double) {
+        lc.rhs = [&ops, &conv, e, speed_law, ref_speed](const solvers::StepView& step) {
+          const double speed = step.speed;
           const double scale = speed_law ? (speed > 0 ? speed / ref_speed : 0.0) : 1.0;
-          if (scale == 0) return Eigen::VectorXd::Zero(t_new.size()).eval();
-          return Eigen::VectorXd(-scale *
-                                 (ops.film[e] * t_new - sink_k(conv[e], t) * ops.film_area[e]));
+          if (scale == 0) return Eigen::VectorXd::Zero(step.state1->size()).eval();
+          return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {
+            return Eigen::VectorXd(-scale *
+                                   (ops.film[e] * temp - sink_k(conv[e], t) * ops.film_area[e]));
+          });
         };
         sources.push_back({Source::load, {static_cast<int>(loads.size())}});
         loads.push_back(std::move(lc));
@@ -423,10 +433,13 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       c.parameters = {"temperature_coefficient_per_K"};
       LoadColumn lc;
       lc.name = c.name;
-      lc.rhs = [&ops, &declared, i, t0_k](const Eigen::VectorXd& t_new, const Eigen::VectorXd&,
-                                          double, double speed, double) {
-        const double q = solvers::source_power(declared.thermal.sources[i], speed);
-        return Eigen::VectorXd(q * (ops.source_shape[i].dot(t_new) - t0_k) * ops.source_shape[i]);
+      lc.rhs = [&ops, &declared, i, t0_k](const solvers::StepView& step) {
+        // The source's heat over the step as the stepper forms it (feed at the step's middle).
+        const double feed = solvers::feed_speed_at(declared.feed_axis, 0.5 * (step.t0 + step.t1));
+        const double q = solvers::source_power(declared.thermal.sources[i], step.speed, feed);
+        return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
+          return Eigen::VectorXd(q * (ops.source_shape[i].dot(temp) - t0_k) * ops.source_shape[i]);
+        });
       };
       sources.push_back({Source::load, {static_cast<int>(loads.size())}});
       loads.push_back(std::move(lc));
@@ -437,7 +450,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       core::CaseSpec doubled = declared;
       doubled.materials[mi].conductivity *= 2;
       doubled.materials[mi].density *= 2;
-      const solvers::ThermalOperators dops = solvers::thermal_operators(m, doubled);
+      const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
       const auto km =
           std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
       const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
@@ -463,12 +476,16 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
           LoadColumn lc;
           lc.name = c.name;
           if (field == "conductivity")
-            lc.rhs = [km](const Eigen::VectorXd& t_new, const Eigen::VectorXd&, double, double,
-                          double) { return Eigen::VectorXd(-(*km * t_new)); };
+            lc.rhs = [km](const solvers::StepView& step) {
+              return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
+                return Eigen::VectorXd(-(*km * temp));
+              });
+            };
           else
-            lc.rhs = [cm](const Eigen::VectorXd& t_new, const Eigen::VectorXd& t_old, double,
-                          double,
-                          double dt) { return Eigen::VectorXd(-(*cm * (t_new - t_old)) / dt); };
+            // C' (T1 - T0) / dt under either scheme.
+            lc.rhs = [cm](const solvers::StepView& step) {
+              return Eigen::VectorXd(-(*cm * (*step.state1 - *step.state0)) / step.dt());
+            };
           sources.push_back({Source::load, {static_cast<int>(loads.size())}});
           loads.push_back(std::move(lc));
         }

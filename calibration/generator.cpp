@@ -266,7 +266,7 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
   const bool relabel = names != mesh_in.group_names;
   const mesh::TetMesh own = relabel ? mesh::mesh_case(truth) : mesh::TetMesh{};
   const mesh::TetMesh& m = relabel ? own : mesh_in;
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, truth);
+  const solvers::FullThermalSystem ops = solvers::thermal_system(m, truth);
   const solvers::ThermalHistory th = solvers::thermal_history(m, truth, ops);
   io::MeasuredRun run;
   run.machine = truth.machine;

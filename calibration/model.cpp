@@ -4,11 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <memory>
-#include <sstream>
 
 #include "core/errors.hpp"
-#include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/elastic.hpp"
 #include "solvers/kernels/element.hpp"
 #include "solvers/loads.hpp"
@@ -31,23 +28,24 @@ Eigen::Vector4d barycentric(const mesh::TetMesh& m, int e, const Eigen::Vector3d
   return Eigen::Vector4d(1 - l.sum(), l(0), l(1), l(2));
 }
 
-/// Values at the grid times, linearly interpolated at `times` (constant beyond the ends).
-Eigen::MatrixXd sample_at(const std::vector<double>& grid,
-                          const std::vector<Eigen::VectorXd>& values,
+/// Values at the grid times (#rows x #grid), linearly interpolated at `times` (constant beyond the
+/// ends): #times x #rows.
+Eigen::MatrixXd sample_at(const std::vector<double>& grid, const Eigen::MatrixXd& values,
                           const Eigen::VectorXd& times) {
-  const Eigen::Index c = values.front().size();
-  Eigen::MatrixXd out(times.size(), c);
+  Eigen::MatrixXd out(times.size(), values.rows());
+  const Eigen::Index last = values.cols() - 1;
   size_t j = 0;
   for (Eigen::Index i = 0; i < times.size(); ++i) {
     const double t = times(i);
     while (j + 2 < grid.size() && grid[j + 1] < t) ++j;
+    const auto c = static_cast<Eigen::Index>(j);
     if (t <= grid.front()) {
-      out.row(i) = values.front().transpose();
+      out.row(i) = values.col(0).transpose();
     } else if (t >= grid.back()) {
-      out.row(i) = values.back().transpose();
+      out.row(i) = values.col(last).transpose();
     } else {
       const double w = (t - grid[j]) / (grid[j + 1] - grid[j]);
-      out.row(i) = ((1 - w) * values[j] + w * values[j + 1]).transpose();
+      out.row(i) = ((1 - w) * values.col(c) + w * values.col(c + 1)).transpose();
     }
   }
   return out;
@@ -199,107 +197,40 @@ Responses march(const mesh::TetMesh& m, const core::CaseSpec& spec, const Readou
                 const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
                 const std::vector<LoadColumn>& loads,
                 const std::vector<Eigen::MatrixXd>& extra_displacement) {
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, spec);
-  const Eigen::Index n = m.nodes.rows();
-  const Eigen::Index ns = static_cast<Eigen::Index>(separable.size());
-  const Eigen::Index nc = ns + static_cast<Eigen::Index>(loads.size());
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsius;
-  Eigen::MatrixXd shapes(n, ns);
-  for (Eigen::Index j = 0; j < ns; ++j) shapes.col(j) = separable[j].shape;
-
-  auto read = [&](const Eigen::VectorXd& t, const Eigen::VectorXd& t_start) {
-    Eigen::VectorXd y(r.channels());
-    if (r.sensors) y.head(r.sensors) = r.temperature * t;
-    if (r.displacement.rows()) y.tail(r.displacement.rows()) = r.displacement * (t - t_start);
-    return y;
-  };
-  auto read_block = [&](const Eigen::MatrixXd& x, const Eigen::MatrixXd& x_start) {
-    Eigen::MatrixXd y(r.channels(), x.cols());
-    if (r.sensors) y.topRows(r.sensors) = r.temperature * x;
-    // A coefficient-wise product: a few probe rows do not pay for a blocked, OpenMP-parallel GEMM,
-    // whose threads wait on each other every step when the cores are shared.
-    if (r.displacement.rows())
-      y.bottomRows(r.displacement.rows()) = r.displacement.lazyProduct(x - x_start);
-    return y;
-  };
-
-  const std::vector<double> steps = solvers::time_grid(spec, spec.thermal.step);
-  std::vector<double> grid{0.0};
-  grid.insert(grid.end(), steps.begin(), steps.end());
-  Eigen::VectorXd temp = Eigen::VectorXd::Constant(n, t0_k);
-  const Eigen::VectorXd temp0 = temp;
-  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, nc);  // responses start from zero
-  const Eigen::MatrixXd x0 = x;
-  std::vector<Eigen::VectorXd> base_hist{read(temp, temp0)};
-  std::vector<Eigen::MatrixXd> col_hist{read_block(x, x0)};
-  std::vector<std::vector<Eigen::VectorXd>> extra_hist(extra_displacement.size());
-  for (size_t k = 0; k < extra_displacement.size(); ++k)
-    extra_hist[k].push_back(Eigen::VectorXd::Zero(extra_displacement[k].rows()));
-
-  std::map<std::pair<double, double>, std::unique_ptr<solvers::cholmod::Factor>> factors;
-  double t_prev = 0;
-  for (double t : steps) {
-    const double dt = t - t_prev, mid = 0.5 * (t + t_prev);
-    const double speed = solvers::speed_at(spec.duty_cycle, mid);
-    const auto key = std::make_pair(std::round(dt * 1e9) / 1e9, speed);
-    auto it = factors.find(key);
-    if (it == factors.end()) {
-      Eigen::SparseMatrix<double> a = ops.conduction;
-      for (size_t c = 0; c < spec.thermal.convection.size(); ++c)
-        a += solvers::film_coefficient(spec.thermal.convection[c], speed) * ops.film[c];
-      a = ops.capacity + dt * a;
-      a.makeCompressed();
-      std::ostringstream what;
-      what << "calibration march (dt = " << dt << " s, speed = " << speed << " rpm)";
-      it = factors.emplace(key, std::make_unique<solvers::cholmod::Factor>(a, what.str())).first;
+  const solvers::FullThermalSystem sys = solvers::thermal_system(m, spec);
+  solvers::StepperRequest q;
+  q.record_times = solvers::time_grid(spec, spec.thermal.step);
+  q.record_states = false;
+  q.column_readout.sparse = r.temperature;
+  q.column_readout.change = r.displacement;
+  // The base reads the channels, then every extra readout.
+  q.base_readout = q.column_readout;
+  Eigen::Index extra_rows = 0;
+  for (const auto& e : extra_displacement) extra_rows += e.rows();
+  if (extra_rows) {
+    Eigen::MatrixXd change(r.displacement.rows() + extra_rows, m.nodes.rows());
+    change.topRows(r.displacement.rows()) = r.displacement;
+    Eigen::Index at = r.displacement.rows();
+    for (const auto& e : extra_displacement) {
+      change.middleRows(at, e.rows()) = e;
+      at += e.rows();
     }
-    // Base step: the declared loads exactly as the thermal solver forms them.
-    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-    for (size_t c = 0; c < spec.thermal.convection.size(); ++c) {
-      const auto& cv = spec.thermal.convection[c];
-      f += (solvers::film_coefficient(cv, speed) * (solvers::table_value(cv.sink, t) + kCelsius)) *
-           ops.film_area[c];
-    }
-    for (size_t i = 0; i < spec.thermal.sources.size(); ++i) {
-      const auto& src = spec.thermal.sources[i];
-      double p = solvers::source_power(src, speed);
-      if (src.temperature_coefficient != 0)
-        p *= 1 + src.temperature_coefficient * (ops.source_shape[i].dot(temp) - t0_k);
-      f += p * ops.source_shape[i];
-    }
-    for (size_t i = 0; i < spec.thermal.fluxes.size(); ++i) {
-      const auto& fl = spec.thermal.fluxes[i];
-      const double scale = fl.follows_speed ? (speed > 0 ? speed / fl.ref_speed_rpm : 0.0) : 1.0;
-      f += fl.flux * scale * ops.flux_area[i];
-    }
-    Eigen::VectorXd next = ops.capacity * temp + dt * f;
-    it->second->solve_in_place(next);
-    if (nc > 0) {
-      Eigen::MatrixXd rhs = ops.capacity * x;
-      for (Eigen::Index j = 0; j < ns; ++j)
-        rhs.col(j) += (dt * separable[j].law(t, speed)) * shapes.col(j);
-      for (size_t j = 0; j < loads.size(); ++j)
-        rhs.col(ns + static_cast<Eigen::Index>(j)) += dt * loads[j].rhs(next, temp, t, speed, dt);
-      x = it->second->solve(rhs);
-    }
-    temp.swap(next);
-    base_hist.push_back(read(temp, temp0));
-    col_hist.push_back(read_block(x, x0));
-    for (size_t k = 0; k < extra_displacement.size(); ++k)
-      extra_hist[k].push_back(extra_displacement[k] * (temp - temp0));
-    t_prev = t;
+    q.base_readout.change = std::move(change);
   }
+  for (const auto& c : separable) q.shape_columns.push_back({c.shape, c.law});
+  for (const auto& c : loads) q.load_columns.push_back(c.rhs);
+  const solvers::SteppedHistory h = solvers::step_thermal(sys, spec, q);
+
   Responses out;
-  out.base = sample_at(grid, base_hist, times);
-  std::vector<Eigen::VectorXd> one(grid.size());
-  for (Eigen::Index j = 0; j < nc; ++j) {
-    for (size_t g = 0; g < grid.size(); ++g) one[g] = col_hist[g].col(j);
-    out.columns.push_back(sample_at(grid, one, times));
-  }
-  for (size_t k = 0; k < extra_displacement.size(); ++k) {
-    Eigen::MatrixXd e = Eigen::MatrixXd::Zero(times.size(), r.channels());
-    e.rightCols(extra_displacement[k].rows()) = sample_at(grid, extra_hist[k], times);
-    out.extra.push_back(e);
+  const Eigen::Index channels = r.channels();
+  out.base = sample_at(h.times, h.readout.topRows(channels), times);
+  for (const auto& col : h.responses) out.columns.push_back(sample_at(h.times, col, times));
+  Eigen::Index at = channels;
+  for (const auto& e : extra_displacement) {
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(times.size(), channels);
+    x.rightCols(e.rows()) = sample_at(h.times, h.readout.middleRows(at, e.rows()), times);
+    out.extra.push_back(std::move(x));
+    at += e.rows();
   }
   return out;
 }
@@ -308,18 +239,14 @@ Eigen::MatrixXd simulated_channels(const mesh::TetMesh& m, const core::CaseSpec&
                                    const Readout& r, const Eigen::VectorXd& times) {
   core::CaseSpec s = spec;
   s.thermal.output_interval = std::min(s.thermal.output_interval, s.thermal.step);
-  const solvers::ThermalOperators ops = solvers::thermal_operators(m, s);
-  const solvers::ThermalHistory th = solvers::thermal_history(m, s, ops);
-  std::vector<Eigen::VectorXd> hist;
-  const Eigen::VectorXd t0 = th.temperature.col(0);
-  for (size_t k = 0; k < th.times.size(); ++k) {
-    const Eigen::VectorXd t = th.temperature.col(static_cast<Eigen::Index>(k));
-    Eigen::VectorXd y(r.channels());
-    if (r.sensors) y.head(r.sensors) = r.temperature * t;
-    if (r.displacement.rows()) y.tail(r.displacement.rows()) = r.displacement * (t - t0);
-    hist.push_back(y);
-  }
-  return sample_at(th.times, hist, times);
+  const solvers::FullThermalSystem sys = solvers::thermal_system(m, s);
+  const solvers::ThermalHistory th = solvers::thermal_history(m, s, sys);
+  const Eigen::MatrixXd& t = th.temperature;
+  Eigen::MatrixXd y(r.channels(), t.cols());
+  if (r.sensors) y.topRows(r.sensors) = r.temperature * t;
+  if (r.displacement.rows())
+    y.bottomRows(r.displacement.rows()) = r.displacement * (t.colwise() - t.col(0));
+  return sample_at(th.times, y, times);
 }
 
 }  // namespace tt::calibration

@@ -1,7 +1,8 @@
 // The declared model under a measured run's inputs, read where the run was measured: the run's
 // speed column becomes the duty cycle, its sensors become interpolation weights, its displacement
 // probes become adjoint influence vectors, and the response of every channel to the declared
-// loads and to unit candidate effects comes out of one backward-Euler march per run.
+// loads and to unit candidate effects comes out of one march per run: the thermal solver's own
+// stepper (solvers::step_thermal) with the candidates as extra right-hand-side columns.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,6 +14,7 @@
 #include "core/case_spec.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "solvers/thermal_stepper.hpp"
 
 namespace tt::calibration {
 
@@ -49,13 +51,11 @@ core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRu
 Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r);
 
 /// A load added to the declared model, whose channel response the march computes. `rhs` gets the
-/// base temperature after and before the step [K], the step's end time [s], the step's speed [rpm]
-/// and the step [s]; it returns a #nodes load vector [W].
+/// step (its ends, speed, scheme weight and the base states at both ends) and returns the step's
+/// weighted load, #nodes [W per unit] (solvers::StepView says how it enters the response).
 struct LoadColumn {
   std::string name;
-  std::function<Eigen::VectorXd(const Eigen::VectorXd& t_new, const Eigen::VectorXd& t_old,
-                                double t, double speed, double dt)>
-      rhs;
+  solvers::LoadCallback rhs;
 };
 
 /// A separable load: spatial vector b [W per unit] times a scalar law of (time, speed).
@@ -72,10 +72,11 @@ struct Responses {
   std::vector<Eigen::MatrixXd> extra;    /// per extra displacement readout, applied to the base
 };
 
-/// Marches `spec` (backward Euler on the case's time grid, loads as in solvers::thermal_history)
-/// and the linear responses to `separable` then `loads` (in that order in `columns`), all read
-/// through `r` and sampled at `times` by linear interpolation. `extra_displacement` are further
-/// #probes x #nodes readouts applied to the base field (e.g. d/dalpha).
+/// Marches `spec` with solvers::step_thermal (the case's scheme and time grid, the loads of
+/// solvers::thermal_history) and the linear responses to `separable` then `loads` (in that order
+/// in `columns`), all read through `r` and sampled at `times` by linear interpolation between the
+/// step ends. `extra_displacement` are further #probes x #nodes readouts applied to the base field
+/// (e.g. d/dalpha).
 Responses march(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Readout& r,
                 const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
                 const std::vector<LoadColumn>& loads,

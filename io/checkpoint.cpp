@@ -13,6 +13,7 @@
 
 #include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
+#include "io/binary.hpp"
 #include "io/case_reader.hpp"
 
 namespace tt::io {
@@ -22,44 +23,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr char kMagic[8] = {'T', 'T', 'C', 'K', 'P', 'T', '0', '1'};
-
-std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t h = 0xcbf29ce484222325ull) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
-
-/// Appends plain values and arrays of doubles to a byte string.
-struct Writer {
-  std::string bytes;
-  template <class T>
-  void put(const T& v) {
-    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  void put_doubles(const double* p, std::size_t n) {
-    bytes.append(reinterpret_cast<const char*>(p), n * sizeof(double));
-  }
-};
-
-/// Reads them back, refusing to run past the end.
-struct Reader {
-  std::string_view bytes;
-  const fs::path& file;
-  std::size_t at = 0;
-  void take(void* out, std::size_t n) {
-    if (n > bytes.size() - at)
-      throw core::DataError(file.string() + ": checkpoint truncated at byte " + std::to_string(at) +
-                            "; remove it and run again without --resume");
-    std::memcpy(out, bytes.data() + at, n);
-    at += n;
-  }
-  template <class T>
-  T get() {
-    T v;
-    take(&v, sizeof v);
-    return v;
-  }
-};
 
 std::string key_text(const CheckpointKey& k) {
   std::ostringstream o;
@@ -120,7 +83,7 @@ void require_writable_checkpoint(const fs::path& file) {
 
 void write_checkpoint(const fs::path& file, const CheckpointKey& key,
                       const solvers::ThermalCheckpoint& s) {
-  Writer w;
+  ByteWriter w;
   w.bytes.append(kMagic, sizeof kMagic);
   w.put(key.case_hash);
   w.put(key.mesh_hash);
@@ -136,7 +99,7 @@ void write_checkpoint(const fs::path& file, const CheckpointKey& key,
   w.put(std::int64_t(s.outputs.cols()));
   w.put_doubles(s.temperature.data(), static_cast<std::size_t>(s.temperature.size()));
   w.put_doubles(s.outputs.data(), static_cast<std::size_t>(s.outputs.size()));
-  w.put(fnv1a(w.bytes.data(), w.bytes.size()));
+  w.seal();
   write_file_atomically(file, w.bytes);
 }
 
@@ -154,13 +117,11 @@ solvers::ThermalCheckpoint read_checkpoint(const fs::path& file, const Checkpoin
   if (bytes.size() < sizeof kMagic + sizeof(std::uint64_t) ||
       std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
     throw corrupt("not a thermotwin checkpoint (expected the header TTCKPT01)");
-  std::uint64_t stored_sum;
-  std::memcpy(&stored_sum, bytes.data() + bytes.size() - sizeof stored_sum, sizeof stored_sum);
-  if (fnv1a(bytes.data(), bytes.size() - sizeof stored_sum) != stored_sum)
-    throw corrupt("checkpoint corrupted (checksum mismatch)");
+  if (!checksum_matches(bytes)) throw corrupt("checkpoint corrupted (checksum mismatch)");
 
-  Reader r{std::string_view(bytes).substr(0, bytes.size() - sizeof stored_sum), file,
-           sizeof kMagic};
+  ByteReader r{std::string_view(bytes).substr(0, bytes.size() - sizeof(std::uint64_t)),
+               file.string() + ": checkpoint", "remove it and run again without --resume",
+               sizeof kMagic};
   CheckpointKey k;
   k.case_hash = r.get<std::uint64_t>();
   k.mesh_hash = r.get<std::uint64_t>();

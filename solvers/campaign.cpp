@@ -116,11 +116,27 @@ std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
   return runs;
 }
 
+std::vector<CampaignRun> validation_runs(const core::CaseSpec& base, std::uint64_t seed) {
+  std::vector<CampaignRun> runs;
+  runs.push_back({"own_cycle", "the case's own duty cycle", base});
+  runs.push_back({"staircase_6h", "speed staircase 1000-2000-4000-6000-3000-0 rpm",
+                  with_cycle(base, {{0, 1000}, {3600, 2000}, {7200, 4000}, {10800, 6000},
+                                    {14400, 3000}, {18000, 0}},
+                             6 * 3600.0)});
+  // Draw until the cycle switches at least 15 times (each draw switches about 20 times in 8 h).
+  const double end = 8 * 3600.0;
+  std::vector<Segment> irregular;
+  for (std::uint64_t k = 0; irregular.size() < 16; ++k)
+    irregular = irregular_cycle(end, core::derived_seed(seed, 100 + k), {1000, 2500, 4000, 5500});
+  runs.push_back({"irregular_8h", "irregular on/off, 8 h", with_cycle(base, irregular, end)});
+  return runs;
+}
+
 std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,
                                               const std::vector<CampaignRun>& runs,
                                               const Progress& progress,
                                               const std::vector<int>& sampled_nodes) {
-  const ThermalOperators ops = thermal_operators(mesh, base);
+  const FullThermalSystem ops = thermal_system(mesh, base);
   const ElasticModel elastic(mesh, base);
   const auto nodes = error_nodes(mesh, base);
   // 9 influence vectors: (tcp, z1, z2) x (x, y, z).

@@ -27,6 +27,12 @@ struct CampaignRun {
 /// spindle speed) and stands while it stops.
 std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed);
 
+/// Duty cycles for judging a reduced model against the full one, none of them used to build it:
+/// the base case's own cycle (P-1 on SB-1, the feed-axis cycle on GM-1), a 6-hour staircase
+/// (1000, 2000, 4000, 6000, 3000, 0 rpm, an hour each) and an 8-hour irregular cycle with at least
+/// 15 switches (seeded from `seed`). A moving feed axis follows the spindle as in campaign_runs.
+std::vector<CampaignRun> validation_runs(const core::CaseSpec& base, std::uint64_t seed);
+
 struct CampaignResult {
   std::string name, shape;
   std::vector<double> times;           /// [s], t = 0 first

@@ -64,6 +64,18 @@ std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
   return out;
 }
 
+Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, Eigen::Index nodes) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(static_cast<size_t>(shape.weight.size()));
+  for (Eigen::Index p = 0; p < shape.nodes.rows(); ++p)
+    for (Eigen::Index a = 0; a < shape.nodes.cols(); ++a)
+      entries.emplace_back(shape.nodes(p, a), p, shape.weight(p, a) / shape.volume(p));
+  Eigen::SparseMatrix<double> load(nodes, shape.nodes.rows());
+  load.setFromTriplets(entries.begin(), entries.end());
+  load.makeCompressed();
+  return load;
+}
+
 Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
                                        double t0, double t1) {
   const auto& src = spec.thermal.sources[shape.source];
@@ -99,26 +111,6 @@ Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingS
     fraction(i) = density * shape.volume(i);
   }
   return fraction;
-}
-
-Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
-                                 const std::vector<MovingSourceShape>& shapes, Eigen::Index nodes,
-                                 double t0, double t1) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(nodes);
-  const double mid = 0.5 * (t0 + t1);
-  const double speed = speed_at(spec.duty_cycle, mid), feed = feed_speed_at(spec.feed_axis, mid);
-  for (const auto& shape : shapes) {
-    const double power = source_power(spec.thermal.sources[shape.source], speed, feed);
-    if (power == 0) continue;
-    const Eigen::VectorXd fraction = moving_piece_fractions(spec, shape, t0, t1);
-    for (Eigen::Index i = 0; i < fraction.size(); ++i) {
-      if (fraction(i) == 0) continue;
-      const double q = power * fraction(i) / shape.volume(i);  // [W/m^3] in this piece
-      for (Eigen::Index a = 0; a < shape.nodes.cols(); ++a)
-        f(shape.nodes(i, a)) += q * shape.weight(i, a);
-    }
-  }
-  return f;
 }
 
 }  // namespace tt::solvers

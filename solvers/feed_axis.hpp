@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <vector>
 
 #include "core/case_spec.hpp"
@@ -27,16 +28,14 @@ struct MovingSourceShape {
 std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
                                                     const core::CaseSpec& spec);
 
+/// Nodal load of the source per watt in each piece: #nodes x #pieces, column p spreads piece p's
+/// unit power over its nodes by int N dV / V_piece (each column sums to 1) [-].
+Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, Eigen::Index nodes);
+
 /// Per piece, the fraction of the source's power it receives averaged over [t0, t1] [-] (sums to
 /// 1): at each of a set of sub-instants the pieces in the window share the power by volume (the
 /// piece nearest the window's centre takes it all when the window holds no centroid).
 Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
                                        double t0, double t1);
-
-/// Nodal heat load [W] of every moving source averaged over the step [t0, t1]: sums to the sources'
-/// total power (spindle and feed speeds are constant within a step of the time grid).
-Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec,
-                                 const std::vector<MovingSourceShape>& shapes, Eigen::Index nodes,
-                                 double t0, double t1);
 
 }  // namespace tt::solvers

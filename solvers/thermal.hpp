@@ -1,6 +1,7 @@
-// Transient heat conduction: operators assembled once from the mesh and the case, then a time
-// history under the duty cycle with one CHOLMOD factor per distinct (step, speed) and a
-// back-substitution per step.
+// Transient heat conduction: the system assembled once from the mesh and the case
+// (solvers/thermal_system.hpp), then a time history under the duty cycle from the one stepper
+// (solvers/thermal_stepper.hpp: a CHOLMOD factor per distinct (step, speed, scheme weight) and a
+// back-substitution per step).
 #pragma once
 
 #include <Eigen/Core>
@@ -11,25 +12,11 @@
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "solvers/feed_axis.hpp"
+#include "solvers/thermal_system.hpp"
 
 namespace tt::solvers {
 
 constexpr double kCelsiusOffset = 273.15;
-
-/// Everything the time loop needs, independent of time and speed.
-struct ThermalOperators {
-  Eigen::SparseMatrix<double> conduction;            /// K [W/K]
-  Eigen::SparseMatrix<double> capacity;              /// M [J/K] (consistent or lumped)
-  std::vector<Eigen::SparseMatrix<double>> film;     /// per convection entry: int N N^T dA [m^2]
-  std::vector<Eigen::VectorXd> film_area;            /// per convection entry: int N dA [m^2]
-  std::vector<Eigen::VectorXd> source_shape;         /// per source: int N dV / V_body [-], sums to 1
-  std::vector<Eigen::VectorXd> flux_area;            /// per surface flux: int N dA [m^2]
-  std::vector<MovingSourceShape> moving;             /// sources that move with the feed axis
-};
-
-/// Assembles the operators (element loops in parallel, deterministic order). Throws SolverError
-/// for inverted elements and sources on empty bodies.
-ThermalOperators thermal_operators(const mesh::TetMesh& mesh, const core::CaseSpec& spec);
 
 /// Heat in, stored and lost, each computed on its own path [J].
 struct EnergyBalance {
@@ -80,8 +67,17 @@ struct Checkpointing {
 /// to the duty cycle's end. Throws SolverError when the resume state does not fit the mesh and
 /// the case's time grid.
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-                               const ThermalOperators& ops, const Progress& progress = {},
+                               const FullThermalSystem& system, const Progress& progress = {},
                                const Checkpointing& checkpointing = {});
+
+/// Heat stored in the mesh at `temperature` relative to the uniform initial temperature [J]:
+/// quadrature of rho c (T - T0) over the elements.
+double stored_heat(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                   const Eigen::VectorXd& temperature);
+
+/// Heat delivered from the laws over the duty cycle, the sources' and the surface fluxes' [J]: the
+/// energy balance's independent path (no solver).
+double heat_in_law(const core::CaseSpec& spec, const FullThermalSystem& system);
 
 /// The history at some nodes, as a sensor there would record it: #times x nodes.size() [K].
 /// Throws SolverError for a node the history does not have.

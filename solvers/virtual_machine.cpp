@@ -1,5 +1,6 @@
 #include "solvers/virtual_machine.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace tt::solvers {
@@ -8,7 +9,7 @@ VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const
                     const Checkpointing& checkpointing) {
   VirtualRun run;
   const auto t0 = std::chrono::steady_clock::now();
-  run.operators = thermal_operators(mesh, spec);
+  run.operators = thermal_system(mesh, spec);
   run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   run.thermal = thermal_history(mesh, spec, run.operators, progress, checkpointing);
   run.thermal.timings.assemble_s = run.operators_s;
@@ -17,6 +18,51 @@ VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const
     if (!spec.mechanical.tcp_point.empty()) run.error = thermal_error(mesh, spec, run.elastic->displacement);
   }
   return run;
+}
+
+VirtualRun simulate_reduced(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Twin& twin,
+                            const Progress& progress) {
+  VirtualRun run;
+  const auto t0 = std::chrono::steady_clock::now();
+  run.operators = thermal_system(mesh, spec);
+  run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  check_reducible(twin.model, run.operators, spec);
+  const TwinRun reduced = twin_run(twin, spec, progress);
+  run.thermal.times = reduced.times;
+  run.thermal.temperature = reconstructed(twin.model, reduced.states);
+  run.thermal.timings = reduced.timings;
+  run.thermal.timings.assemble_s = run.operators_s;
+  run.thermal.energy.heat_in = reduced.heat_in;
+  run.thermal.energy.lost = reduced.lost;
+  run.thermal.energy.stored =
+      stored_heat(mesh, spec, run.thermal.temperature.col(run.thermal.temperature.cols() - 1));
+  run.thermal.energy.heat_in_law = heat_in_law(spec, run.operators);
+  if (spec.mechanical.enabled) {
+    run.elastic = elastic_history(mesh, spec, run.thermal.temperature);
+    if (!spec.mechanical.tcp_point.empty()) run.error = thermal_error(mesh, spec, run.elastic->displacement);
+  }
+  return run;
+}
+
+ReducedCheck verify_reduced(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                            const VirtualRun& reduced) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const ThermalHistory full = thermal_history(mesh, spec, reduced.operators);
+  ReducedCheck c;
+  const Eigen::MatrixXd diff = (full.temperature - reduced.thermal.temperature).cwiseAbs();
+  c.max_temperature_error_k = diff.maxCoeff();
+  for (const auto& p : mesh.points)
+    c.max_point_error_k = std::max(c.max_point_error_k, diff.row(p.node).maxCoeff());
+  if (reduced.error) {
+    const ElasticHistory elastic = elastic_history(mesh, spec, full.temperature);
+    const ThermalError e = thermal_error(mesh, spec, elastic.displacement);
+    for (int d = 0; d < 3; ++d) {
+      c.tcp_error_m(d) = (e.values.col(d) - reduced.error->values.col(d)).cwiseAbs().maxCoeff();
+      c.tcp_peak_m(d) = e.values.col(d).cwiseAbs().maxCoeff();
+    }
+  }
+  c.full_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return c;
 }
 
 }  // namespace tt::solvers

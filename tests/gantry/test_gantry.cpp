@@ -16,37 +16,14 @@
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
-#include "tests/common/case_toml.hpp"
+#include "solvers/thermal_stepper.hpp"
+#include "tests/common/gantry_bar.hpp"
 
 namespace tt::gantry_test {
 namespace {
 
-/// A steel bar 1 m along x on [0, 1] with a moving source in it (window 0.2 m) and a fixed
-/// feed-speed source in a pad; the axis reciprocates over [0.2, 0.8] at 6 m/min, then stands.
-std::string bar_case(int order, const std::string& scheme = "backward_euler") {
-  std::string t = test_toml::header("bar") + test_toml::steel();
-  t += test_toml::box_body("bar", "steel", "0.04", "[0.0, 0.0, 0.0]", "[1.0, 0.05, 0.05]");
-  t += test_toml::box_body("pad", "steel", "0.04", "[-0.05, 0.0, 0.0]", "[0.0, 0.05, 0.05]");
-  t += "[mesh]\norder = " + std::to_string(order) + "\n";
-  t += "[[boundary]]\nname = \"all\"\nrest = true\nselect = [ {} ]\n";
-  t += "[thermal]\nscheme = \"" + scheme + "\"\nstep_s = 10.0\noutput_interval_s = 60.0\n";
-  t += "[[thermal.convection]]\ngroup = \"all\"\nh_W_m2K = 10.0\nsink_degC = 20.0\n";
-  t += "[[thermal.heat_sources]]\nname = \"nut\"\nbody = \"bar\"\nlaw = "
-       "\"feed_power\"\npower_ref_W = 30.0\n"
-       "ref_feed_m_min = 10.0\nmoving = { window = 0.2 }\n";
-  t += "[[thermal.heat_sources]]\nname = \"bearing\"\nbody = \"pad\"\nlaw = "
-       "\"feed_power\"\npower_ref_W = 8.0\n"
-       "ref_feed_m_min = 10.0\nexponent = 2.0\n";
-  t += "[duty_cycle]\nend_s = 600.0\nsegments = [ { start_s = 0.0, speed_rpm = 0.0 } ]\n";
-  t += "[feed_axis]\nname = \"X\"\ndirection = \"x\"\nsegments = [ { start_s = 0.0, from = 0.2, to "
-       "= 0.8, "
-       "feed_m_min = 6.0 }, { start_s = 300.0, position = 0.7 } ]\n";
-  t += "[mechanical]\nenabled = false\n";
-  return t;
-}
-
 core::CaseSpec bar_spec(int order, const std::string& scheme = "backward_euler") {
-  return io::case_from_toml(bar_case(order, scheme), "bar.toml");
+  return io::case_from_toml(test_toml::gantry_bar(order, scheme), "bar.toml");
 }
 
 /// Load-weighted mean x of a nodal load [m].
@@ -86,20 +63,22 @@ TEST(FeedAxis, FeedPowerLawAndHeatDelivered) {
 TEST(FeedAxis, MovingLoadHasExactPowerAndFollowsTheAxis) {
   const core::CaseSpec s = bar_spec(2);
   const mesh::TetMesh m = mesh::mesh_case(s);
-  const auto shapes = solvers::moving_source_shapes(m, s);
+  const solvers::FullThermalSystem sys = solvers::thermal_system(m, s);
+  const auto& shapes = sys.moving_pieces;
   ASSERT_EQ(shapes.size(), 1u);
+  ASSERT_EQ(sys.moving_source, std::vector<int>{0});
   EXPECT_EQ(shapes[0].source, 0);
   EXPECT_NEAR(shapes[0].volume.sum(), 1.0 * 0.05 * 0.05, 1e-12);
   // Short steps at several instants: the whole power, centred on the axis position.
   for (double t0 : {0.0, 1.0, 2.5, 4.0, 7.0, 10.0}) {
     const double t1 = t0 + 0.05;
-    const Eigen::VectorXd f = solvers::moving_heat_load(s, shapes, m.nodes.rows(), t0, t1);
+    const Eigen::VectorXd f = solvers::moving_heat_load(s, sys, t0, t1);
     EXPECT_NEAR(f.sum(), 18.0, 1e-10) << "t0 = " << t0;
     const double p = solvers::axis_position_at(s.feed_axis, 0.5 * (t0 + t1));
     EXPECT_NEAR(load_centre(m, f), p, 0.03) << "t0 = " << t0;
   }
   // A step over a whole cycle spreads the heat over the stroke [0.2, 0.8] (window included).
-  const Eigen::VectorXd cycle = solvers::moving_heat_load(s, shapes, m.nodes.rows(), 0.0, 12.0);
+  const Eigen::VectorXd cycle = solvers::moving_heat_load(s, sys, 0.0, 12.0);
   EXPECT_NEAR(cycle.sum(), 18.0, 1e-10);
   EXPECT_NEAR(load_centre(m, cycle), 0.5, 0.01);
   double outside = 0;
@@ -107,7 +86,7 @@ TEST(FeedAxis, MovingLoadHasExactPowerAndFollowsTheAxis) {
     if (m.nodes(i, 0) < 0.05 || m.nodes(i, 0) > 0.95) outside += std::abs(cycle(i));
   EXPECT_LT(outside, 1e-9);
   // Standing: no feed, so no heat; the fractions still sit at the standing position.
-  EXPECT_EQ(solvers::moving_heat_load(s, shapes, m.nodes.rows(), 300.0, 310.0).sum(), 0.0);
+  EXPECT_EQ(solvers::moving_heat_load(s, sys, 300.0, 310.0).sum(), 0.0);
   const Eigen::VectorXd frac = solvers::moving_piece_fractions(s, shapes[0], 300.0, 310.0);
   EXPECT_NEAR(frac.sum(), 1.0, 1e-12);
   EXPECT_NEAR(frac.dot(shapes[0].centre), 0.7, 0.03);
@@ -117,8 +96,7 @@ TEST(FeedAxis, WindowNarrowerThanTheMeshStillDeliversEverything) {
   core::CaseSpec s = bar_spec(1);
   s.thermal.sources[0].window = 1e-4;  // holds no centroid: the nearest tet takes the heat
   const mesh::TetMesh m = mesh::mesh_case(s);
-  const auto shapes = solvers::moving_source_shapes(m, s);
-  const Eigen::VectorXd f = solvers::moving_heat_load(s, shapes, m.nodes.rows(), 2.0, 2.01);
+  const Eigen::VectorXd f = solvers::moving_heat_load(s, solvers::thermal_system(m, s), 2.0, 2.01);
   EXPECT_NEAR(f.sum(), 18.0, 1e-10);
   EXPECT_NEAR(load_centre(m, f), solvers::axis_position_at(s.feed_axis, 2.005), 0.05);
 }
@@ -127,7 +105,7 @@ TEST(FeedAxis, EnergyClosesWithMovingSources) {
   for (const char* scheme : {"backward_euler", "crank_nicolson"}) {
     const core::CaseSpec s = bar_spec(1, scheme);
     const mesh::TetMesh m = mesh::mesh_case(s);
-    const auto ops = solvers::thermal_operators(m, s);
+    const auto ops = solvers::thermal_system(m, s);
     const auto h = solvers::thermal_history(m, s, ops);
     EXPECT_NEAR(h.energy.heat_in, h.energy.heat_in_law, 1e-9 * h.energy.heat_in_law) << scheme;
     EXPECT_NEAR(h.energy.heat_in_law, (18.0 + 2.88) * 300.0, 1e-6);
@@ -245,7 +223,7 @@ TEST(Gm1Case, TargetsComeFromTheCaseAndAxisPointsAreNoCandidates) {
 }
 
 TEST(Gm1Case, BadFeedAxisInputIsRefused) {
-  const std::string base = bar_case(1);
+  const std::string base = test_toml::gantry_bar(1);
   auto with = [&](const std::string& from, const std::string& to) {
     std::string t = base;
     const auto at = t.find(from);

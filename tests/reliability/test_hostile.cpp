@@ -142,7 +142,7 @@ enabled = false
   ASSERT_GT(std::count(m.tet_region.begin(), m.tet_region.end(), pad), 0);
   for (auto& r : m.tet_region) r = core::RegionId(0);
   try {
-    solvers::thermal_operators(m, spec);
+    solvers::thermal_system(m, spec);
     ADD_FAILURE() << "a source on a body with no elements was accepted";
   } catch (const core::SolverError& e) {
     EXPECT_NE(std::string(e.what()).find("pad heat"), std::string::npos) << e.what();

@@ -64,7 +64,7 @@ TEST(ThermalEnergy, ClosesForBothSchemesAndOrders) {
     c.order = order;
     core::CaseSpec spec = case_of(c.toml());
     const mesh::TetMesh mesh = mesh::mesh_case(spec);
-    const auto ops = solvers::thermal_operators(mesh, spec);
+    const auto ops = solvers::thermal_system(mesh, spec);
     for (auto scheme : {core::TimeScheme::backward_euler, core::TimeScheme::crank_nicolson}) {
       spec.thermal.scheme = scheme;
       const auto h = solvers::thermal_history(mesh, spec, ops);
@@ -103,7 +103,7 @@ TEST(ThermalEnergy, LumpedQuadraticTetsConserveTheirOwnEnergy) {
   c.lumped = true;
   const auto spec = case_of(c.toml());
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
-  const auto ops = solvers::thermal_operators(mesh, spec);
+  const auto ops = solvers::thermal_system(mesh, spec);
   const auto h = solvers::thermal_history(mesh, spec, ops);
   const double t0 = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
   const Eigen::VectorXd rise = h.temperature.col(h.temperature.cols() - 1) -
@@ -164,7 +164,7 @@ TEST(ThermalEnergy, SuddenHeatInputUndershootStaysBounded) {
     c.end = 2.0;
     const auto spec = case_of(c.toml());
     const mesh::TetMesh mesh = mesh::mesh_case(spec);
-    const auto ops = solvers::thermal_operators(mesh, spec);
+    const auto ops = solvers::thermal_system(mesh, spec);
     const auto h = solvers::thermal_history(mesh, spec, ops);
     const double t0 = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
     const double volume = 0.13 * 0.05 * 0.04, rho_c = 7250.0 * 510.0;

@@ -1,6 +1,6 @@
 // Spatial order of the conduction operator with a manufactured steady solution
 //   u = sin(2x + y) exp(z / 2) + x^2 on the unit cube, k = 1 W/(m K), q = -k lap u,
-// from the assembled K of thermal_operators, a load vector built here from the kernels' shape
+// from the assembled K of thermal_system, a load vector built here from the kernels' shape
 // functions and degree-5 quadrature, and u prescribed at every boundary node by elimination. The
 // L2 error, by the same quadrature, should fall as h^2 on 4-node and h^3 on 10-node tets, with
 // h = (volume / #tets)^(1/3) measured on the meshes TetGen makes for four max_edge levels.
@@ -55,7 +55,7 @@ MmsResult mms_error(double max_edge) {
   const auto spec = case_of(cube.toml());
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   EXPECT_EQ(mesh.nodes_per_tet(), N);
-  const Eigen::SparseMatrix<double> k = solvers::thermal_operators(mesh, spec).conduction;
+  const Eigen::SparseMatrix<double> k = solvers::thermal_system(mesh, spec).conduction;
   const int n = static_cast<int>(mesh.nodes.rows()), nt = static_cast<int>(mesh.tets.rows());
   const auto& rule = kn::tet_rule_degree5();
   auto coords = [&](int t) {

@@ -170,7 +170,7 @@ TEST(SurfaceCandidateSet, CampaignHistoriesEqualTheNodalTemperaturesOfADirectRun
       app::histories_from_nodes(spec, set, r.times, r.node_temperature, r.error);
 
   const solvers::ThermalHistory direct =
-      solvers::thermal_history(m, spec, solvers::thermal_operators(m, spec));
+      solvers::thermal_history(m, spec, solvers::thermal_system(m, spec));
   ASSERT_EQ(h.times.size(), static_cast<Eigen::Index>(direct.times.size()));
   ASSERT_EQ(h.temperature.cols(), static_cast<Eigen::Index>(set.nodes.size()));
   double worst = 0;

@@ -32,7 +32,7 @@ TEST(ThermalTimeOrder, BackwardEulerFirstCrankNicolsonSecond) {
   cube.extra += "[duty_cycle]\nend_s = 600.0\nsegments = [ { start_s = 0.0, speed_rpm = 0.0 } ]\n";
   core::CaseSpec spec = case_of(cube.toml());
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
-  const auto ops = solvers::thermal_operators(mesh, spec);
+  const auto ops = solvers::thermal_system(mesh, spec);
   auto history = [&](core::TimeScheme scheme, double step) {
     spec.thermal.scheme = scheme;
     spec.thermal.step = step;

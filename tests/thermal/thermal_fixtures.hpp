@@ -91,7 +91,7 @@ struct Solution {
 };
 
 inline Solution run_case(const core::CaseSpec& spec, const mesh::TetMesh& mesh) {
-  const auto ops = solvers::thermal_operators(mesh, spec);
+  const auto ops = solvers::thermal_system(mesh, spec);
   return {mesh, solvers::thermal_history(mesh, spec, ops)};
 }
 

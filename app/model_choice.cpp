@@ -1,0 +1,59 @@
+// The thermal model a study steps: a reduced model from --rom, the full one with --full, or a
+// reduced one built on the fly (the default).
+#include <chrono>
+#include <iostream>
+#include <optional>
+
+#include "app/commands.hpp"
+#include "app/study.hpp"
+#include "io/reduced_model_io.hpp"
+#include "solvers/twin.hpp"
+
+namespace tt::app {
+
+CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                                  const std::vector<solvers::CampaignRun>& runs,
+                                  const ModelChoice& choice,
+                                  const std::vector<int>& sampled_nodes, bool quiet) {
+  const auto say = [&](const std::string& what) {
+    if (!quiet) std::cerr << "thermotwin: " << what << "\n";
+  };
+  const solvers::Progress progress = [&](double t, double end) {
+    if (!quiet) report_progress("campaign", t, end);
+  };
+  CampaignOnModel out;
+  if (choice.full) {
+    say("model: full order (" + std::to_string(mesh.nodes.rows()) + " nodes), as --full asks");
+    out.results = solvers::simulate_campaign(mesh, spec, runs, progress, sampled_nodes);
+    out.model = {{"kind", "full"}, {"nodes", mesh.nodes.rows()}};
+    return out;
+  }
+  std::optional<solvers::Twin> built;
+  io::ReducedModelFile file;
+  const solvers::Twin* twin = nullptr;
+  if (!choice.rom.empty()) {
+    file = io::read_reduced_model(choice.rom);
+    io::check_reduced_model_fits(file, io::reduced_model_key(spec, mesh), choice.rom);
+    twin = &file.twin;
+    out.model = {{"kind", "reduced"},
+                 {"rom", std::filesystem::absolute(choice.rom).string()},
+                 {"built_from", file.case_name}};
+  } else {
+    say("model: building the reduced model (--full for the full order)");
+    const auto t0 = std::chrono::steady_clock::now();
+    built = solvers::case_twin(mesh, spec);
+    twin = &*built;
+    out.model = {{"kind", "reduced"},
+                 {"rom", "built on the fly"},
+                 {"build_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+                                 .count()}};
+  }
+  out.model["order"] = twin->model.states();
+  out.model["nodes"] = mesh.nodes.rows();
+  say("model: reduced, order " + std::to_string(twin->model.states()) + " of " +
+      std::to_string(mesh.nodes.rows()) + " nodes");
+  out.results = solvers::twin_campaign(*twin, runs, progress, sampled_nodes);
+  return out;
+}
+
+}  // namespace tt::app

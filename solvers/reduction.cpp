@@ -1,0 +1,410 @@
+#include "solvers/reduction.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "core/errors.hpp"
+#include "solvers/cholmod/cholmod_factor.hpp"
+#include "solvers/loads.hpp"
+
+namespace tt::solvers {
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+using Clock = std::chrono::steady_clock;
+
+/// K(h) = K + sum_c h_c F_c [W/K].
+Sparse film_stiffness(const FullThermalSystem& full, const std::vector<double>& h) {
+  Sparse k = full.conduction;
+  for (size_t c = 0; c < h.size(); ++c) k += h[c] * full.film[c];
+  k.makeCompressed();
+  return k;
+}
+
+/// Whether some film removes heat under h, so that K(h) is positive definite (s = 0 allowed).
+bool removes_heat(const FullThermalSystem& full, const std::vector<double>& h) {
+  for (size_t c = 0; c < h.size(); ++c)
+    if (h[c] > 0 && full.film_area[c].sum() > 0) return true;
+  return false;
+}
+
+void check_options(const ReductionOptions& o) {
+  const auto fail = [](const std::string& what) {
+    throw core::SolverError("reduction options: " + what);
+  };
+  for (double s : o.shifts_per_s)
+    if (!(s >= 0) || !std::isfinite(s))
+      fail("shift " + std::to_string(s) + " 1/s: must be finite and >= 0");
+  for (double n : o.speeds_rpm)
+    if (!(n >= 0) || !std::isfinite(n))
+      fail("speed " + std::to_string(n) + " rpm: must be finite and >= 0");
+  if (!(o.deflation_tolerance > 0 && o.deflation_tolerance < 1))
+    fail("deflation_tolerance = " + std::to_string(o.deflation_tolerance) + ": must be in (0, 1)");
+  if (!(o.compression_tolerance >= 0 && o.compression_tolerance < 1))
+    fail("compression_tolerance = " + std::to_string(o.compression_tolerance) +
+         ": must be in [0, 1)");
+  if (!(o.moving_slice_fraction > 0 && o.moving_slice_fraction <= 1))
+    fail("moving_slice_fraction = " + std::to_string(o.moving_slice_fraction) +
+         ": must be in (0, 1]");
+}
+
+/// Per film state, h per convection entry at each speed asked for (duplicates once).
+std::vector<std::vector<double>> film_states(const core::CaseSpec& spec,
+                                             const ReductionOptions& o) {
+  std::vector<double> speeds = o.speeds_rpm;
+  if (speeds.empty()) {
+    double top = 0;
+    for (const auto& seg : spec.duty_cycle.segments) top = std::max(top, seg.speed_rpm);
+    speeds = {0.0, top};
+  }
+  std::vector<std::vector<double>> states;
+  for (double n : speeds) {
+    std::vector<double> h;
+    for (const auto& c : spec.thermal.convection) h.push_back(film_coefficient(c, n));
+    if (std::find(states.begin(), states.end(), h) == states.end()) states.push_back(h);
+  }
+  return states;
+}
+
+/// 0 (when allowed) and five shifts log-spaced from 1/(10 h) to 1/step [1/s].
+std::vector<double> default_shifts(const core::CaseSpec& spec, bool steady) {
+  std::vector<double> s;
+  if (steady) s.push_back(0.0);
+  const double lo = 1.0 / 36000.0, hi = 1.0 / std::max(spec.thermal.step, 1e-3);
+  constexpr int count = 5;
+  for (int i = 0; i < count; ++i) s.push_back(lo * std::pow(hi / lo, i / double(count - 1)));
+  return s;
+}
+
+/// The pieces of a moving source grouped into slices of width `width` along the axis: per
+/// slice, weights over the pieces (their volumes, summing to 1): #pieces x #slices.
+Eigen::MatrixXd slice_weights(const MovingSourceShape& shape, double width) {
+  const Eigen::Index n = shape.centre.size();
+  std::vector<Eigen::VectorXd> slices;
+  Eigen::Index i = 0;
+  while (i < n) {
+    const double start = shape.centre(i);
+    Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
+    for (; i < n && shape.centre(i) < start + width; ++i) w(i) = shape.volume(i);
+    slices.push_back(w / w.sum());
+  }
+  Eigen::MatrixXd out(n, static_cast<Eigen::Index>(slices.size()));
+  for (size_t j = 0; j < slices.size(); ++j) out.col(static_cast<Eigen::Index>(j)) = slices[j];
+  return out;
+}
+
+/// Orthonormal basis under construction, in the capacity inner product.
+class CapacityOrthonormalBasis {
+ public:
+  CapacityOrthonormalBasis(const Sparse& capacity, double tolerance, double compression)
+      : c_(capacity), tol_(tolerance), compression_(compression), v_(capacity.rows(), 0) {}
+
+  /// Appends what each column adds to the span (block Gram-Schmidt against the basis twice, then
+  /// column by column twice: "twice is enough"); returns the number of columns dropped.
+  int append(Eigen::MatrixXd x) {
+    Eigen::VectorXd norm0 = c_norms(x);
+    for (int pass = 0; pass < 2 && v_.cols() > 0; ++pass) {
+      const Eigen::MatrixXd cx = c_ * x;
+      x -= v_ * (v_.transpose() * cx);
+    }
+    const Eigen::Index offered = x.cols();
+    if (compression_ > 0) {
+      x = compressed(std::move(x), norm0);
+      norm0 = Eigen::VectorXd::Ones(x.cols());
+    }
+    const Eigen::Index first = v_.cols();
+    int dropped = static_cast<int>(offered - x.cols());
+    for (Eigen::Index j = 0; j < x.cols(); ++j) {
+      Eigen::VectorXd col = x.col(j);
+      for (int pass = 0; pass < 2 && v_.cols() > first; ++pass) {
+        const auto fresh = v_.rightCols(v_.cols() - first);
+        col -= fresh * (fresh.transpose() * (c_ * col));
+      }
+      const double norm = std::sqrt(std::max(0.0, col.dot(c_ * col)));
+      if (!(norm0(j) > 0) || !(norm > tol_ * norm0(j))) {
+        ++dropped;
+        continue;
+      }
+      v_.conservativeResize(Eigen::NoChange, v_.cols() + 1);
+      v_.col(v_.cols() - 1) = col / norm;
+    }
+    return dropped;
+  }
+  const Eigen::MatrixXd& basis() const { return v_; }
+
+ private:
+  /// The block's principal directions in the C inner product, each column scaled by its norm
+  /// before orthogonalisation (every input counts alike): those whose singular value exceeds
+  /// the compression tolerance, C-orthonormal.
+  Eigen::MatrixXd compressed(Eigen::MatrixXd x, const Eigen::VectorXd& norm0) const {
+    for (Eigen::Index j = 0; j < x.cols(); ++j)
+      x.col(j) =
+          norm0(j) > 0 ? Eigen::VectorXd(x.col(j) / norm0(j)) : Eigen::VectorXd::Zero(x.rows());
+    const Eigen::MatrixXd g = x.transpose() * (c_ * x);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = g.rows() - 1; i >= 0; --i)
+      if (eig.eigenvalues()(i) > compression_ * compression_) keep.push_back(i);
+    Eigen::MatrixXd out(x.rows(), static_cast<Eigen::Index>(keep.size()));
+    for (size_t k = 0; k < keep.size(); ++k)
+      out.col(static_cast<Eigen::Index>(k)) =
+          x * eig.eigenvectors().col(keep[k]) / std::sqrt(eig.eigenvalues()(keep[k]));
+    return out;
+  }
+  Eigen::VectorXd c_norms(const Eigen::MatrixXd& x) const {
+    const Eigen::MatrixXd cx = c_ * x;
+    return (x.cwiseProduct(cx)).colwise().sum().cwiseMax(0.0).cwiseSqrt().transpose();
+  }
+  const Sparse& c_;
+  double tol_, compression_;
+  Eigen::MatrixXd v_;
+};
+
+Eigen::MatrixXd symmetric_projection(const Sparse& a, const Eigen::MatrixXd& v) {
+  const Eigen::MatrixXd av = a * v;
+  const Eigen::MatrixXd r = v.transpose() * av;
+  return 0.5 * (r + r.transpose());
+}
+
+std::string count_mismatch(const std::string& what, size_t model, size_t now) {
+  return what + ": the reduced model was built with " + std::to_string(model) + ", the case has " +
+         std::to_string(now);
+}
+
+}  // namespace
+
+Eigen::MatrixXd input_columns(const FullThermalSystem& full, const core::CaseSpec& spec,
+                              const ReductionOptions& options) {
+  check_options(options);
+  const Eigen::Index n = full.states();
+  std::vector<Eigen::VectorXd> cols;
+  cols.push_back(Eigen::VectorXd::Ones(n));
+  for (size_t i = 0; i < full.source_shape.size(); ++i)
+    if (!(i < spec.thermal.sources.size() && spec.thermal.sources[i].window > 0))
+      cols.push_back(full.source_shape[i]);
+  for (const auto& a : full.film_area) cols.push_back(a);
+  for (const auto& a : full.flux_area) cols.push_back(a);
+  for (size_t k = 0; k < full.moving.size(); ++k) {
+    const double window = spec.thermal.sources[full.moving_source[k]].window;
+    const Eigen::MatrixXd w =
+        slice_weights(full.moving_pieces[k], options.moving_slice_fraction * window);
+    const Eigen::MatrixXd loads = full.moving[k] * w;
+    for (Eigen::Index j = 0; j < loads.cols(); ++j) cols.push_back(loads.col(j));
+  }
+  Eigen::MatrixXd b(n, static_cast<Eigen::Index>(cols.size()));
+  for (size_t j = 0; j < cols.size(); ++j) b.col(static_cast<Eigen::Index>(j)) = cols[j];
+  return b;
+}
+
+Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseSpec& spec,
+                                const ReductionOptions& options, ReductionStats* stats) {
+  const auto t0 = Clock::now();
+  check_options(options);
+  ReductionStats st;
+  const Eigen::MatrixXd b = input_columns(full, spec, options);
+  st.input_columns = static_cast<int>(b.cols());
+  CapacityOrthonormalBasis v(full.capacity, options.deflation_tolerance,
+                             options.compression_tolerance);
+  // The uniform field first: every run starts from it, exactly.
+  v.append(Eigen::VectorXd::Ones(full.states()));
+  // The remaining input columns: the load shapes themselves (the response at s -> infinity).
+  st.deflated_columns += v.append(b.rightCols(b.cols() - 1));
+  st.candidate_columns = static_cast<int>(b.cols());
+  st.film_states = film_states(spec, options);
+  for (const auto& h : st.film_states) {
+    const bool steady = removes_heat(full, h);
+    std::vector<double> shifts =
+        options.shifts_per_s.empty() ? default_shifts(spec, steady) : options.shifts_per_s;
+    const Sparse k = film_stiffness(full, h);
+    for (double s : shifts) {
+      if (s == 0 && !steady) continue;  // K alone is singular: no film removes heat
+      if (std::find(st.shifts_per_s.begin(), st.shifts_per_s.end(), s) == st.shifts_per_s.end())
+        st.shifts_per_s.push_back(s);
+      Sparse a = k + s * full.capacity;
+      a.makeCompressed();
+      std::ostringstream what;
+      what << "reduction: K(h) + s C at s = " << s << " 1/s";
+      const cholmod::Factor factor(a, what.str());
+      ++st.factorizations;
+      Eigen::MatrixXd x = factor.solve(b);
+      st.candidate_columns += static_cast<int>(x.cols());
+      st.deflated_columns += v.append(x);
+      if (options.second_moment) {
+        x = factor.solve(full.capacity * x);
+        st.candidate_columns += static_cast<int>(x.cols());
+        st.deflated_columns += v.append(x);
+      }
+    }
+  }
+  st.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (stats) *stats = st;
+  return v.basis();
+}
+
+ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis) {
+  if (basis.rows() != full.states())
+    throw core::SolverError("reduction: the basis has " + std::to_string(basis.rows()) +
+                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+  ReducedThermalSystem r;
+  r.capacity = symmetric_projection(full.capacity, basis);
+  r.conduction = symmetric_projection(full.conduction, basis);
+  for (const auto& f : full.film) r.film.push_back(symmetric_projection(f, basis));
+  const auto project = [&](const std::vector<Eigen::VectorXd>& in) {
+    std::vector<Eigen::VectorXd> out;
+    for (const auto& x : in) out.push_back(basis.transpose() * x);
+    return out;
+  };
+  r.film_area = project(full.film_area);
+  r.source_shape = project(full.source_shape);
+  r.flux_area = project(full.flux_area);
+  for (const auto& p : full.moving) r.moving.push_back(basis.transpose() * p);
+  r.moving_source = full.moving_source;
+  r.moving_pieces = full.moving_pieces;
+  r.uniform = basis.transpose() * (full.capacity * Eigen::VectorXd::Ones(full.states()));
+  return r;
+}
+
+ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& spec,
+                           const ReductionOptions& options) {
+  const auto t0 = Clock::now();
+  ReducedModel m;
+  m.basis = reduction_basis(full, spec, options, &m.stats);
+  m.system = projected_system(full, m.basis);
+  m.stats.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return m;
+}
+
+Eigen::MatrixXd project_rows(const ReducedModel& model, const Eigen::SparseMatrix<double>& rows) {
+  if (rows.cols() != model.basis.rows())
+    throw core::SolverError("reduction: output rows have " + std::to_string(rows.cols()) +
+                            " columns, the reduced model's mesh " +
+                            std::to_string(model.basis.rows()) + " nodes");
+  return rows * model.basis;
+}
+
+Eigen::MatrixXd project_rows(const ReducedModel& model, const Eigen::MatrixXd& rows) {
+  if (rows.cols() != model.basis.rows())
+    throw core::SolverError("reduction: output rows have " + std::to_string(rows.cols()) +
+                            " columns, the reduced model's mesh " +
+                            std::to_string(model.basis.rows()) + " nodes");
+  return rows * model.basis;
+}
+
+Eigen::MatrixXd reconstructed(const ReducedModel& model, const Eigen::MatrixXd& states) {
+  if (states.rows() != model.basis.cols())
+    throw core::SolverError("reduction: states have " + std::to_string(states.rows()) +
+                            " rows, the reduced model " + std::to_string(model.basis.cols()));
+  return model.basis * states;
+}
+
+void check_reducible(const ReducedModel& model, const FullThermalSystem& full,
+                     const core::CaseSpec& spec) {
+  const auto fail = [](const std::string& what) {
+    throw core::SolverError("reduced model does not fit this case: " + what +
+                            ". Hint: build the reduced model again from this case and mesh");
+  };
+  if (model.basis.rows() != full.states())
+    fail(count_mismatch("nodes", static_cast<size_t>(model.basis.rows()),
+                        static_cast<size_t>(full.states())));
+  const auto& sys = model.system;
+  if (sys.film.size() != spec.thermal.convection.size())
+    fail(count_mismatch("thermal.convection entries", sys.film.size(),
+                        spec.thermal.convection.size()));
+  if (sys.source_shape.size() != spec.thermal.sources.size())
+    fail(count_mismatch("thermal.heat_sources", sys.source_shape.size(),
+                        spec.thermal.sources.size()));
+  if (sys.flux_area.size() != spec.thermal.fluxes.size())
+    fail(count_mismatch("thermal.fluxes", sys.flux_area.size(), spec.thermal.fluxes.size()));
+  std::vector<int> moving;
+  for (size_t i = 0; i < spec.thermal.sources.size(); ++i)
+    if (spec.thermal.sources[i].window > 0) moving.push_back(static_cast<int>(i));
+  if (moving != sys.moving_source)
+    fail("the heat sources that move with the feed axis differ (" +
+         std::to_string(sys.moving_source.size()) + " in the model, " +
+         std::to_string(moving.size()) + " in the case)");
+}
+
+namespace {
+
+void check_step(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                const ReducedStep& step) {
+  const Eigen::Index n = full.states();
+  if (basis.rows() != n || step.state_old.size() != basis.cols() ||
+      step.state_new.size() != basis.cols() || step.load.size() != n ||
+      step.film.size() != full.film.size() || !(step.dt > 0))
+    throw core::SolverError(
+        "reduction error indicator: the sampled step does not fit the system (basis " +
+        std::to_string(basis.rows()) + " x " + std::to_string(basis.cols()) + ", states " +
+        std::to_string(step.state_old.size()) + " and " + std::to_string(step.state_new.size()) +
+        ", load " + std::to_string(step.load.size()) + ", " + std::to_string(step.film.size()) +
+        " film coefficients, dt = " + std::to_string(step.dt) + " s)");
+}
+
+/// The step's full-order residual [W].
+Eigen::VectorXd step_residual(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                              const Sparse& k, const ReducedStep& step) {
+  const Eigen::VectorXd t_old = basis * step.state_old, t_new = basis * step.state_new;
+  const Eigen::VectorXd mid = step.theta * t_new + (1 - step.theta) * t_old;
+  return full.capacity * ((t_new - t_old) / step.dt) + k * mid - step.load;
+}
+
+/// The horizon rounded to a power of sqrt(2) (at least dt) [s], so that samples share factors.
+double rounded_horizon(const ReducedStep& step) {
+  const double tau = std::max(step.dt, step.horizon);
+  return std::pow(std::sqrt(2.0), std::round(std::log(tau) / std::log(std::sqrt(2.0))));
+}
+
+/// max |e| of the residuals [K], e = (K(h) + C/tau)^{-1} r, one factor for all of them.
+Eigen::VectorXd estimates(const FullThermalSystem& full, const Sparse& k, double tau,
+                          const Eigen::MatrixXd& residuals) {
+  Sparse a = k + (1.0 / tau) * full.capacity;
+  a.makeCompressed();
+  std::ostringstream what;
+  what << "reduction error indicator: K(h) + C/tau at tau = " << tau << " s";
+  const cholmod::Factor factor(a, what.str());
+  return factor.solve(residuals).cwiseAbs().colwise().maxCoeff().transpose();
+}
+
+}  // namespace
+
+double step_error_estimate(const FullThermalSystem& full, const Eigen::MatrixXd& basis,
+                           const ReducedStep& step) {
+  check_step(full, basis, step);
+  const Sparse k = film_stiffness(full, step.film);
+  return estimates(full, k, rounded_horizon(step), step_residual(full, basis, k, step))(0);
+}
+
+ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel& model,
+                               const std::vector<ReducedStep>& steps, double tolerance_k) {
+  ErrorIndicator out;
+  out.tolerance_k = tolerance_k;
+  out.samples_k.assign(steps.size(), 0.0);
+  for (const auto& s : steps) check_step(full, model.basis, s);
+  // Samples grouped by (film state, rounded horizon): one factor and one block solve per group.
+  std::vector<bool> done(steps.size(), false);
+  for (size_t i = 0; i < steps.size(); ++i) {
+    if (done[i]) continue;
+    const double tau = rounded_horizon(steps[i]);
+    std::vector<size_t> group;
+    for (size_t j = i; j < steps.size(); ++j)
+      if (!done[j] && steps[j].film == steps[i].film && rounded_horizon(steps[j]) == tau)
+        group.push_back(j);
+    const Sparse k = film_stiffness(full, steps[i].film);
+    Eigen::MatrixXd r(full.states(), static_cast<Eigen::Index>(group.size()));
+    for (size_t g = 0; g < group.size(); ++g)
+      r.col(static_cast<Eigen::Index>(g)) = step_residual(full, model.basis, k, steps[group[g]]);
+    const Eigen::VectorXd e = estimates(full, k, tau, r);
+    for (size_t g = 0; g < group.size(); ++g) {
+      out.samples_k[group[g]] = e(static_cast<Eigen::Index>(g));
+      done[group[g]] = true;
+    }
+  }
+  for (double e : out.samples_k) out.max_k = std::max(out.max_k, e);
+  return out;
+}
+
+}  // namespace tt::solvers

@@ -1,0 +1,475 @@
+#include "solvers/thermal_stepper.hpp"
+
+#include <Eigen/Cholesky>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <type_traits>
+
+#include "core/errors.hpp"
+#include "core/limits.hpp"
+#include "solvers/cholmod/cholmod_factor.hpp"
+#include "solvers/feed_axis.hpp"
+#include "solvers/loads.hpp"
+
+namespace tt::solvers {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Sparse = Eigen::SparseMatrix<double>;
+using Dense = Eigen::MatrixXd;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// The solve of C + theta dt A: CHOLMOD for the sparse system, a dense Cholesky for a reduced one.
+template <class Matrix>
+class StepFactor;
+
+template <>
+class StepFactor<Sparse> {
+ public:
+  StepFactor(const Sparse& a, const std::string& what) : f_(a, what) {}
+  void solve_in_place(Eigen::VectorXd& x) const { f_.solve_in_place(x); }
+  Dense solve(const Dense& b) const { return f_.solve(b); }
+  double entries() const { return f_.factor_entries(); }
+
+ private:
+  cholmod::Factor f_;
+};
+
+/// A reduced system's step matrix is small and dense: its inverse, formed once from the Cholesky
+/// factor, makes each step one matrix-vector product instead of two triangular solves.
+template <>
+class StepFactor<Dense> {
+ public:
+  StepFactor(const Dense& a, const std::string& what) {
+    const Eigen::LLT<Dense> llt(a);
+    if (llt.info() != Eigen::Success)
+      throw core::SolverError(what +
+                              ": the dense Cholesky factorisation failed (the matrix is "
+                              "not positive definite). Hint: check the reduced basis");
+    inverse_ = llt.solve(Dense::Identity(a.rows(), a.cols()));
+  }
+  void solve_in_place(Eigen::VectorXd& x) const { x = inverse_ * x; }
+  Dense solve(const Dense& b) const { return inverse_ * b; }
+  double entries() const { return static_cast<double>(inverse_.size()); }
+
+ private:
+  Dense inverse_;
+};
+
+/// The loads at one instant: matrix key (speed), film coefficients, sinks, source powers.
+struct LoadState {
+  double speed = 0;
+  std::vector<double> h, sink_k, power;
+};
+
+template <class Matrix>
+LoadState load_state(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>& sys,
+                     double t_load, double t_sink, const Eigen::VectorXd& state, double t0_k) {
+  LoadState s;
+  s.speed = speed_at(spec.duty_cycle, t_load);
+  for (const auto& c : spec.thermal.convection) {
+    s.h.push_back(film_coefficient(c, s.speed));
+    s.sink_k.push_back(table_value(c.sink, t_sink) + kCelsiusOffset);
+  }
+  const double feed = feed_speed_at(spec.feed_axis, t_load);
+  for (size_t i = 0; i < spec.thermal.sources.size(); ++i) {
+    const auto& src = spec.thermal.sources[i];
+    // Moving sources enter through moving_heat_load, not through source_shape.
+    double p = src.window > 0 ? 0.0 : source_power(src, s.speed, feed);
+    if (src.temperature_coefficient != 0)
+      p *= 1 + src.temperature_coefficient * (sys.source_shape[i].dot(state) - t0_k);
+    s.power.push_back(p);
+  }
+  return s;
+}
+
+/// Scale of a surface flux at spindle speed n [-].
+double flux_scale(const core::SurfaceFlux& fl, double speed) {
+  return fl.follows_speed ? (speed > 0 ? speed / fl.ref_speed_rpm : 0.0) : 1.0;
+}
+
+template <class Matrix>
+Eigen::VectorXd load_vector(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>& sys,
+                            const LoadState& s) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(sys.states());
+  for (size_t c = 0; c < s.h.size(); ++c) f += (s.h[c] * s.sink_k[c]) * sys.film_area[c];
+  for (size_t i = 0; i < s.power.size(); ++i) f += s.power[i] * sys.source_shape[i];
+  for (size_t i = 0; i < spec.thermal.fluxes.size(); ++i) {
+    const auto& fl = spec.thermal.fluxes[i];
+    f += fl.flux * flux_scale(fl, s.speed) * sys.flux_area[i];
+  }
+  return f;
+}
+
+/// Heat rate leaving through every film [W]: h (int T dA - T_sink int dA).
+template <class Matrix>
+double convected_rate(const LinearThermalSystem<Matrix>& sys, const std::vector<double>& area,
+                      const Eigen::VectorXd& state, const LoadState& s) {
+  double rate = 0;
+  for (size_t c = 0; c < s.h.size(); ++c)
+    rate += s.h[c] * (sys.film_area[c].dot(state) - s.sink_k[c] * area[c]);
+  return rate;
+}
+
+/// Checks that a saved state belongs to this system and time grid before the loop trusts it.
+void check_resume(const ThermalCheckpoint& c, Eigen::Index states, const std::vector<double>& grid,
+                  size_t times) {
+  const auto fail = [](const std::string& what) {
+    throw core::SolverError("checkpoint does not fit this run: " + what +
+                            "; remove the checkpoint or run without --resume");
+  };
+  if (c.temperature.size() != states || c.outputs.rows() != states)
+    fail("it has " + std::to_string(c.temperature.size()) + " nodes, the mesh " +
+         std::to_string(states));
+  if (c.steps < 1 || static_cast<size_t>(c.steps) >= grid.size() || grid[c.steps - 1] != c.time)
+    fail("step " + std::to_string(c.steps) + " at t = " + std::to_string(c.time) +
+         " s is not an inner step of the time grid (" + std::to_string(grid.size()) + " steps)");
+  if (c.outputs.cols() < 1 || static_cast<size_t>(c.outputs.cols()) > times)
+    fail(std::to_string(c.outputs.cols()) + " output columns, at most " + std::to_string(times) +
+         " expected");
+}
+
+/// The readout of one state (the base) [rows].
+Eigen::VectorXd read_state(const StateReadout& r, const Eigen::VectorXd& x,
+                           const Eigen::VectorXd& x_start) {
+  Eigen::VectorXd y(r.rows());
+  const Eigen::Index a = r.sparse.rows(), b = r.dense.rows(), c = r.change.rows();
+  if (a) y.head(a) = r.sparse * x;
+  if (b) y.segment(a, b) = r.dense * x;
+  if (c) y.tail(c) = r.change * (x - x_start);
+  return y;
+}
+
+/// The readout of a block of response columns (which start from zero): rows x #columns.
+Dense read_block(const StateReadout& r, const Dense& x) {
+  Dense y(r.rows(), x.cols());
+  const Eigen::Index a = r.sparse.rows(), b = r.dense.rows(), c = r.change.rows();
+  if (a) y.topRows(a) = r.sparse * x;
+  // Coefficient-wise products: a few rows do not pay for a blocked, OpenMP-parallel GEMM, whose
+  // threads wait on each other every step when the cores are shared.
+  if (b) y.middleRows(a, b) = r.dense.lazyProduct(x);
+  if (c) y.bottomRows(c) = r.change.lazyProduct(x);
+  return y;
+}
+
+template <class Matrix>
+void check_request(const LinearThermalSystem<Matrix>& sys, const StepperRequest& q, double end) {
+  const Eigen::Index n = sys.states();
+  const auto fits = [n](const StateReadout& r) {
+    return (r.sparse.rows() == 0 || r.sparse.cols() == n) &&
+           (r.dense.rows() == 0 || r.dense.cols() == n) &&
+           (r.change.rows() == 0 || r.change.cols() == n);
+  };
+  if (!fits(q.base_readout) || !fits(q.column_readout))
+    throw core::SolverError("thermal stepper: a readout's rows do not have " + std::to_string(n) +
+                            " columns (the system's states)");
+  for (size_t k = 0; k < q.record_times.size(); ++k)
+    if (!(q.record_times[k] > (k ? q.record_times[k - 1] : 0.0)) ||
+        q.record_times[k] > end * (1 + 1e-9))
+      throw core::SolverError("thermal stepper: record time " + std::to_string(q.record_times[k]) +
+                              " s is not after the one before it or beyond the end (" +
+                              std::to_string(end) + " s): expected ascending times in (0, end]");
+  for (const auto& c : q.shape_columns)
+    if (c.shape.size() != n || !c.law)
+      throw core::SolverError("thermal stepper: a shape column has " +
+                              std::to_string(c.shape.size()) + " entries (expected " +
+                              std::to_string(n) + ") or no law");
+}
+
+/// Stiffness K + sum h_c F_c per speed and factors of C + theta dt A per (step, speed, theta),
+/// built on first use; factorisations are counted in `timings`.
+template <class Matrix>
+class StepOperators {
+ public:
+  StepOperators(const LinearThermalSystem<Matrix>& sys, ThermalTimings& timings)
+      : sys_(sys), timings_(timings) {}
+
+  const Matrix& stiffness(const LoadState& s) {
+    auto it = stiffness_.find(s.speed);
+    if (it != stiffness_.end()) return it->second;
+    Matrix kk = sys_.conduction;
+    for (size_t c = 0; c < s.h.size(); ++c) kk += s.h[c] * sys_.film[c];
+    if constexpr (std::is_same_v<Matrix, Sparse>) kk.makeCompressed();
+    return stiffness_.emplace(s.speed, std::move(kk)).first->second;
+  }
+
+  const StepFactor<Matrix>& factor(double dt, double theta, const LoadState& s) {
+    const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, s.speed, theta);
+    auto it = factors_.find(key);
+    if (it != factors_.end()) return *it->second;
+    const auto t_f = Clock::now();
+    Matrix a = sys_.capacity + (theta * dt) * stiffness(s);
+    if constexpr (std::is_same_v<Matrix, Sparse>) a.makeCompressed();
+    std::ostringstream what;
+    what << "thermal system (dt = " << dt << " s, speed = " << s.speed << " rpm)";
+    auto f = std::make_unique<StepFactor<Matrix>>(a, what.str());
+    timings_.factor_s += seconds_since(t_f);
+    timings_.factorizations += 1;
+    timings_.factor_entries = std::max(timings_.factor_entries, f->entries());
+    return *factors_.emplace(key, std::move(f)).first->second;
+  }
+
+ private:
+  const LinearThermalSystem<Matrix>& sys_;
+  ThermalTimings& timings_;
+  std::map<double, Matrix> stiffness_;
+  std::map<std::tuple<double, double, double>, std::unique_ptr<StepFactor<Matrix>>> factors_;
+};
+
+/// The caller columns' responses after the step `view` from `x` (#states x #columns), with the
+/// base's stiffness and factor: (C + theta dt A) x1 = (C - (1 - theta) dt A) x + dt b.
+template <class Matrix>
+Dense stepped_responses(const LinearThermalSystem<Matrix>& sys, const StepperRequest& q,
+                        const StepView& view, const Matrix& kk, const StepFactor<Matrix>& factor,
+                        const Dense& x) {
+  const double dt = view.dt(), t = view.t1, speed = view.speed;
+  const bool cn = view.theta != 1;
+  Dense b = sys.capacity * x;
+  if (cn) b -= (0.5 * dt) * (kk * x);
+  const auto ns = static_cast<Eigen::Index>(q.shape_columns.size());
+  for (Eigen::Index j = 0; j < ns; ++j) {
+    const auto& col = q.shape_columns[static_cast<size_t>(j)];
+    const double law = cn ? 0.5 * (col.law(t, speed) + col.law(view.t0, speed)) : col.law(t, speed);
+    b.col(j) += (dt * law) * col.shape;
+  }
+  for (size_t j = 0; j < q.load_columns.size(); ++j)
+    b.col(ns + static_cast<Eigen::Index>(j)) += dt * q.load_columns[j](view);
+  return factor.solve(b);
+}
+
+/// Why a step's temperatures are not finite: the step, a state entry, and the loads that entered
+/// it (the case's numbers that can overflow: heat source powers, film coefficients, sinks).
+core::SolverError non_finite_temperature(const core::CaseSpec& spec, const LoadState& s,
+                                         const Eigen::VectorXd& temperature, std::size_t step,
+                                         double t) {
+  Eigen::Index node = 0;
+  while (node + 1 < temperature.size() && std::isfinite(temperature[node])) ++node;
+  std::ostringstream o;
+  o << spec.source.string() << ": the temperature is not finite (" << temperature[node]
+    << " at node " << node << ") after time step " << step + 1 << ", t = " << t
+    << " s; nothing is written. The step's loads:";
+  for (std::size_t k = 0; k < s.power.size(); ++k)
+    o << " heat source '" << spec.thermal.sources[k].name << "' " << s.power[k] << " W;";
+  for (std::size_t k = 0; k < s.h.size(); ++k)
+    o << " convection[" << k << "] h = " << s.h[k] << " W/(m^2 K), sink "
+      << s.sink_k[k] - kCelsiusOffset << " degC;";
+  o << " Hint: a power, flux or coefficient far beyond a machine's (thermal.heat_sources "
+       "power_ref_W, surface_flux flux_W_m2, h_W_m2K, the material values) overflows a double.";
+  return core::SolverError(o.str());
+}
+
+/// The recorded states (and the displacement history after them, three values per node) are
+/// kept whole in memory: refuse before allocating beyond core::limits::kHistoryBytes.
+void require_history_fits(const core::CaseSpec& spec, Eigen::Index states, std::size_t times) {
+  const double per_state = spec.mechanical.enabled ? 4 : 1;
+  const double bytes =
+      per_state * sizeof(double) * static_cast<double>(states) * static_cast<double>(times);
+  if (bytes <= static_cast<double>(core::limits::kHistoryBytes)) return;
+  throw core::SolverError(
+      spec.source.string() +
+      ": thermal.output_interval_s = " + std::to_string(spec.thermal.output_interval) +
+      " s gives " + std::to_string(times) + " output times of " + std::to_string(states) +
+      " nodes: the histories would take " + std::to_string(bytes / 1e9) +
+      " GB, more than the limit of " + core::limits::bytes_text(core::limits::kHistoryBytes) +
+      " (core/limits.hpp). Hint: lengthen output_interval_s or coarsen the mesh.");
+}
+
+}  // namespace
+
+template <class Matrix>
+Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>& sys,
+                                 double t0, double t1) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(sys.states());
+  const double mid = 0.5 * (t0 + t1);
+  const double speed = speed_at(spec.duty_cycle, mid), feed = feed_speed_at(spec.feed_axis, mid);
+  for (size_t k = 0; k < sys.moving.size(); ++k) {
+    const double power = source_power(spec.thermal.sources[sys.moving_source[k]], speed, feed);
+    if (power == 0) continue;
+    // Only the pieces under the window take heat: a reduced system's moving matrix is dense.
+    const Eigen::VectorXd share = moving_piece_fractions(spec, sys.moving_pieces[k], t0, t1);
+    for (Eigen::Index p = 0; p < share.size(); ++p)
+      if (share(p) != 0) f += (share(p) * power) * sys.moving[k].col(p);
+  }
+  return f;
+}
+
+template <class Matrix>
+StepLoad step_load(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec, double t0,
+                   double t1, const Eigen::VectorXd& state0) {
+  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const LoadState s = load_state(spec, sys, 0.5 * (t0 + t1), t1, state0, t0_k);
+  return {load_vector(spec, sys, s) + moving_heat_load(spec, sys, t0, t1), s.h};
+}
+
+template <class Matrix>
+SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec,
+                            const StepperRequest& q, const Progress& progress,
+                            const Checkpointing& checkpointing) {
+  using Scheme = core::TimeScheme;
+  const Scheme scheme = spec.thermal.scheme;
+  if (scheme == Scheme::bdf2)
+    throw core::SolverError(
+        "thermal.scheme = \"bdf2\" is not implemented: use \"backward_euler\" "
+        "or \"crank_nicolson\"");
+  const Eigen::Index n = sys.states();
+  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const double end = spec.duty_cycle.end;
+  check_request(sys, q, end);
+  const std::vector<double> grid = time_grid(spec, spec.thermal.step);
+  const Eigen::Index ns = static_cast<Eigen::Index>(q.shape_columns.size());
+  const Eigen::Index nc = ns + static_cast<Eigen::Index>(q.load_columns.size());
+  const bool reads = q.base_readout.rows() > 0;
+  if ((checkpointing.save || checkpointing.resume) && (nc > 0 || reads || !q.record_states))
+    throw core::SolverError(
+        "thermal stepper: checkpoints hold the base states only; they cannot "
+        "be used with caller columns or readouts");
+  // Int dA of every film: the uniform state's film load (the area in the full space).
+  std::vector<double> film_total;
+  for (const auto& a : sys.film_area) film_total.push_back(a.dot(sys.uniform));
+
+  SteppedHistory hist;
+  hist.times.push_back(0.0);
+  hist.times.insert(hist.times.end(), q.record_times.begin(), q.record_times.end());
+  const auto times = static_cast<Eigen::Index>(hist.times.size());
+  if (q.record_states) {
+    require_history_fits(spec, n, static_cast<std::size_t>(times));
+    hist.states.resize(n, times);
+  }
+  hist.readout.resize(q.base_readout.rows(), times);
+  for (Eigen::Index j = 0; j < nc; ++j) hist.responses.emplace_back(q.column_readout.rows(), times);
+  const Eigen::VectorXd start = t0_k * sys.uniform;
+  Eigen::VectorXd temp = start;
+  Dense x = Dense::Zero(n, nc);  // responses start from zero
+  Eigen::VectorXd read_prev = reads ? read_state(q.base_readout, temp, start) : Eigen::VectorXd();
+  Dense block_prev = nc ? read_block(q.column_readout, x) : Dense();
+  if (q.record_states) hist.states.col(0) = temp;
+  if (reads) hist.readout.col(0) = read_prev;
+  for (Eigen::Index j = 0; j < nc; ++j) hist.responses[j].col(0) = block_prev.col(j);
+  size_t next_out = 1;
+
+  StepOperators<Matrix> ops(sys, hist.timings);
+
+  const auto t_solve = Clock::now();
+  double t_prev = 0, prev_speed = std::nan("");
+  double lost_rate_prev = 0;  // heat rate out at t_prev under the current interval's h (CN)
+  size_t first_step = 0;
+  if (const ThermalCheckpoint* c = checkpointing.resume) {
+    check_resume(*c, n, grid, hist.times.size());
+    first_step = static_cast<size_t>(c->steps);
+    t_prev = c->time;
+    prev_speed = c->speed;
+    temp = c->temperature;
+    next_out = static_cast<size_t>(c->outputs.cols());
+    hist.states.leftCols(c->outputs.cols()) = c->outputs;
+    hist.heat_in = c->heat_in;
+    hist.lost = c->lost;
+    hist.timings.steps = c->steps;
+  }
+  auto t_saved = Clock::now();
+  Eigen::VectorXd rhs(n), f_prev, f_new, read_new;
+  Dense block_new;
+  for (size_t i = first_step; i < grid.size(); ++i) {
+    const double t = grid[i], dt = t - t_prev, mid = 0.5 * (t_prev + t);
+    const LoadState s_new = load_state(spec, sys, mid, t, temp, t0_k);
+    // Crank–Nicolson restarts with one backward-Euler step after every load discontinuity.
+    const bool restart = i == 0 || s_new.speed != prev_speed;
+    const bool cn = scheme == Scheme::crank_nicolson && !restart;
+    const double theta = cn ? 0.5 : 1.0;
+    const Matrix& kk = ops.stiffness(s_new);
+    // Heat moving with the feed axis: averaged over the step, the same for both ends of CN.
+    const Eigen::VectorXd f_moving = moving_heat_load(spec, sys, t_prev, t);
+    f_new = load_vector(spec, sys, s_new) + f_moving;
+    if (cn) {
+      const LoadState s_old = load_state(spec, sys, mid, t_prev, temp, t0_k);
+      f_prev = load_vector(spec, sys, s_old) + f_moving;
+      rhs = sys.capacity * temp - (0.5 * dt) * (kk * temp) + (0.5 * dt) * (f_prev + f_new);
+      lost_rate_prev = convected_rate(sys, film_total, temp, s_old);
+    } else {
+      rhs = sys.capacity * temp + dt * f_new;
+    }
+    const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
+    Eigen::VectorXd next = rhs;
+    factor.solve_in_place(next);
+    if (!next.allFinite()) throw non_finite_temperature(spec, s_new, next, i, t);
+
+    if (nc > 0)
+      x = stepped_responses(sys, q, {t_prev, t, s_new.speed, theta, &temp, &next}, kk, factor, x);
+
+    double power = 0;
+    for (double p : s_new.power) power += p;
+    const double lost_new = convected_rate(sys, film_total, next, s_new);
+    hist.heat_in += dt * (power + f_moving.dot(sys.uniform));
+    hist.lost += cn ? 0.5 * dt * (lost_rate_prev + lost_new) : dt * lost_new;
+    // Surface fluxes enter as heat too.
+    for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {
+      const auto& fl = spec.thermal.fluxes[j];
+      hist.heat_in +=
+          dt * fl.flux * flux_scale(fl, s_new.speed) * sys.flux_area[j].dot(sys.uniform);
+    }
+
+    if (reads) read_new = read_state(q.base_readout, next, start);
+    if (nc) block_new = read_block(q.column_readout, x);
+    while (next_out < hist.times.size() && hist.times[next_out] <= t + 1e-9 * end) {
+      const double w = (hist.times[next_out] - t_prev) / dt;
+      const auto k = static_cast<Eigen::Index>(next_out);
+      if (q.record_states) hist.states.col(k) = (1 - w) * temp + w * next;
+      // Readouts are linear: interpolate them rather than the states (exact at a step end).
+      if (reads) {
+        if (w == 1)
+          hist.readout.col(k) = read_new;
+        else
+          hist.readout.col(k) = (1 - w) * read_prev + w * read_new;
+      }
+      for (Eigen::Index j = 0; j < nc; ++j) {
+        if (w == 1)
+          hist.responses[j].col(k) = block_new.col(j);
+        else
+          hist.responses[j].col(k) = (1 - w) * block_prev.col(j) + w * block_new.col(j);
+      }
+      ++next_out;
+    }
+    temp.swap(next);
+    if (reads) read_prev.swap(read_new);
+    if (nc) block_prev.swap(block_new);
+    t_prev = t;
+    prev_speed = s_new.speed;
+    hist.timings.steps += 1;
+    if (progress) progress(t, end);
+    if (checkpointing.save && i + 1 < grid.size() &&
+        seconds_since(t_saved) >= checkpointing.interval_s) {
+      const auto cols = static_cast<Eigen::Index>(next_out);
+      checkpointing.save({static_cast<int>(i + 1), t, prev_speed, temp, hist.states.leftCols(cols),
+                          hist.heat_in, hist.lost});
+      t_saved = Clock::now();
+    }
+  }
+  hist.timings.solve_s = seconds_since(t_solve) - hist.timings.factor_s;
+  hist.final_state = std::move(temp);
+  return hist;
+}
+
+template SteppedHistory step_thermal<Sparse>(const FullThermalSystem&, const core::CaseSpec&,
+                                             const StepperRequest&, const Progress&,
+                                             const Checkpointing&);
+template SteppedHistory step_thermal<Dense>(const ReducedThermalSystem&, const core::CaseSpec&,
+                                            const StepperRequest&, const Progress&,
+                                            const Checkpointing&);
+template Eigen::VectorXd moving_heat_load<Sparse>(const core::CaseSpec&, const FullThermalSystem&,
+                                                  double, double);
+template Eigen::VectorXd moving_heat_load<Dense>(const core::CaseSpec&, const ReducedThermalSystem&,
+                                                 double, double);
+
+template StepLoad step_load<Sparse>(const FullThermalSystem&, const core::CaseSpec&, double,
+                                    double, const Eigen::VectorXd&);
+template StepLoad step_load<Dense>(const ReducedThermalSystem&, const core::CaseSpec&, double,
+                                   double, const Eigen::VectorXd&);
+
+}  // namespace tt::solvers

@@ -1,0 +1,143 @@
+// The reduced-order twin through the CLI and the library, on the coarse SB-1 and GM-1 cases:
+// `reduce` then `run --rom --verify`, refusals of damaged and foreign models, and the virtual
+// campaign on the twin against the full campaign (issue 15's accuracy limits: 0.01 K at the named
+// points, the TCP drift within 1 % of its peak or 0.02 um).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/campaign.hpp"
+#include "solvers/twin.hpp"
+#include "tests/reliability/process.hpp"
+
+namespace tt::twin_test {
+namespace {
+
+namespace fs = std::filesystem;
+namespace rt = reliability_test;
+
+nlohmann::json read_json(const fs::path& f) { return nlohmann::json::parse(std::ifstream(f)); }
+
+/// One reduced model of the coarse SB-1, built once for the cases that read it.
+class Twin : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = rt::scratch("twin");
+    rom_ = dir_ / "rom";
+    const fs::path log = dir_ / "reduce.log";
+    ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom_.string(),
+                       "--quick-validation", "--quiet"},
+                      {}, log),
+              0)
+        << rt::read_text(log);
+  }
+  static fs::path dir_, rom_;
+};
+fs::path Twin::dir_, Twin::rom_;
+
+TEST_F(Twin, ReduceWritesAModelItsValidationPasses) {
+  const auto j = read_json(rom_ / "reduced_model.json");
+  EXPECT_EQ(j["format"], "thermotwin reduced model");
+  EXPECT_GT(j["order"].get<int>(), 1);
+  EXPECT_LT(j["order"].get<int>(), 400);
+  EXPECT_EQ(j["outputs"]["temperatures"].get<int>(), 57);  // T01..T54, TCP, Z1, Z2
+  EXPECT_TRUE(j["outputs"]["tcp"].get<bool>());
+  EXPECT_TRUE(j["validation_passes"].get<bool>());
+  const auto& v = j["validation"][0];
+  EXPECT_LE(v["max_temperature_error_K"].get<double>(), 0.01);
+  EXPECT_TRUE(fs::exists(rom_ / "validation.csv"));
+}
+
+TEST_F(Twin, RunFromTheReducedModelMatchesTheFullRun) {
+  const fs::path out = dir_ / "run_rom", log = dir_ / "run_rom.log";
+  ASSERT_EQ(rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--verify", "--out",
+                     out.string(), "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const auto s = read_json(out / "summary.json");
+  EXPECT_EQ(s["model"]["kind"], "reduced");
+  const auto& v = s["model"]["verify"];
+  EXPECT_LE(v["max_point_temperature_error_K"].get<double>(), 0.01);
+  for (int d = 0; d < 3; ++d)
+    EXPECT_LE(v["tcp_error_um"][d].get<double>(),
+              std::max(0.02, 0.01 * v["tcp_peak_um"][d].get<double>()))
+        << "direction " << d;
+  for (const char* f : {"temperatures.csv", "thermal_error.csv", "fields.pvd", "mesh.vtu"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+}
+
+TEST_F(Twin, DamagedModelIsRefusedAndNothingIsWritten) {
+  const fs::path bad = dir_ / "rom_damaged", out = dir_ / "run_damaged", log = dir_ / "damaged.log";
+  fs::remove_all(bad);
+  fs::copy(rom_, bad);
+  {
+    std::fstream f(bad / "reduced_model.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(200);
+    f.put('\x7f');
+  }
+  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--rom", bad.string(), "--out",
+                     out.string(), "--quiet"},
+                    {}, log),
+            0);
+  EXPECT_NE(rt::read_text(log).find("checksum"), std::string::npos) << rt::read_text(log);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Twin, ModelOfAnotherMachineIsRefused) {
+  // The same case with another conductivity of cast iron: same mesh, another machine.
+  std::string text = rt::read_text(rt::kCoarseCase);
+  const std::string key = "conductivity_W_mK = ";
+  const auto at = text.find(key);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at + key.size(), text.find('\n', at) - at - key.size(), "99.0");
+  const fs::path other = dir_ / "other.toml", out = dir_ / "run_other", log = dir_ / "other.log";
+  std::ofstream(other) << text;
+  EXPECT_NE(rt::run({"run", other.string(), "--rom", rom_.string(), "--out", out.string(),
+                     "--quiet"},
+                    {}, log),
+            0);
+  EXPECT_NE(rt::read_text(log).find("another machine"), std::string::npos) << rt::read_text(log);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+/// The campaign on the twin against the full campaign: every named point within 0.01 K and the
+/// TCP drift within 1 % of its peak or 0.02 um, on two runs of the campaign the fit uses.
+void expect_campaign_matches(const fs::path& case_file, double hours, std::size_t count) {
+  const core::CaseSpec spec = io::read_case(case_file);
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  auto runs = solvers::campaign_runs(spec, hours, spec.seed);
+  runs.resize(count);
+  const auto full = solvers::simulate_campaign(mesh, spec, runs);
+  const auto reduced = solvers::twin_campaign(solvers::case_twin(mesh, spec), runs);
+  ASSERT_EQ(full.size(), reduced.size());
+  for (std::size_t r = 0; r < full.size(); ++r) {
+    const double dt =
+        (full[r].point_temperature - reduced[r].point_temperature).cwiseAbs().maxCoeff();
+    EXPECT_LE(dt, 0.01) << runs[r].name;
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd f = full[r].error.col(d), g = reduced[r].error.col(d);
+      const double limit = std::max(0.02e-6, 0.01 * f.cwiseAbs().maxCoeff());
+      EXPECT_LE((f - g).cwiseAbs().maxCoeff(), limit) << runs[r].name << " direction " << d;
+    }
+    std::printf("[twin] %s %s: max |dT| %.2e K, |d dy| %.2e um, |d dz| %.2e um\n",
+                case_file.filename().c_str(), runs[r].name.c_str(), dt,
+                (full[r].error.col(1) - reduced[r].error.col(1)).cwiseAbs().maxCoeff() * 1e6,
+                (full[r].error.col(2) - reduced[r].error.col(2)).cwiseAbs().maxCoeff() * 1e6);
+  }
+}
+
+TEST(TwinCampaign, MatchesTheFullCampaignOnSb1Coarse) {
+  expect_campaign_matches(rt::kCoarseCase, 2.0, 2);
+}
+
+TEST(TwinCampaign, MatchesTheFullCampaignOnGm1CoarseWithItsFeedAxis) {
+  // One run: the campaign's first, P-1 with the axis reciprocating while the spindle runs.
+  expect_campaign_matches(fs::path(TT_SOURCE_DIR) / "cases" / "gm1_coarse.toml", 2.0, 1);
+}
+
+}  // namespace
+}  // namespace tt::twin_test
