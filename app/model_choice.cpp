@@ -13,8 +13,8 @@ namespace tt::app {
 
 CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                   const std::vector<solvers::CampaignRun>& runs,
-                                  const ModelChoice& choice,
-                                  const std::vector<int>& sampled_nodes, bool quiet) {
+                                  const ModelChoice& choice, const std::vector<int>& sampled_nodes,
+                                  bool quiet) {
   const auto say = [&](const std::string& what) {
     if (!quiet) std::cerr << "thermotwin: " << what << "\n";
   };
@@ -43,16 +43,30 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
     const auto t0 = std::chrono::steady_clock::now();
     built = solvers::case_twin(mesh, spec);
     twin = &*built;
-    out.model = {{"kind", "reduced"},
-                 {"rom", "built on the fly"},
-                 {"build_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-                                 .count()}};
+    out.model = {
+        {"kind", "reduced"},
+        {"rom", "built on the fly"},
+        {"build_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
   }
   out.model["order"] = twin->model.states();
   out.model["nodes"] = mesh.nodes.rows();
   say("model: reduced, order " + std::to_string(twin->model.states()) + " of " +
       std::to_string(mesh.nodes.rows()) + " nodes");
   out.results = solvers::twin_campaign(*twin, runs, progress, sampled_nodes);
+  // Trust: the full-order residual at a few output steps of the first run (each distinct step
+  // size and horizon costs a full factor, so few samples).
+  if (spec.thermal.scheme == core::TimeScheme::backward_euler && !runs.empty()) {
+    const auto ind =
+        solvers::twin_indicator(solvers::thermal_system(mesh, spec), *twin, runs.front().spec, 3);
+    out.model["indicator"] = {{"run", runs.front().name},
+                              {"max_K", ind.max_k},
+                              {"tolerance_K", ind.tolerance_k},
+                              {"above_tolerance", ind.above_tolerance()}};
+    if (ind.above_tolerance())
+      std::cerr << "thermotwin: warning: the reduced model's error indicator is " << ind.max_k
+                << " K on run '" << runs.front().name << "', above its tolerance of "
+                << ind.tolerance_k << " K: check with --full\n";
+  }
   return out;
 }
 

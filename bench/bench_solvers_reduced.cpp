@@ -56,7 +56,8 @@ int main(int argc, char** argv) {
     t = Clock::now();
     std::optional<solvers::ElasticModel> elastic;
     if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) elastic.emplace(mesh, spec);
-    const solvers::TwinOutputs out = solvers::full_outputs(mesh, spec, elastic ? &*elastic : nullptr);
+    const solvers::TwinOutputs out =
+        solvers::full_outputs(mesh, spec, elastic ? &*elastic : nullptr);
     elastic.reset();
     const double outputs_s = seconds_since(t);
     t = Clock::now();
@@ -79,16 +80,18 @@ int main(int argc, char** argv) {
     std::printf("case %s: %ld nodes, %ld tets, order %d\n", case_file.c_str(),
                 static_cast<long>(mesh.nodes.rows()), static_cast<long>(mesh.tets.rows()),
                 mesh.order);
-    std::printf("mesh %.1f s, assemble %.1f s, influence rows %.1f s, reduce %.1f s (%d factors, "
-                "%d of %d columns kept)\n",
-                mesh_s, assemble_s, outputs_s, reduce_s, twin.model.stats.factorizations,
-                twin.model.states(), twin.model.stats.candidate_columns);
+    std::printf(
+        "mesh %.1f s, assemble %.1f s, influence rows %.1f s, reduce %.1f s (%d factors, "
+        "%d of %d columns kept)\n",
+        mesh_s, assemble_s, outputs_s, reduce_s, twin.model.stats.factorizations,
+        twin.model.states(), twin.model.stats.candidate_columns);
     std::printf("reduced order r = %d; peak RSS after the build %.0f MB\n", twin.model.states(),
                 build_rss);
-    std::printf("duty cycle %.0f s, %d steps: full %.3f s, reduced %.6f s (best of %d), ratio "
-                "%.0f, %.3g x real time\n",
-                spec.duty_cycle.end, run.timings.steps, full_s, reduced_s, repeats,
-                full_s / reduced_s, spec.duty_cycle.end / reduced_s);
+    std::printf(
+        "duty cycle %.0f s, %d steps: full %.3f s, reduced %.6f s (best of %d), ratio "
+        "%.0f, %.3g x real time\n",
+        spec.duty_cycle.end, run.timings.steps, full_s, reduced_s, repeats, full_s / reduced_s,
+        spec.duty_cycle.end / reduced_s);
     std::printf("max |dT| %.2e K (%s)", c.max_temperature_error_k, c.worst_point.c_str());
     for (std::size_t k = 0; k < c.drift_names.size(); ++k) {
       const auto i = static_cast<Eigen::Index>(k);

@@ -28,8 +28,8 @@ core::CaseSpec machine_only(core::CaseSpec s) {
   s.name = "machine";
   s.seed = 1;
   s.duty_cycle = core::DutyCycle{{{0.0, 0.0}}, 1.0};
-  for (auto& seg : s.feed_axis.segments) seg = {0.0, s.feed_axis.segments.front().from,
-                                                s.feed_axis.segments.front().from, 0.0};
+  for (auto& seg : s.feed_axis.segments)
+    seg = {0.0, s.feed_axis.segments.front().from, s.feed_axis.segments.front().from, 0.0};
   if (!s.feed_axis.segments.empty()) s.feed_axis.segments.resize(1);
   s.thermal.initial_temperature_c = 20;
   s.thermal.scheme = core::TimeScheme::backward_euler;
@@ -51,16 +51,22 @@ void put(ByteWriter& w, const std::string& name, const Eigen::MatrixXd& m) {
   w.put_doubles(m.data(), static_cast<std::size_t>(m.size()));
 }
 
-Eigen::MatrixXd column(const Eigen::VectorXd& v) { return v; }
+Eigen::MatrixXd column(const Eigen::VectorXd& v) {
+  return v;
+}
 
-std::string indexed(const char* what, std::size_t k) { return what + std::to_string(k); }
+std::string indexed(const char* what, std::size_t k) {
+  return what + std::to_string(k);
+}
 
 Named read_named(const std::string& bytes, const fs::path& file) {
   const std::string hint = "rebuild it with `thermotwin reduce`";
   if (bytes.size() < sizeof kMagic + sizeof(std::uint64_t) ||
       std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    throw core::DataError(file.string() + ": not a thermotwin reduced model (expected the header "
-                          "TTROM001); " + hint);
+    throw core::DataError(file.string() +
+                          ": not a thermotwin reduced model (expected the header "
+                          "TTROM001); " +
+                          hint);
   if (!checksum_matches(bytes))
     throw core::DataError(file.string() + ": reduced model corrupted (checksum mismatch); " + hint);
   ByteReader r{std::string_view(bytes).substr(0, bytes.size() - sizeof(std::uint64_t)),
@@ -70,15 +76,15 @@ Named read_named(const std::string& bytes, const fs::path& file) {
     const auto len = r.get<std::int32_t>();
     if (len < 1 || len > 64 || static_cast<std::size_t>(len) > r.left())
       throw core::DataError(file.string() + ": reduced model: a matrix name of " +
-                            std::to_string(len) + " bytes at byte " + std::to_string(r.at) +
-                            "; " + hint);
+                            std::to_string(len) + " bytes at byte " + std::to_string(r.at) + "; " +
+                            hint);
     std::string name(static_cast<std::size_t>(len), '\0');
     r.take(name.data(), name.size());
     const auto rows = r.get<std::int64_t>();
     const auto cols = r.get<std::int64_t>();
     // Sizes are checked against the bytes left before anything is allocated.
-    if (rows < 0 || cols < 0 || (rows > 0 && static_cast<std::uint64_t>(cols) >
-                                                 r.left() / sizeof(double) / rows))
+    if (rows < 0 || cols < 0 ||
+        (rows > 0 && static_cast<std::uint64_t>(cols) > r.left() / sizeof(double) / rows))
       throw core::DataError(file.string() + ": reduced model: matrix '" + name + "' of " +
                             std::to_string(rows) + " x " + std::to_string(cols) +
                             " does not fit the file; " + hint);
@@ -92,7 +98,8 @@ Named read_named(const std::string& bytes, const fs::path& file) {
 std::string read_all(const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec))
-    throw core::IoError(file.string() + ": not found or not a file; expected a folder written by "
+    throw core::IoError(file.string() +
+                        ": not found or not a file; expected a folder written by "
                         "`thermotwin reduce CASE --out DIR`");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw core::IoError(file.string() + ": cannot open");
@@ -208,7 +215,8 @@ ReducedModelFile read_reduced_model(const fs::path& dir) {
     throw core::DataError(json_file.string() + ": key 'format' is not \"" + kFormat +
                           "\"; expected a folder written by `thermotwin reduce`");
   if (j.value("version", 0) != kVersion)
-    throw core::DataError(json_file.string() + ": version " + j.value("version", nlohmann::json()).dump() +
+    throw core::DataError(json_file.string() + ": version " +
+                          j.value("version", nlohmann::json()).dump() +
                           ", this thermotwin reads version " + std::to_string(kVersion) +
                           "; rebuild it with `thermotwin reduce`");
   f.key.model_hash = from_hex(j, "model_hash", json_file);
@@ -305,7 +313,8 @@ void check_reduced_model_fits(const ReducedModelFile& file, const ReducedModelKe
     throw core::DataError(dir.string() + ": reduced model built from another machine (case '" +
                           file.case_name + "', model hash " + hex(file.key.model_hash) +
                           "): this case differs in geometry, materials, films or sources (model "
-                          "hash " + hex(key.model_hash) + "); rebuild it with `thermotwin reduce`");
+                          "hash " +
+                          hex(key.model_hash) + "); rebuild it with `thermotwin reduce`");
 }
 
 }  // namespace tt::io

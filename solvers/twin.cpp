@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "core/errors.hpp"
-#include "solvers/thermal.hpp"
 #include "solvers/loads.hpp"
+#include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
 
 namespace tt::solvers {
@@ -115,7 +115,8 @@ TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& p
   TwinRun run;
   run.times = h.times;
   run.states = h.states;
-  run.outputs = output_history(twin.outputs, twin.outputs.rows * h.states, twin.model.system.uniform);
+  run.outputs =
+      output_history(twin.outputs, twin.outputs.rows * h.states, twin.model.system.uniform);
   run.timings = h.timings;
   run.heat_in = h.heat_in;
   run.lost = h.lost;
@@ -125,8 +126,9 @@ TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& p
 ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
                               const core::CaseSpec& spec, int samples) {
   if (spec.thermal.scheme != core::TimeScheme::backward_euler)
-    throw core::SolverError("the reduced model's error indicator samples backward-Euler steps; "
-                            "this case uses another scheme: check it with run --rom --verify");
+    throw core::SolverError(
+        "the reduced model's error indicator samples backward-Euler steps; "
+        "this case uses another scheme: check it with run --rom --verify");
   const std::vector<double> grid = time_grid(spec, spec.thermal.step);
   const std::vector<double> outs = output_times(spec);
   const std::vector<double> switches = switch_times(spec);
@@ -209,8 +211,7 @@ TwinComparison compare_outputs(const TwinOutputs& out, const Eigen::MatrixXd& fu
   c.drift_peak_m = df.cwiseAbs().colwise().maxCoeff().transpose();
   c.drift_limit_m = (0.01 * c.drift_peak_m).cwiseMax(0.02e-6);
   for (Eigen::Index k = 0; k < nd; ++k) {
-    const Eigen::Index row = out.tcp && k < 3 ? out.temperatures + k
-                                              : full.cols() - nd + k;
+    const Eigen::Index row = out.tcp && k < 3 ? out.temperatures + k : full.cols() - nd + k;
     c.drift_names.push_back(out.names[static_cast<std::size_t>(row)]);
   }
   return c;
@@ -221,14 +222,16 @@ std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<Ca
                                           const std::vector<int>& sampled_nodes) {
   const TwinOutputs& out = twin.outputs;
   if (!out.tcp)
-    throw core::SolverError("the reduced model has no TCP rows: a campaign needs the thermal error at the "
-                      "tool (mechanical.enabled and mechanical.tcp_point in the case it was built "
-                      "from)");
+    throw core::SolverError(
+        "the reduced model has no TCP rows: a campaign needs the thermal error at the "
+        "tool (mechanical.enabled and mechanical.tcp_point in the case it was built "
+        "from)");
   Eigen::MatrixXd node_rows(static_cast<Eigen::Index>(sampled_nodes.size()), twin.model.states());
   for (std::size_t i = 0; i < sampled_nodes.size(); ++i) {
     if (sampled_nodes[i] < 0 || sampled_nodes[i] >= twin.model.basis.rows())
-      throw core::SolverError("node " + std::to_string(sampled_nodes[i]) + " asked for a history: the " +
-                        "reduced model has " + std::to_string(twin.model.basis.rows()) + " nodes");
+      throw core::SolverError("node " + std::to_string(sampled_nodes[i]) +
+                              " asked for a history: the " + "reduced model has " +
+                              std::to_string(twin.model.basis.rows()) + " nodes");
     node_rows.row(static_cast<Eigen::Index>(i)) = twin.model.basis.row(sampled_nodes[i]);
   }
   double total = 0, done = 0;

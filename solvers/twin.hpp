@@ -61,9 +61,9 @@ Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
 
 /// A run of the twin: the case's duty cycle stepped on the reduced states by the one stepper.
 struct TwinRun {
-  std::vector<double> times;  /// t = 0, then the case's output times [s]
-  Eigen::MatrixXd states;     /// #states x #times
-  Eigen::MatrixXd outputs;    /// #times x #outputs, as output_history gives
+  std::vector<double> times;     /// t = 0, then the case's output times [s]
+  Eigen::MatrixXd states;        /// #states x #times
+  Eigen::MatrixXd outputs;       /// #times x #outputs, as output_history gives
   double heat_in = 0, lost = 0;  /// from the step loads and through the films [J]
   ThermalTimings timings;
 };

@@ -5,42 +5,50 @@
 
 namespace tt::solvers {
 
-VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress,
-                    const Checkpointing& checkpointing) {
+namespace {
+
+/// A run with its full system assembled (and timed), before any time loop.
+VirtualRun assembled_run(const mesh::TetMesh& mesh, const core::CaseSpec& spec) {
   VirtualRun run;
   const auto t0 = std::chrono::steady_clock::now();
   run.operators = thermal_system(mesh, spec);
   run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  run.thermal = thermal_history(mesh, spec, run.operators, progress, checkpointing);
+  return run;
+}
+
+/// Thermo-elasticity on the run's temperatures, and the thermal error at the tool.
+void add_displacements(const mesh::TetMesh& mesh, const core::CaseSpec& spec, VirtualRun& run) {
   run.thermal.timings.assemble_s = run.operators_s;
-  if (spec.mechanical.enabled) {
-    run.elastic = elastic_history(mesh, spec, run.thermal.temperature);
-    if (!spec.mechanical.tcp_point.empty()) run.error = thermal_error(mesh, spec, run.elastic->displacement);
-  }
+  if (!spec.mechanical.enabled) return;
+  run.elastic = elastic_history(mesh, spec, run.thermal.temperature);
+  if (!spec.mechanical.tcp_point.empty())
+    run.error = thermal_error(mesh, spec, run.elastic->displacement);
+}
+
+}  // namespace
+
+VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress,
+                    const Checkpointing& checkpointing) {
+  VirtualRun run = assembled_run(mesh, spec);
+  run.thermal = thermal_history(mesh, spec, run.operators, progress, checkpointing);
+  add_displacements(mesh, spec, run);
   return run;
 }
 
 VirtualRun simulate_reduced(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Twin& twin,
                             const Progress& progress) {
-  VirtualRun run;
-  const auto t0 = std::chrono::steady_clock::now();
-  run.operators = thermal_system(mesh, spec);
-  run.operators_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  VirtualRun run = assembled_run(mesh, spec);
   check_reducible(twin.model, run.operators, spec);
   const TwinRun reduced = twin_run(twin, spec, progress);
   run.thermal.times = reduced.times;
   run.thermal.temperature = reconstructed(twin.model, reduced.states);
   run.thermal.timings = reduced.timings;
-  run.thermal.timings.assemble_s = run.operators_s;
   run.thermal.energy.heat_in = reduced.heat_in;
   run.thermal.energy.lost = reduced.lost;
   run.thermal.energy.stored =
       stored_heat(mesh, spec, run.thermal.temperature.col(run.thermal.temperature.cols() - 1));
   run.thermal.energy.heat_in_law = heat_in_law(spec, run.operators);
-  if (spec.mechanical.enabled) {
-    run.elastic = elastic_history(mesh, spec, run.thermal.temperature);
-    if (!spec.mechanical.tcp_point.empty()) run.error = thermal_error(mesh, spec, run.elastic->displacement);
-  }
+  add_displacements(mesh, spec, run);
   return run;
 }
 

@@ -20,8 +20,8 @@ struct VirtualRun {
 
 /// Thermal transient, then (if enabled) thermo-elastic displacements at every output time.
 /// `checkpointing` saves (and resumes) the thermal time loop's state.
-VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Progress& progress = {},
-                    const Checkpointing& checkpointing = {});
+VirtualRun simulate(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                    const Progress& progress = {}, const Checkpointing& checkpointing = {});
 
 /// The same run with the thermal transient from a twin (reduced order) instead: the states at the
 /// output times reconstructed to nodal temperatures (T = V z), the energy balance on them, then
@@ -34,9 +34,10 @@ VirtualRun simulate_reduced(const mesh::TetMesh& mesh, const core::CaseSpec& spe
 struct ReducedCheck {
   double max_temperature_error_k = 0;  /// over every node and output time [K]
   double max_point_error_k = 0;        /// over the named points [K]
-  Eigen::Vector3d tcp_error_m = Eigen::Vector3d::Zero();  /// largest |dx|, |dy|, |dz| difference [m]
-  Eigen::Vector3d tcp_peak_m = Eigen::Vector3d::Zero();   /// the full run's largest |dx|, |dy|, |dz|
-  double full_s = 0;                   /// wall time of the full recomputation [s]
+  Eigen::Vector3d tcp_error_m =
+      Eigen::Vector3d::Zero();                           /// largest |dx|, |dy|, |dz| difference [m]
+  Eigen::Vector3d tcp_peak_m = Eigen::Vector3d::Zero();  /// the full run's largest |dx|, |dy|, |dz|
+  double full_s = 0;                                     /// wall time of the full recomputation [s]
 };
 
 /// Runs `spec` in full order (thermal, and elastic when the reduced run has it) and compares.

@@ -19,7 +19,9 @@ namespace {
 namespace fs = std::filesystem;
 namespace rt = reliability_test;
 
-nlohmann::json read_json(const fs::path& f) { return nlohmann::json::parse(std::ifstream(f)); }
+nlohmann::json read_json(const fs::path& f) {
+  return nlohmann::json::parse(std::ifstream(f));
+}
 
 /// One reduced model of the coarse SB-1, built once for the cases that read it.
 class Twin : public ::testing::Test {
@@ -79,8 +81,8 @@ TEST_F(Twin, DamagedModelIsRefusedAndNothingIsWritten) {
     f.seekp(200);
     f.put('\x7f');
   }
-  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--rom", bad.string(), "--out",
-                     out.string(), "--quiet"},
+  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--rom", bad.string(), "--out", out.string(),
+                     "--quiet"},
                     {}, log),
             0);
   EXPECT_NE(rt::read_text(log).find("checksum"), std::string::npos) << rt::read_text(log);
@@ -96,10 +98,10 @@ TEST_F(Twin, ModelOfAnotherMachineIsRefused) {
   text.replace(at + key.size(), text.find('\n', at) - at - key.size(), "99.0");
   const fs::path other = dir_ / "other.toml", out = dir_ / "run_other", log = dir_ / "other.log";
   std::ofstream(other) << text;
-  EXPECT_NE(rt::run({"run", other.string(), "--rom", rom_.string(), "--out", out.string(),
-                     "--quiet"},
-                    {}, log),
-            0);
+  EXPECT_NE(
+      rt::run({"run", other.string(), "--rom", rom_.string(), "--out", out.string(), "--quiet"}, {},
+              log),
+      0);
   EXPECT_NE(rt::read_text(log).find("another machine"), std::string::npos) << rt::read_text(log);
   EXPECT_FALSE(fs::exists(out));
 }
