@@ -72,39 +72,6 @@ const char* kStaircase =
     "{ start_s = 3600.0, speed_rpm = 3000.0 }, { start_s = 4500.0, speed_rpm = 0.0 } ]";
 const char* kSwingingSink = "[[0.0, 20.0], [1500.0, 24.0], [3000.0, 18.0], [5400.0, 21.0]]";
 
-// --- The full-order load of a step, for the error indicator's samples ------------------------
-// The stepper forms this load privately; until it offers it, this backward-Euler copy (the same
-// formulas as solvers/thermal_stepper.cpp's load_state, load_vector and moving_heat_load) gives
-// the indicator the full load at a sampled step.
-
-/// Load of the backward-Euler step [t_prev, t] in the full space from the state T_prev [W], and
-/// the step's film coefficients.
-Eigen::VectorXd full_step_load(const solvers::FullThermalSystem& sys, const core::CaseSpec& spec,
-                               double t_prev, double t, const Eigen::VectorXd& t_prev_k,
-                               std::vector<double>* film) {
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
-  const double mid = 0.5 * (t_prev + t);
-  const double speed = solvers::speed_at(spec.duty_cycle, mid);
-  const double feed = solvers::feed_speed_at(spec.feed_axis, mid);
-  Eigen::VectorXd f = solvers::moving_heat_load(spec, sys, t_prev, t);
-  film->clear();
-  for (size_t c = 0; c < spec.thermal.convection.size(); ++c) {
-    const auto& cv = spec.thermal.convection[c];
-    film->push_back(solvers::film_coefficient(cv, speed));
-    f += film->back() * (solvers::table_value(cv.sink, t) + kCelsiusOffset) * sys.film_area[c];
-  }
-  for (size_t i = 0; i < spec.thermal.sources.size(); ++i) {
-    const auto& src = spec.thermal.sources[i];
-    if (src.window > 0) continue;
-    double p = solvers::source_power(src, speed, feed);
-    if (src.temperature_coefficient != 0)
-      p *= 1 + src.temperature_coefficient * (sys.source_shape[i].dot(t_prev_k) - t0_k);
-    f += p * sys.source_shape[i];
-  }
-  return f;
-}
-// ------------------------------------------------------------------------------------------------
-
 struct ReducedRun {
   Eigen::MatrixXd temperature;                /// #nodes x #output times (t = 0 first) [K]
   std::vector<solvers::ReducedStep> samples;  /// the steps that end at an output time
@@ -149,7 +116,9 @@ ReducedRun reduced_run(const solvers::FullThermalSystem& full, const solvers::Re
     s.dt = t - t_prev;
     s.state_old = state_at(t_prev);
     s.state_new = state_at(t);
-    s.load = full_step_load(full, spec, t_prev, t, model.basis * s.state_old, &s.film);
+    solvers::StepLoad load = solvers::step_load(full, spec, t_prev, t, model.basis * s.state_old);
+    s.load = std::move(load.load);
+    s.film = std::move(load.film);
     double last_switch = 0;
     for (double w : switches)
       if (w < t) last_switch = w;
