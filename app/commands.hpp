@@ -21,6 +21,8 @@ struct RunArgs {
   std::filesystem::path dump;     /// tests: temperatures and displacements as raw doubles
   std::filesystem::path rom;      /// a reduced model (reduce --out DIR): thermal transient from it
   bool verify = false;            /// with rom: recompute the output times in full and compare
+  std::filesystem::path duty_cycle;  /// another duty cycle: CSV "time_s,speed_rpm"
+  std::optional<double> end_s;       /// with duty_cycle: the run's end [s] (default: the case's)
 };
 
 struct ProbesArgs {
@@ -62,6 +64,7 @@ struct CalibrateArgs {
   std::filesystem::path case_file, out;
   std::vector<std::filesystem::path> train, test;
   std::optional<double> split_s;  /// a run given as --train and --test: train before, test from
+  bool full = false;              /// with --case: march the full model, not the reduced one
   bool quiet = false;
 };
 

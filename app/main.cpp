@@ -42,6 +42,13 @@ int main(int argc, char** argv) {
                 "with --rom: recompute the output times with the full model and report the "
                 "difference in summary.json");
   // Hidden (empty group): for the reliability tests.
+  run->add_option("--duty-cycle", run_args.duty_cycle,
+                  "another duty cycle for the case: CSV \"time_s,speed_rpm\" (a row per speed "
+                  "change, the first at 0), instead of its [duty_cycle]")
+      ->check(CLI::ExistingFile);
+  run->add_option("--end-s", run_args.end_s,
+                  "with --duty-cycle: the run's end [s] (default: the case's duty_cycle.end_s)")
+      ->check(positive_number());
   run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
   run->add_option("--dump", run_args.dump)->group("");
 
@@ -143,6 +150,9 @@ int main(int argc, char** argv) {
                    "a run in both --train and --test: train before, test from")
       ->check(finite_number());
   calibrate->add_option("--out", calibrate_args.out, "output directory")->required();
+  calibrate->add_flag("--full", calibrate_args.full,
+                      "with --case: march the full-order model (default: a reduced model built on "
+                      "the runs' channels)");
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
 
   CLI11_PARSE(cli, argc, argv);
@@ -172,9 +182,14 @@ int main(int argc, char** argv) {
       if (fit_args.case_file.empty()) throw tt::core::CaseError("fit: give a case file or --data RUN...");
       return fit_command(fit_args);
     }
-    if (*calibrate)
+    if (*calibrate) {
+      if (calibrate_args.case_file.empty() && calibrate_args.full)
+        throw tt::core::CaseError("calibrate: --full chooses the model of calibrate --case; without "
+                               "--case there is no model to reduce. Hint: drop --full or give "
+                               "--case CASE");
       return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
                                               : calibrate_command_with_case(calibrate_args);
+    }
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

@@ -170,7 +170,14 @@ int run_command(const RunArgs& args) {
   const auto t_start = Clock::now();
   // 1. Read and validate the case; claim the output and the checkpoint beside it before any
   //    work, so that a refused or unwritable --out fails at once, not after the solve.
-  const core::CaseSpec spec = io::read_case(args.case_file);
+  if (args.end_s && args.duty_cycle.empty())
+    throw core::CaseError("run: --end-s " + std::to_string(*args.end_s) +
+                          " sets the end of a duty cycle given with --duty-cycle; hint: give "
+                          "--duty-cycle FILE.csv, or change duty_cycle.end_s in the case");
+  const core::CaseSpec spec =
+      args.duty_cycle.empty()
+          ? io::read_case(args.case_file)
+          : io::with_duty_cycle_csv(io::read_case(args.case_file), args.duty_cycle, args.end_s);
   const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
   std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
   inputs.push_back(checkpoint);

@@ -715,28 +715,12 @@ Names point_ids(const CaseSpec& spec) {
   return out;
 }
 
-/// Segments from a CSV "time_s,speed_rpm" with a header; errors point into the CSV.
-std::vector<core::DutyCycle::Segment> csv_segments(const Ctx& c, const toml::node& n,
-                                                   const std::string& path) {
-  std::string rel = as_string(c, n, path);
-  const fs::path file = c.dir / rel;
-  using core::limits::kDutyCycleFileBytes;
-  std::optional<std::string> bytes;
-  try {
-    if (!rel.empty()) bytes = core::limits::file_text_up_to(file, kDutyCycleFileBytes);
-  } catch (const core::IoError&) {
-    rel.clear();
-  }
-  if (rel.empty())
-    fail_value(c, n, path, "cannot read " + file.string(),
-               "paths are relative to the case file's folder");
-  if (!bytes)
-    fail_value(c, n, path,
-               file.string() + " holds more than " + core::limits::bytes_text(kDutyCycleFileBytes) +
-                   ", the limit for a duty-cycle CSV",
-               "a row per speed change is enough");
-  std::istringstream in(*bytes);
-  const std::string where = " (" + path + " of " + c.file + ")";
+/// Segments from the text of a CSV "time_s,speed_rpm" with a header; errors name `file` and the
+/// line, then `where` (what named the file).
+std::vector<core::DutyCycle::Segment> parse_duty_cycle_csv(const std::string& bytes,
+                                                           const fs::path& file,
+                                                           const std::string& where) {
+  std::istringstream in(bytes);
   auto csv_fail = [&](int line, const std::string& msg) -> void {
     throw CaseError(core::located(file.string(), line, msg + where));
   };
@@ -782,6 +766,29 @@ std::vector<core::DutyCycle::Segment> csv_segments(const Ctx& c, const toml::nod
   }
   if (out.empty()) csv_fail(line, "no data rows: expected \"time_s,speed_rpm\" then rows");
   return out;
+}
+
+/// Segments of the CSV that duty_cycle.csv names; errors point into the CSV and at the key.
+std::vector<core::DutyCycle::Segment> csv_segments(const Ctx& c, const toml::node& n,
+                                                   const std::string& path) {
+  std::string rel = as_string(c, n, path);
+  const fs::path file = c.dir / rel;
+  using core::limits::kDutyCycleFileBytes;
+  std::optional<std::string> bytes;
+  try {
+    if (!rel.empty()) bytes = core::limits::file_text_up_to(file, kDutyCycleFileBytes);
+  } catch (const core::IoError&) {
+    rel.clear();
+  }
+  if (rel.empty())
+    fail_value(c, n, path, "cannot read " + file.string(),
+               "paths are relative to the case file's folder");
+  if (!bytes)
+    fail_value(c, n, path,
+               file.string() + " holds more than " + core::limits::bytes_text(kDutyCycleFileBytes) +
+                   ", the limit for a duty-cycle CSV",
+               "a row per speed change is enough");
+  return parse_duty_cycle_csv(*bytes, file, " (" + path + " of " + c.file + ")");
 }
 
 void read_duty_cycle(const Tab& root, CaseSpec& spec) {
@@ -1376,6 +1383,34 @@ CaseSpec read_case(const fs::path& file) {
                     core::limits::bytes_text(kCaseFileBytes) +
                     ", the limit for a case file; is it the case file (a TOML text)?");
   return case_from_toml(*text, file);
+}
+
+CaseSpec with_duty_cycle_csv(const CaseSpec& spec, const fs::path& file,
+                             std::optional<double> end_s) {
+  using core::limits::kDutyCycleFileBytes;
+  const std::optional<std::string> bytes = core::limits::file_text_up_to(file, kDutyCycleFileBytes);
+  if (!bytes)
+    throw CaseError(file.string() + ": holds more than " +
+                    core::limits::bytes_text(kDutyCycleFileBytes) +
+                    ", the limit for a duty-cycle CSV; a row per speed change is enough");
+  CaseSpec out = spec;
+  out.duty_cycle.segments = parse_duty_cycle_csv(*bytes, file, " (--duty-cycle)");
+  out.duty_cycle.csv = fs::absolute(file).lexically_normal();
+  if (end_s) out.duty_cycle.end = *end_s;
+  const double end = out.duty_cycle.end, last = out.duty_cycle.segments.back().start;
+  const std::string end_from = end_s ? "--end-s" : "duty_cycle.end_s of " + spec.source.string();
+  if (!(std::isfinite(end) && end > last))
+    throw CaseError(file.string() + ": the last row starts at " + number_text(last) +
+                    " s, not before the run's end " + number_text(end) + " s (" + end_from +
+                    "); hint: give --end-s beyond the last row");
+  if (end / out.thermal.step > static_cast<double>(core::limits::kTimeSteps) ||
+      end / out.thermal.output_interval > static_cast<double>(core::limits::kOutputTimes))
+    throw CaseError(end_from + " = " + number_text(end) + " s: more than " +
+                    std::to_string(core::limits::kTimeSteps) + " steps of " +
+                    number_text(out.thermal.step) + " s or " +
+                    std::to_string(core::limits::kOutputTimes) + " output times of " +
+                    number_text(out.thermal.output_interval) + " s; hint: a shorter run");
+  return out;
 }
 
 std::vector<fs::path> case_input_files(const CaseSpec& spec) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,13 @@ core::CaseSpec read_case(const std::filesystem::path& file);
 /// The case file and every file it names (surface meshes, a duty-cycle CSV): the inputs an
 /// output folder must stay apart from.
 std::vector<std::filesystem::path> case_input_files(const core::CaseSpec& spec);
+
+/// `spec` with its duty cycle from a CSV "time_s,speed_rpm" (as duty_cycle.csv reads it) and its
+/// end at `end_s` (default: the case's). Throws core::IoError when the file cannot be read and
+/// core::CaseError, naming the file and line, for anything wrong in it, when its last row does
+/// not start before the end, or when the run would exceed the step limits.
+core::CaseSpec with_duty_cycle_csv(const core::CaseSpec& spec, const std::filesystem::path& file,
+                                   std::optional<double> end_s);
 
 /// read_case on text already in memory; `file` names it in messages and anchors relative paths.
 core::CaseSpec case_from_toml(std::string_view text, const std::filesystem::path& file);

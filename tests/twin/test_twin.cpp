@@ -72,6 +72,48 @@ TEST_F(Twin, RunFromTheReducedModelMatchesTheFullRun) {
     EXPECT_TRUE(fs::exists(out / f)) << f;
 }
 
+TEST_F(Twin, AnotherDutyCycleFromTheCommandLine) {
+  // The 6-hour staircase as a CSV: the reduced run follows it to its end, --verify agrees.
+  const fs::path csv = dir_ / "staircase.csv", out = dir_ / "run_staircase",
+                 log = dir_ / "staircase.log";
+  std::ofstream(csv) << "time_s,speed_rpm\n0,1000\n3600,2000\n7200,4000\n10800,6000\n"
+                        "14400,3000\n18000,0\n";
+  ASSERT_EQ(rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--duty-cycle",
+                     csv.string(), "--end-s", "21600", "--verify", "--out", out.string(),
+                     "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const auto s = read_json(out / "summary.json");
+  EXPECT_LE(s["model"]["verify"]["max_point_temperature_error_K"].get<double>(), 0.01);
+  const std::string t = rt::read_text(out / "thermal_error.csv");
+  EXPECT_NE(t.find("\n21600"), std::string::npos) << "the run ends at --end-s";
+  EXPECT_NE(rt::read_text(out / "case.resolved.toml").find("6000"), std::string::npos);
+
+  // A bad row is refused naming the file and the line; nothing is written.
+  const fs::path bad = dir_ / "bad.csv", out2 = dir_ / "run_bad", log2 = dir_ / "bad.log";
+  std::ofstream(bad) << "time_s,speed_rpm\n0,1000\n3600,fast\n";
+  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--duty-cycle",
+                     bad.string(), "--out", out2.string(), "--quiet"},
+                    {}, log2),
+            0);
+  const std::string msg = rt::read_text(log2);
+  EXPECT_NE(msg.find(bad.string() + ":3"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("speed_rpm"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out2));
+  // --end-s without a duty cycle, or before the last row, is refused.
+  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--end-s", "100", "--out", out2.string(),
+                     "--quiet"},
+                    {}, log2),
+            0);
+  EXPECT_NE(rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--duty-cycle",
+                     csv.string(), "--end-s", "18000", "--out", out2.string(), "--quiet"},
+                    {}, log2),
+            0);
+  EXPECT_NE(rt::read_text(log2).find("--end-s"), std::string::npos) << rt::read_text(log2);
+  EXPECT_FALSE(fs::exists(out2));
+}
+
 TEST_F(Twin, DamagedModelIsRefusedAndNothingIsWritten) {
   const fs::path bad = dir_ / "rom_damaged", out = dir_ / "run_damaged", log = dir_ / "damaged.log";
   fs::remove_all(bad);
