@@ -6,6 +6,7 @@
 // inputs), DIR/augmented/<run>.toml per test run, DIR/sensor_corrections.json, DIR/residuals.csv
 // and the figures residual_before_after.png and effect.png.
 #include <cctype>
+#include <cmath>
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -20,11 +21,16 @@
 #include "io/measured_data.hpp"
 #include "io/reports.hpp"
 #include "mesh/mesher.hpp"
+#include "solvers/twin.hpp"
 
 namespace tt::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 std::string file_name(const std::string& run) {
   std::string s;
@@ -91,21 +97,63 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   std::vector<io::MeasuredRun> train, test;
   for (const auto& f : args.train) train.push_back(io::read_measured_run(f));
   for (const auto& f : args.test) test.push_back(io::read_measured_run(f));
+  const auto say = [&](const std::string& what) {
+    if (!args.quiet)
+      std::cerr << "thermotwin: calibrate: [" << std::lround(seconds_since(t0)) << " s] " << what
+                << "\n";
+  };
   // 2. The mesh, the channels' readout, the candidates' responses on the training runs.
+  say("meshing " + declared.name);
   const mesh::TetMesh mesh = mesh::mesh_case(declared);
   calibration::CalibrationOptions options;
   options.seed = declared.seed;
+  say(std::to_string(mesh.nodes.rows()) + " nodes; locating the channels (probes: elastic "
+      "influence rows)");
   const calibration::Readout r = calibration::readout(mesh, declared, train.front());
-  if (!args.quiet)
-    std::cerr << "thermotwin: calibrate: " << r.channels() << " channels, responses on "
-              << train.size() << " training runs\n";
-  const calibration::Catalogue cat = calibration::catalogue(mesh, declared, r, train, options);
-  if (!args.quiet)
-    std::cerr << "thermotwin: calibrate: " << cat.candidates.size()
-              << " candidate effects; choosing\n";
+  // The model the candidates' responses are marched on: reduced (its basis holds the channels'
+  // Krylov vectors, so that every candidate's response at the channels is kept) unless --full.
+  const auto tm = Clock::now();
+  say(args.full ? "model: full order (" + std::to_string(mesh.nodes.rows()) +
+                      " nodes), as --full asks"
+                : "model: building the reduced model on the channels (--full for the full order)");
+  const calibration::MarchModel model =
+      args.full ? calibration::MarchModel(mesh, declared)
+                : calibration::MarchModel(mesh, declared, r, solvers::ReductionOptions{});
+  nlohmann::json model_json = {{"kind", args.full ? "full" : "reduced"},
+                               {"nodes", mesh.nodes.rows()},
+                               {"order", model.order()},
+                               {"build_s", seconds_since(tm)}};
+  if (model.is_reduced()) {
+    say("model: reduced, order " + std::to_string(model.order()) + " of " +
+        std::to_string(mesh.nodes.rows()) + " nodes");
+    // Trust: the full-order residual of the declared model's base state on the first training
+    // run, at a few output steps (backward Euler only).
+    const core::CaseSpec first = calibration::case_for_run(declared, train.front());
+    if (first.thermal.scheme == core::TimeScheme::backward_euler) {
+      solvers::Twin twin;
+      twin.model = *model.reduced();
+      const auto ind = solvers::twin_indicator(model.full(), twin, first, 3);
+      model_json["indicator"] = {{"run", train.front().run},
+                                 {"max_K", ind.max_k},
+                                 {"tolerance_K", ind.tolerance_k},
+                                 {"above_tolerance", ind.above_tolerance()}};
+      if (ind.above_tolerance())
+        std::cerr << "thermotwin: warning: the reduced model's error indicator is " << ind.max_k
+                  << " K on run '" << train.front().run << "', above its tolerance of "
+                  << ind.tolerance_k << " K: check with --full\n";
+    }
+  }
+  say(std::to_string(r.channels()) + " channels, responses on " + std::to_string(train.size()) +
+      " training runs");
+  const solvers::Progress progress = [&](double t, double end) {
+    if (!args.quiet) report_progress("calibrate responses", t, end);
+  };
+  const calibration::Catalogue cat =
+      calibration::catalogue(model, declared, r, train, options, false, progress);
+  say(std::to_string(cat.candidates.size()) + " candidate effects; choosing, then the test runs");
   // 3. Choose the effect, write it into the case, evaluate on the test runs.
   const calibration::CalibrationResult res =
-      calibration::calibrate(mesh, declared, cat, test, options);
+      calibration::calibrate(model, declared, cat, test, options);
   // 4. Outputs, all or nothing.
   const auto& dir = out.path();
   std::vector<std::string> train_names;
@@ -128,6 +176,7 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   j["augmented_cases"] = files;
   j["sensor_corrections"] = corrections;
   j["runtime_s"] = std::chrono::duration<double>(Clock::now() - t0).count();
+  j["model"] = model_json;
   io::write_json(dir / "sensor_corrections.json", corrections);
   io::write_json(dir / "calibration.json", j);
 
@@ -159,6 +208,11 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   for (const auto& n : train_names) md << "`" << n << "` ";
   md << "\n\nTest runs: ";
   for (const auto& t : res.tests) md << "`" << t.name << "` ";
+  md << "\n\nModel marched: "
+     << (model.is_reduced() ? "reduced, order " + std::to_string(model.order()) + " of " +
+                                  std::to_string(mesh.nodes.rows()) + " nodes"
+                            : "full order, " + std::to_string(mesh.nodes.rows()) + " nodes")
+     << " (`model` in calibration.json).";
   md << "\n\n| | temperature RMS [K] | displacement RMS [um] |\n| --- | --- | --- |\n";
   md << "| before | " << res.before.temperature_rms_K << " | " << res.before.displacement_rms_um
      << " |\n";

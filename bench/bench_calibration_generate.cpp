@@ -1,5 +1,6 @@
 // Writes measured-data sets with one undeclared effect, for `thermotwin calibrate`.
 // Usage: bench_calibration_generate CASE KIND OUT_DIR [RUNS=3] [HOURS=2] [SEED=1]
+//   HOURS: one length for every run, or one per run separated by commas (e.g. 2,6,8)
 //   KIND: none | ambient_temperature | heat_input | speed_dependent_convection |
 //         temperature_dependent_heat | boundary_conductance | material_parameter | sensor_offset |
 //         sensor_lag
@@ -8,6 +9,8 @@
 // cycles; 4. simulate each run with the effect on, add sensor noise, write it.
 #include <fstream>
 #include <iostream>
+#include <sstream>
+#include <vector>
 #include <string>
 
 #include "calibration/generator.hpp"
@@ -26,7 +29,16 @@ int main(int argc, char** argv) {
     const std::string kind_text = argv[2];
     const std::filesystem::path out = argv[3];
     const int runs = argc > 4 ? std::stoi(argv[4]) : 3;
-    const double hours = argc > 5 ? std::stod(argv[5]) : 2.0;
+    std::vector<double> hours;
+    if (argc > 5) {
+      std::stringstream list(argv[5]);
+      for (std::string item; std::getline(list, item, ',');) hours.push_back(std::stod(item));
+    }
+    if (hours.empty()) hours.push_back(2.0);
+    if (hours.size() != 1 && static_cast<int>(hours.size()) != runs) {
+      std::cerr << "HOURS: " << hours.size() << " lengths for " << runs << " runs\n";
+      return 2;
+    }
     const std::uint64_t seed = argc > 6 ? std::stoull(argv[6]) : 1;
     const core::CaseSpec declared = io::read_case(argv[1]);
     const calibration::GeneratorOptions options;
@@ -47,7 +59,8 @@ int main(int argc, char** argv) {
     }
     std::filesystem::create_directories(out);
     for (int k = 0; k < runs; ++k) {
-      const core::DutyCycle duty = calibration::random_duty_cycle(hours, rng);
+      const double h = hours[hours.size() == 1 ? 0 : static_cast<size_t>(k)];
+      const core::DutyCycle duty = calibration::random_duty_cycle(h, rng);
       const core::CaseSpec truth = calibration::truth_case(gen, effect, duty, k);
       const io::MeasuredRun run = calibration::synthetic_run(m, truth, effect, inst, options,
                                                              "run " + std::to_string(k), rng);

@@ -13,6 +13,12 @@ namespace tt::calibration {
 
 namespace {
 
+/// Whether two meshes have the same nodes and tets (a case meshed again with other groups).
+bool same_tets(const mesh::TetMesh& a, const mesh::TetMesh& b) {
+  return a.nodes.rows() == b.nodes.rows() && a.tets.rows() == b.tets.rows() &&
+         a.tets.cols() == b.tets.cols() && a.tets == b.tets && a.nodes == b.nodes;
+}
+
 int group_index(const core::CaseSpec& spec, const std::string& name) {
   for (size_t g = 0; g < spec.groups.size(); ++g)
     if (spec.groups[g].name == name) return static_cast<int>(g);
@@ -221,10 +227,11 @@ RmsFigures rms_figures(const std::vector<Eigen::MatrixXd>& measured,
   return {nt > 0 ? std::sqrt(st / nt) : 0.0, nu > 0 ? 1e6 * std::sqrt(su / nu) : 0.0};
 }
 
-CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& declared,
                             const Catalogue& train, const std::vector<io::MeasuredRun>& test,
                             const CalibrationOptions& o) {
   CalibrationResult res;
+  const mesh::TetMesh& mesh = model.mesh();
   res.selection = select_effects(train, o);
   // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
   // grids around the best ones, and the choice made again with those candidates, so that the
@@ -233,7 +240,7 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
   if (!res.selection.claimed.empty()) {
     const Candidate& first = train.candidates[res.selection.claimed.front().candidate];
     if (first.kind == EffectKind::heat_input && o.heat_refine_levels > 0)
-      refined = with_refined_heat_inputs(mesh, train, o);
+      refined = with_refined_heat_inputs(model, train, o);
     else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
       refined = with_refined_lag(train, first.sensor, first.time_constant, o);
     if (refined) res.selection = select_effects(*refined, o);
@@ -245,7 +252,7 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
   bool per_run = false;
   for (const auto& f : res.selection.claimed) per_run |= cat.candidates[f.candidate].per_run;
   Catalogue test_cat;
-  if (per_run && !test.empty()) test_cat = catalogue(mesh, declared, r, test, o, true);
+  if (per_run && !test.empty()) test_cat = catalogue(model, declared, r, test, o, true);
 
   std::vector<Eigen::MatrixXd> meas, before, after;
   for (size_t ti = 0; ti < test.size(); ++ti) {
@@ -253,14 +260,14 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
     TestRun tr;
     tr.name = run.run;
     tr.times = run.time;
-    const Readout rt = readout(mesh, declared, run);
+    const Readout rt = readout_like(mesh, declared, run, r);
     if (rt.ids != r.ids)
       throw core::DataError("test run '" + run.run +
                             "' has other located channels than the training runs; " +
                             "every run must list the same sensors and probes");
     tr.measured = measured_channels(run, rt);
     const core::CaseSpec spec = case_for_run(declared, run);
-    tr.before = simulated_channels(mesh, spec, rt, run.time);
+    tr.before = march(model, spec, rt, run.time, {}, {}).base;
     AugmentedCase aug{spec, {}};
     for (const auto& f : res.selection.claimed) {
       const Candidate& c = cat.candidates[f.candidate];
@@ -281,9 +288,22 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
     if (res.selection.claimed.empty()) {
       tr.after = tr.before;
     } else {
+      // The augmented case's own mesh: its new boundary groups take faces of the same tets.
       const mesh::TetMesh m2 = mesh::mesh_case(again);
-      const Readout r2 = readout(m2, again, run);
-      tr.after = corrected(simulated_channels(m2, again, r2, run.time), run.time, r2, aug.sensors);
+      if (model.is_reduced() && same_tets(m2, mesh)) {
+        // The same basis: the augmented operators projected; the channels' rows kept (the sensor
+        // weights depend on the tets only), the probes' with any change of expansion (exact:
+        // the stiffness and the supports are the declared case's).
+        Readout r2 = rt;
+        r2.displacement = displacement_with_expansions(rt, declared, again);
+        const MarchModel augmented = model.with_case(m2, again);
+        tr.after = corrected(march(augmented, again, r2, run.time, {}, {}).base, run.time, r2,
+                             aug.sensors);
+      } else {
+        const Readout r2 = readout(m2, again, run);
+        tr.after = corrected(march(MarchModel(m2, again), again, r2, run.time, {}, {}).base,
+                             run.time, r2, aug.sensors);
+      }
     }
     tr.augmented = aug;
     meas.push_back(tr.measured);

@@ -64,9 +64,11 @@ struct CalibrationResult {
 };
 
 /// Selects effects on `train` (a catalogue built from the training runs) and evaluates the
-/// augmented model on `test` runs through the project's pipeline (mesh_case of the augmented case,
-/// thermal_history, elastic influence vectors), exactly as the written case file reads back.
-CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+/// declared and the augmented model on `test` runs as the written case file reads back (the
+/// augmented case meshed again). On a reduced `model` the augmented case's operators are
+/// projected on the same basis when its mesh has the same tets; otherwise, and in full order,
+/// its full system is marched.
+CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& declared,
                             const Catalogue& train, const std::vector<io::MeasuredRun>& test,
                             const CalibrationOptions& options);
 

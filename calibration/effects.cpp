@@ -19,18 +19,6 @@ namespace {
 
 constexpr double kCelsius = 273.15;
 
-double sink_k(const core::Convection& c, double t) {
-  return solvers::table_value(c.sink, t) + kCelsius;
-}
-
-/// A load column's weighted load over a step from its load at one end, `at(base state, time)`:
-/// the end's for backward Euler, theta-weighted over both ends for Crank–Nicolson.
-template <class AtEnd>
-Eigen::VectorXd at_step_ends(const solvers::StepView& step, const AtEnd& at) {
-  if (step.theta == 1) return at(*step.state1, step.t1);
-  return step.theta * at(*step.state1, step.t1) + (1 - step.theta) * at(*step.state0, step.t0);
-}
-
 /// Whitened residual rows of one run: vec(#samples x #channels) / sigma, with the mask of rows.
 struct Whitened {
   Eigen::VectorXd y;               /// kept rows
@@ -300,13 +288,14 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
   return sigma;
 }
 
-Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, const Readout& r,
+Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
                     const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
-                    bool ambient_only) {
+                    bool ambient_only, const solvers::Progress& progress) {
   Catalogue cat;
   cat.readout = r;
+  const mesh::TetMesh& m = model.mesh();
   const auto& conv = declared.thermal.convection;
-  const solvers::FullThermalSystem ops = solvers::thermal_system(m, declared);
+  const solvers::FullThermalSystem& ops = model.full();
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
   if (ref_speed <= 0) {
@@ -366,16 +355,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
       LoadColumn lc;
       lc.name = c.name + " knot " + std::to_string(k);
-      lc.rhs = [&ops, &conv, entries, tk, dk](const solvers::StepView& step) {
-        return at_step_ends(step, [&](const Eigen::VectorXd&, double t) {
-          const double hat = std::max(0.0, 1 - std::abs(t - tk) / dk);
-          Eigen::VectorXd f = Eigen::VectorXd::Zero(ops.conduction.rows());
-          if (hat == 0) return f;
-          for (int e : entries)
-            f += (hat * solvers::film_coefficient(conv[e], step.speed)) * ops.film_area[e];
-          return f;
-        });
-      };
+      lc.form = SinkHat{entries, tk, dk};
       loads.push_back(std::move(lc));
     }
     cands.push_back(std::move(c));
@@ -407,15 +387,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
                                   : "delta_h_W_m2K"};
         LoadColumn lc;
         lc.name = c.name;
-        lc.rhs = [&ops, &conv, e, speed_law, ref_speed](const solvers::StepView& step) {
-          const double speed = step.speed;
-          const double scale = speed_law ? (speed > 0 ? speed / ref_speed : 0.0) : 1.0;
-          if (scale == 0) return Eigen::VectorXd::Zero(step.state1->size()).eval();
-          return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {
-            return Eigen::VectorXd(-scale *
-                                   (ops.film[e] * temp - sink_k(conv[e], t) * ops.film_area[e]));
-          });
-        };
+        lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
         sources.push_back({Source::load, {static_cast<int>(loads.size())}});
         loads.push_back(std::move(lc));
         cands.push_back(std::move(c));
@@ -433,14 +405,7 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
       c.parameters = {"temperature_coefficient_per_K"};
       LoadColumn lc;
       lc.name = c.name;
-      lc.rhs = [&ops, &declared, i, t0_k](const solvers::StepView& step) {
-        // The source's heat over the step as the stepper forms it (feed at the step's middle).
-        const double feed = solvers::feed_speed_at(declared.feed_axis, 0.5 * (step.t0 + step.t1));
-        const double q = solvers::source_power(declared.thermal.sources[i], step.speed, feed);
-        return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
-          return Eigen::VectorXd(q * (ops.source_shape[i].dot(temp) - t0_k) * ops.source_shape[i]);
-        });
-      };
+      lc.form = SourceGrowth{static_cast<int>(i), t0_k};
       sources.push_back({Source::load, {static_cast<int>(loads.size())}});
       loads.push_back(std::move(lc));
       cands.push_back(std::move(c));
@@ -467,25 +432,20 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
         c.location = {{"material", mname}, {"field", field}};
         c.parameters = {"relative_change"};
         if (field == "expansion") {
-          core::CaseSpec a2 = declared;
-          a2.materials[mi].expansion *= 2;
-          io::MeasuredRun probe_run = runs.front();
-          extra.push_back(displacement_readout(m, a2, probe_run, r) - r.displacement);
+          // The probes' rows gain the material's part per unit relative change.
+          extra.push_back(r.expansion.at(mi));
           sources.push_back({Source::extra_readout, {static_cast<int>(extra.size()) - 1}});
         } else {
+          // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
+          OperatorChange change;
+          change.which = field == "conductivity" ? OperatorChange::Operator::conduction
+                                                 : OperatorChange::Operator::capacity;
+          change.full = field == "conductivity" ? km : cm;
+          if (model.is_reduced())
+            change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
           LoadColumn lc;
           lc.name = c.name;
-          if (field == "conductivity")
-            lc.rhs = [km](const solvers::StepView& step) {
-              return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
-                return Eigen::VectorXd(-(*km * temp));
-              });
-            };
-          else
-            // C' (T1 - T0) / dt under either scheme.
-            lc.rhs = [cm](const solvers::StepView& step) {
-              return Eigen::VectorXd(-(*cm * (*step.state1 - *step.state0)) / step.dt());
-            };
+          lc.form = std::move(change);
           sources.push_back({Source::load, {static_cast<int>(loads.size())}});
           loads.push_back(std::move(lc));
         }
@@ -496,13 +456,17 @@ Catalogue catalogue(const mesh::TetMesh& m, const core::CaseSpec& declared, cons
 
   // 2. One march per run with every column; sensors' own effects from the base histories.
   std::vector<Responses> resp;
+  double simulated = 0, total = 0;
+  for (const auto& run : runs) total += run.time(run.time.size() - 1);
   for (const auto& run : runs) {
     RunModel rm;
     rm.name = run.run;
     rm.spec = case_for_run(declared, run);
     rm.times = run.time;
     rm.measured = measured_channels(run, r);
-    Responses rs = march(m, rm.spec, r, run.time, sep, loads, extra);
+    Responses rs = march(model, rm.spec, r, run.time, sep, loads, extra);
+    simulated += run.time(run.time.size() - 1);
+    if (progress) progress(simulated, total);
     rm.base = rs.base;
     cat.runs.push_back(std::move(rm));
     resp.push_back(std::move(rs));
@@ -651,11 +615,12 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
 
 }  // namespace
 
-Catalogue with_refined_heat_inputs(const mesh::TetMesh& m, const Catalogue& cat,
+Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat,
                                    const CalibrationOptions& o) {
   Catalogue out = cat;
   if (out.runs.empty()) return out;
   const core::CaseSpec& spec = out.runs.front().spec;
+  const mesh::TetMesh& m = model.mesh();
   const Eigen::VectorXd sigma = noise_sigma(out.runs, out.readout.sensors, o);
   std::vector<Whitened> ws;
   std::vector<Eigen::VectorXd> ys;
@@ -708,7 +673,7 @@ Catalogue with_refined_heat_inputs(const mesh::TetMesh& m, const Catalogue& cat,
     if (added.empty()) break;
     // One march per run with the new patches as columns, as in the catalogue.
     for (const auto& rm : out.runs) {
-      const Responses rs = march(m, rm.spec, out.readout, rm.times, sep, {});
+      const Responses rs = march(model, rm.spec, out.readout, rm.times, sep, {});
       for (size_t k = 0; k < added.size(); ++k)
         added[k].columns.push_back(
             Eigen::Map<const Eigen::VectorXd>(rs.columns[k].data(), rs.columns[k].size()));

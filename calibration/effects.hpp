@@ -102,15 +102,17 @@ std::vector<Patch> surface_patches(const mesh::TetMesh& mesh, double spacing, do
 Eigen::VectorXd face_load(const mesh::TetMesh& mesh, const std::vector<int>& faces);
 
 /// Builds the catalogue: `runs` carry the measured channels (order of `r`). `ambient_only`
-/// restricts the candidates to the air temperature (for runs held for testing).
-Catalogue catalogue(const mesh::TetMesh& mesh, const core::CaseSpec& declared, const Readout& r,
+/// restricts the candidates to the air temperature (for runs held for testing). The responses
+/// come from marches of `model` (full or reduced order); `progress` gets the simulated time over
+/// the runs' total.
+Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
                     const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& options,
-                    bool ambient_only = false);
+                    bool ambient_only = false, const solvers::Progress& progress = {});
 
 /// `cat` with heat-input candidates added on finer grids around its best heat-input places (scored
 /// on the training residual as select_effects scores them), marched like the catalogue's own: the
 /// grid's spacing bounds how well a place can be found, and a finer grid everywhere costs too much.
-Catalogue with_refined_heat_inputs(const mesh::TetMesh& mesh, const Catalogue& cat,
+Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat,
                                    const CalibrationOptions& options);
 
 /// `cat` with lag candidates of `sensor` at `lag_refine_steps` time constants spaced

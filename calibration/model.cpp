@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <type_traits>
+#include <variant>
 
 #include "core/errors.hpp"
 #include "solvers/elastic.hpp"
@@ -94,7 +96,11 @@ std::vector<std::pair<int, double>> point_weights(const mesh::TetMesh& m,
   return w;
 }
 
-Readout readout(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::MeasuredRun& run) {
+namespace {
+
+/// The located channels of `run`: sensors with their weights, probes with their geometry; no
+/// displacement rows yet.
+Readout located(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::MeasuredRun& run) {
   Readout r;
   const Eigen::Index n = m.nodes.rows();
   std::vector<Eigen::Triplet<double>> trip;
@@ -118,8 +124,9 @@ Readout readout(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
     for (int p : probes) {
       r.ids.push_back(run.displacements[p].id);
       r.run_column.push_back(p);
+      r.probe_point.push_back(*run.displacements[p].point);
+      r.probe_direction.push_back(run.displacements[p].direction->normalized());
     }
-    r.displacement = displacement_readout(m, spec, run, r);
   }
   if (r.ids.empty())
     throw core::DataError("measured run '" + run.run + "' (" + run.folder.string() +
@@ -128,25 +135,56 @@ Readout readout(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
   return r;
 }
 
-Eigen::MatrixXd displacement_readout(const mesh::TetMesh& m, const core::CaseSpec& spec,
-                                     const io::MeasuredRun& run, const Readout& like) {
-  const int probes = like.channels() - like.sensors;
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(probes, m.nodes.rows());
-  if (probes == 0) return d;
+/// The probes' influence rows (r.displacement) and their parts per material (r.expansion): one
+/// elastic factor, one block solve for all probes.
+void add_displacement_rows(const mesh::TetMesh& m, const core::CaseSpec& spec, Readout& r) {
+  if (r.probe_point.empty()) return;
+  std::vector<Eigen::Triplet<double>> trip;
+  for (size_t k = 0; k < r.probe_point.size(); ++k)
+    for (const auto& [node, w] : point_weights(m, r.probe_point[k]))
+      for (int a = 0; a < 3; ++a)
+        if (w != 0 && r.probe_direction[k](a) != 0)
+          trip.emplace_back(static_cast<int>(k), 3 * node + a, w * r.probe_direction[k](a));
+  Eigen::SparseMatrix<double> f(static_cast<Eigen::Index>(r.probe_point.size()),
+                                3 * m.nodes.rows());
+  f.setFromTriplets(trip.begin(), trip.end());
   const solvers::ElasticModel model(m, spec);
-  std::map<std::pair<int, int>, Eigen::VectorXd> cache;  // (node, direction) -> influence
-  for (int k = 0; k < probes; ++k) {
-    const auto& probe = run.displacements[like.run_column[like.sensors + k]];
-    Eigen::Vector3d dir = *probe.direction;
-    dir.normalize();
-    for (const auto& [node, w] : point_weights(m, *probe.point))
-      for (int a = 0; a < 3; ++a) {
-        if (dir(a) == 0 || w == 0) continue;
-        auto it = cache.find({node, a});
-        if (it == cache.end())
-          it = cache.emplace(std::make_pair(node, a), model.influence(node, a)).first;
-        d.row(k) += (w * dir(a)) * it->second.transpose();
-      }
+  r.expansion = model.influence_rows_by_material(f, m, spec);
+  r.displacement = Eigen::MatrixXd::Zero(f.rows(), m.nodes.rows());
+  for (const auto& part : r.expansion) r.displacement += part;
+}
+
+}  // namespace
+
+Readout readout(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::MeasuredRun& run) {
+  Readout r = located(m, spec, run);
+  add_displacement_rows(m, spec, r);
+  return r;
+}
+
+Readout readout_like(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                     const io::MeasuredRun& run, const Readout& like) {
+  Readout r = located(m, spec, run);
+  if (r.probe_point.empty()) return r;
+  const bool same = r.probe_point == like.probe_point &&
+                    r.probe_direction == like.probe_direction &&
+                    like.displacement.rows() == static_cast<Eigen::Index>(r.probe_point.size()) &&
+                    like.displacement.cols() == m.nodes.rows();
+  if (same) {
+    r.displacement = like.displacement;
+    r.expansion = like.expansion;
+  } else {
+    add_displacement_rows(m, spec, r);
+  }
+  return r;
+}
+
+Eigen::MatrixXd displacement_with_expansions(const Readout& like, const core::CaseSpec& declared,
+                                             const core::CaseSpec& spec) {
+  Eigen::MatrixXd d = like.displacement;
+  for (size_t k = 0; k < like.expansion.size() && k < spec.materials.size(); ++k) {
+    const double a0 = declared.materials[k].expansion, a1 = spec.materials[k].expansion;
+    if (a1 != a0) d += ((a1 - a0) / a0) * like.expansion[k];
   }
   return d;
 }
@@ -193,46 +231,217 @@ Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r) 
   return y;
 }
 
-Responses march(const mesh::TetMesh& m, const core::CaseSpec& spec, const Readout& r,
-                const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
-                const std::vector<LoadColumn>& loads,
-                const std::vector<Eigen::MatrixXd>& extra_displacement) {
-  const solvers::FullThermalSystem sys = solvers::thermal_system(m, spec);
+MarchModel::MarchModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec)
+    : mesh_(&mesh),
+      full_(std::make_shared<const solvers::FullThermalSystem>(solvers::thermal_system(mesh, spec))) {
+}
+
+MarchModel::MarchModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Readout& r,
+                       solvers::ReductionOptions options)
+    : MarchModel(mesh, spec) {
+  const Eigen::Index n = mesh.nodes.rows();
+  Eigen::MatrixXd rows(r.temperature.rows() + r.displacement.rows(), n);
+  rows.topRows(r.temperature.rows()) = Eigen::MatrixXd(r.temperature);
+  rows.bottomRows(r.displacement.rows()) = r.displacement;
+  options.output_columns = rows.transpose();
+  reduced_ =
+      std::make_shared<const solvers::ReducedModel>(solvers::reduced_model(*full_, spec, options));
+  system_ = std::shared_ptr<const solvers::ReducedThermalSystem>(reduced_, &reduced_->system);
+}
+
+MarchModel MarchModel::with_case(const mesh::TetMesh& mesh, const core::CaseSpec& other) const {
+  if (mesh.nodes.rows() != mesh_->nodes.rows())
+    throw core::SolverError("calibration: a case meshed with " + std::to_string(mesh.nodes.rows()) +
+                            " nodes cannot use a model of " +
+                            std::to_string(mesh_->nodes.rows()) + " nodes");
+  MarchModel m(mesh, other);
+  if (reduced_) {
+    m.reduced_ = reduced_;
+    m.system_ = std::make_shared<const solvers::ReducedThermalSystem>(
+        solvers::projected_system(*m.full_, reduced_->basis));
+  }
+  return m;
+}
+
+Eigen::MatrixXd MarchModel::projected(const Eigen::SparseMatrix<double>& a) const {
+  if (!reduced_) throw core::SolverError("calibration: projected operator of a full-order model");
+  const Eigen::MatrixXd av = a * reduced_->basis;
+  const Eigen::MatrixXd p = reduced_->basis.transpose() * av;
+  return 0.5 * (p + p.transpose());
+}
+
+int MarchModel::order() const {
+  return reduced_ ? reduced_->states() : static_cast<int>(full_->states());
+}
+
+namespace {
+
+/// A load's weighted load over a step from its load at one end, `at(base state, time)`: the
+/// end's for backward Euler, theta-weighted over both ends for Crank–Nicolson.
+template <class AtEnd>
+Eigen::VectorXd at_step_ends(const solvers::StepView& step, const AtEnd& at) {
+  if (step.theta == 1) return at(*step.state1, step.t1);
+  return step.theta * at(*step.state1, step.t1) + (1 - step.theta) * at(*step.state0, step.t0);
+}
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+/// The step load of `form` on `ops` (the full system, or the reduced one with the same entries).
+/// `spec` gives the films' laws and sinks and the sources' powers; its lifetime must cover the
+/// march.
+template <class Matrix>
+solvers::LoadCallback load_callback(const solvers::LinearThermalSystem<Matrix>& ops,
+                                    const core::CaseSpec& spec, const LoadForm& form) {
+  constexpr bool reduced = std::is_same_v<Matrix, Eigen::MatrixXd>;
+  const auto& conv = spec.thermal.convection;
+  return std::visit(
+      Overloaded{
+          [&](const SinkHat& f) -> solvers::LoadCallback {
+            return [&ops, &conv, f](const solvers::StepView& step) {
+              return at_step_ends(step, [&](const Eigen::VectorXd&, double t) {
+                const double hat = std::max(0.0, 1 - std::abs(t - f.knot_s) / f.width_s);
+                Eigen::VectorXd b = Eigen::VectorXd::Zero(ops.states());
+                if (hat == 0) return b;
+                for (int e : f.entries)
+                  b += (hat * solvers::film_coefficient(conv[e], step.speed)) * ops.film_area[e];
+                return b;
+              });
+            };
+          },
+          [&](const FilmChange& f) -> solvers::LoadCallback {
+            return [&ops, &conv, f](const solvers::StepView& step) {
+              const double scale =
+                  f.follows_speed ? (step.speed > 0 ? step.speed / f.ref_speed_rpm : 0.0) : 1.0;
+              if (scale == 0) return Eigen::VectorXd::Zero(ops.states()).eval();
+              const auto& c = conv[f.entry];
+              return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {
+                const double sink = solvers::table_value(c.sink, t) + solvers::kCelsiusOffset;
+                return Eigen::VectorXd(-scale *
+                                       (ops.film[f.entry] * temp - sink * ops.film_area[f.entry]));
+              });
+            };
+          },
+          [&](const SourceGrowth& f) -> solvers::LoadCallback {
+            return [&ops, &spec, f](const solvers::StepView& step) {
+              // The source's heat over the step as the stepper forms it (feed at the middle).
+              const double feed = solvers::feed_speed_at(spec.feed_axis, 0.5 * (step.t0 + step.t1));
+              const auto& src = spec.thermal.sources[static_cast<size_t>(f.source)];
+              const double q = solvers::source_power(src, step.speed, feed);
+              const Eigen::VectorXd& shape = ops.source_shape[static_cast<size_t>(f.source)];
+              return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
+                return Eigen::VectorXd(q * (shape.dot(temp) - f.reference_k) * shape);
+              });
+            };
+          },
+          [&](const OperatorChange& f) -> solvers::LoadCallback {
+            std::shared_ptr<const Matrix> a;
+            if constexpr (reduced) a = f.reduced;
+            else a = f.full;
+            if (!a)
+              throw core::SolverError("calibration: an operator change without its " +
+                                      std::string(reduced ? "projected" : "full") + " operator");
+            if (f.which == OperatorChange::Operator::conduction)
+              return [a](const solvers::StepView& step) {
+                return at_step_ends(step, [&](const Eigen::VectorXd& temp, double) {
+                  return Eigen::VectorXd(-(*a * temp));
+                });
+              };
+            // dC (T1 - T0) / dt under either scheme.
+            return [a](const solvers::StepView& step) {
+              return Eigen::VectorXd(-(*a * (*step.state1 - *step.state0)) / step.dt());
+            };
+          },
+          [&](const solvers::LoadCallback& f) -> solvers::LoadCallback {
+            if (reduced)
+              throw core::SolverError(
+                  "calibration: a load given as a callback on the full system cannot be marched "
+                  "on the reduced model; use the full order");
+            return f;
+          }},
+      form);
+}
+
+/// The march on one system: `read` the channels' rows on its states (the base reads them and
+/// `extra` after), `shapes` the separable columns' shapes on its states.
+template <class Matrix>
+Responses march_on(const solvers::LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec,
+                   const solvers::StateReadout& read, Eigen::Index channels,
+                   const std::vector<Eigen::MatrixXd>& extra, const Eigen::VectorXd& times,
+                   const std::vector<SeparableColumn>& separable,
+                   const std::vector<Eigen::VectorXd>& shapes, const std::vector<LoadColumn>& loads) {
   solvers::StepperRequest q;
   q.record_times = solvers::time_grid(spec, spec.thermal.step);
   q.record_states = false;
-  q.column_readout.sparse = r.temperature;
-  q.column_readout.change = r.displacement;
-  // The base reads the channels, then every extra readout.
-  q.base_readout = q.column_readout;
+  q.column_readout = read;
+  q.base_readout = read;
   Eigen::Index extra_rows = 0;
-  for (const auto& e : extra_displacement) extra_rows += e.rows();
+  for (const auto& e : extra) extra_rows += e.rows();
   if (extra_rows) {
-    Eigen::MatrixXd change(r.displacement.rows() + extra_rows, m.nodes.rows());
-    change.topRows(r.displacement.rows()) = r.displacement;
-    Eigen::Index at = r.displacement.rows();
-    for (const auto& e : extra_displacement) {
+    Eigen::MatrixXd change(read.change.rows() + extra_rows, read.change.cols());
+    change.topRows(read.change.rows()) = read.change;
+    Eigen::Index at = read.change.rows();
+    for (const auto& e : extra) {
       change.middleRows(at, e.rows()) = e;
       at += e.rows();
     }
     q.base_readout.change = std::move(change);
   }
-  for (const auto& c : separable) q.shape_columns.push_back({c.shape, c.law});
-  for (const auto& c : loads) q.load_columns.push_back(c.rhs);
+  for (size_t k = 0; k < separable.size(); ++k)
+    q.shape_columns.push_back({shapes[k], separable[k].law});
+  for (const auto& c : loads) q.load_columns.push_back(load_callback(sys, spec, c.form));
   const solvers::SteppedHistory h = solvers::step_thermal(sys, spec, q);
 
   Responses out;
-  const Eigen::Index channels = r.channels();
   out.base = sample_at(h.times, h.readout.topRows(channels), times);
   for (const auto& col : h.responses) out.columns.push_back(sample_at(h.times, col, times));
   Eigen::Index at = channels;
-  for (const auto& e : extra_displacement) {
+  for (const auto& e : extra) {
     Eigen::MatrixXd x = Eigen::MatrixXd::Zero(times.size(), channels);
     x.rightCols(e.rows()) = sample_at(h.times, h.readout.middleRows(at, e.rows()), times);
     out.extra.push_back(std::move(x));
     at += e.rows();
   }
   return out;
+}
+
+}  // namespace
+
+Responses march(const MarchModel& model, const core::CaseSpec& spec, const Readout& r,
+                const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
+                const std::vector<LoadColumn>& loads,
+                const std::vector<Eigen::MatrixXd>& extra_displacement) {
+  if (!model.is_reduced()) {
+    solvers::StateReadout read;
+    read.sparse = r.temperature;
+    read.change = r.displacement;
+    std::vector<Eigen::VectorXd> shapes;
+    for (const auto& c : separable) shapes.push_back(c.shape);
+    return march_on(model.full(), spec, read, r.channels(), extra_displacement, times, separable,
+                    shapes, loads);
+  }
+  // Reduced: the rows and shapes on the basis, T = V z.
+  const Eigen::MatrixXd& v = model.reduced()->basis;
+  solvers::StateReadout read;
+  read.dense = r.temperature * v;
+  read.change = r.displacement * v;
+  std::vector<Eigen::MatrixXd> extra;
+  for (const auto& e : extra_displacement) extra.push_back(e * v);
+  std::vector<Eigen::VectorXd> shapes;
+  for (const auto& c : separable) shapes.push_back(v.transpose() * c.shape);
+  return march_on(model.reduced_system(), spec, read, r.channels(), extra, times, separable,
+                  shapes, loads);
+}
+
+Responses march(const mesh::TetMesh& m, const core::CaseSpec& spec, const Readout& r,
+                const Eigen::VectorXd& times, const std::vector<SeparableColumn>& separable,
+                const std::vector<LoadColumn>& loads,
+                const std::vector<Eigen::MatrixXd>& extra_displacement) {
+  return march(MarchModel(m, spec), spec, r, times, separable, loads, extra_displacement);
 }
 
 Eigen::MatrixXd simulated_channels(const mesh::TetMesh& m, const core::CaseSpec& spec,

@@ -225,22 +225,72 @@ Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) 
   return u;
 }
 
+namespace {
+
+/// Per-material influence rows: sum over material m's tets of (W_e^T g_e), W the adjoint
+/// solutions (3 #nodes x #rows), g_e the element's thermal coupling.
+template <int N>
+std::vector<Eigen::MatrixXd> rows_by_material(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                                              const Eigen::MatrixXd& w) {
+  const Eigen::Index rows = w.cols();
+  std::vector<Eigen::MatrixXd> out(spec.materials.size(),
+                                   Eigen::MatrixXd::Zero(rows, m.nodes.rows()));
+  Eigen::MatrixXd we(3 * N, rows);
+  for (int t = 0; t < m.tets.rows(); ++t) {
+    const int mat = spec.bodies[core::index_of(m.tet_region[t])].material;
+    const auto g = k::thermal_coupling_matrix(coords<N>(m, t), elastic_material(m, spec, t), t);
+    for (int i = 0; i < 3 * N; ++i) we.row(i) = w.row(3 * m.tets(t, i / 3) + i % 3);
+    const Eigen::MatrixXd part = we.transpose() * g;  // #rows x N
+    for (int j = 0; j < N; ++j) out[static_cast<size_t>(mat)].col(m.tets(t, j)) += part.col(j);
+  }
+  return out;
+}
+
+}  // namespace
+
 Eigen::VectorXd ElasticModel::influence(int node, int direction) const {
   if (node < 0 || node >= impl_->coupling.cols() || direction < 0 || direction > 2)
     throw core::SolverError("influence at node " + std::to_string(node) + ", direction " +
                             std::to_string(direction) + ": expected 0 <= node < " +
                             std::to_string(impl_->coupling.cols()) + " and direction 0, 1 or 2");
-  const int dof = 3 * node + direction;
-  const int n = static_cast<int>(impl_->coupling.cols());
-  if (impl_->free_index[dof] < 0) return Eigen::VectorXd::Zero(n);
-  // K is symmetric: u_dof = e^T K^-1 G dT = (G^T K^-1 e)^T dT.
-  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(impl_->free_dofs, 1);
-  e(impl_->free_index[dof], 0) = 1.0;
-  const Eigen::MatrixXd wf = impl_->factor->solve(e);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(impl_->coupling.rows());
-  for (int i = 0; i < static_cast<int>(w.size()); ++i)
-    if (impl_->free_index[i] >= 0) w(i) = wf(impl_->free_index[i], 0);
-  return impl_->coupling.transpose() * w;
+  Eigen::SparseMatrix<double> f(1, impl_->coupling.rows());
+  f.insert(0, 3 * node + direction) = 1.0;
+  return influence_rows(f).row(0).transpose();
+}
+
+Eigen::MatrixXd ElasticModel::adjoint_solutions(
+    const Eigen::SparseMatrix<double>& functionals) const {
+  const Impl& impl = *impl_;
+  const int ndof = static_cast<int>(impl.coupling.rows());
+  if (functionals.cols() != ndof)
+    throw core::SolverError("displacement functionals have " +
+                            std::to_string(functionals.cols()) + " columns, expected 3 per node (" +
+                            std::to_string(ndof) + ")");
+  // K is symmetric: f . u = f^T K^-1 G dT = (G^T K^-1 f)^T dT.
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(functionals.transpose());
+  Eigen::MatrixXd rhs(impl.free_dofs, functionals.rows());
+  for (int i = 0; i < ndof; ++i)
+    if (impl.free_index[i] >= 0) rhs.row(impl.free_index[i]) = dense.row(i);
+  const Eigen::MatrixXd wf = impl.factor->solve(rhs);
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(ndof, functionals.rows());
+  for (int i = 0; i < ndof; ++i)
+    if (impl.free_index[i] >= 0) w.row(i) = wf.row(impl.free_index[i]);
+  return w;
+}
+
+Eigen::MatrixXd ElasticModel::influence_rows(const Eigen::SparseMatrix<double>& functionals) const {
+  return (impl_->coupling.transpose() * adjoint_solutions(functionals)).transpose();
+}
+
+std::vector<Eigen::MatrixXd> ElasticModel::influence_rows_by_material(
+    const Eigen::SparseMatrix<double>& functionals, const mesh::TetMesh& mesh,
+    const core::CaseSpec& spec) const {
+  if (mesh.nodes.rows() != impl_->coupling.cols())
+    throw core::SolverError("influence rows by material: the mesh has " +
+                            std::to_string(mesh.nodes.rows()) + " nodes, the model " +
+                            std::to_string(impl_->coupling.cols()));
+  const Eigen::MatrixXd w = adjoint_solutions(functionals);
+  return mesh.order == 1 ? rows_by_material<4>(mesh, spec, w) : rows_by_material<10>(mesh, spec, w);
 }
 
 ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spec,

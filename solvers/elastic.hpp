@@ -39,11 +39,23 @@ class ElasticModel {
   Eigen::MatrixXd displacements(const Eigen::MatrixXd& temperature) const;
   /// a with u(node, direction) = a . (T - T_ref) for every temperature field T [m/K].
   Eigen::VectorXd influence(int node, int direction) const;
+  /// Influence rows of displacement functionals: row i is a_i with f_i . u = a_i . (T - T_ref),
+  /// f = `functionals` (#rows x 3 #nodes, node-major x, y, z) [m/K]; one block solve.
+  Eigen::MatrixXd influence_rows(const Eigen::SparseMatrix<double>& functionals) const;
+  /// The same rows split by material: entry m is the part of influence_rows that the thermal
+  /// strain of material m's elements makes, so that a change of material m's expansion
+  /// coefficient by a factor (1 + x) adds x times it (the stiffness does not depend on the
+  /// expansion). `mesh` and `spec` must be the model's. Entries sum to influence_rows.
+  std::vector<Eigen::MatrixXd> influence_rows_by_material(
+      const Eigen::SparseMatrix<double>& functionals, const mesh::TetMesh& mesh,
+      const core::CaseSpec& spec) const;
   double reference_temperature_k() const { return reference_k_; }
   const ElasticTimings& timings() const { return timings_; }
 
  private:
   struct Impl;
+  /// K^-1 f^T on the free dofs, scattered to all dofs (held ones 0): 3 #nodes x #rows.
+  Eigen::MatrixXd adjoint_solutions(const Eigen::SparseMatrix<double>& functionals) const;
   std::unique_ptr<Impl> impl_;
   double reference_k_ = 0;
   ElasticTimings timings_;

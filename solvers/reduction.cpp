@@ -1,5 +1,6 @@
 #include "solvers/reduction.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
@@ -214,6 +215,15 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   // The remaining input columns: the load shapes themselves (the response at s -> infinity).
   st.deflated_columns += v.append(b.rightCols(b.cols() - 1));
   st.candidate_columns = static_cast<int>(b.cols());
+  if (options.output_columns.size() && options.output_columns.rows() != full.states())
+    throw core::SolverError("reduction: the output columns have " +
+                            std::to_string(options.output_columns.rows()) +
+                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+  st.output_columns = static_cast<int>(options.output_columns.cols());
+  // The inputs' and the outputs' Krylov vectors come from the same factors.
+  Eigen::MatrixXd rhs(b.rows(), b.cols() + options.output_columns.cols());
+  rhs.leftCols(b.cols()) = b;
+  rhs.rightCols(options.output_columns.cols()) = options.output_columns;
   st.film_states = film_states(spec, options);
   for (const auto& h : st.film_states) {
     const bool steady = removes_heat(full, h);
@@ -230,7 +240,7 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
       what << "reduction: K(h) + s C at s = " << s << " 1/s";
       const cholmod::Factor factor(a, what.str());
       ++st.factorizations;
-      Eigen::MatrixXd x = factor.solve(b);
+      Eigen::MatrixXd x = factor.solve(rhs);
       st.candidate_columns += static_cast<int>(x.cols());
       st.deflated_columns += v.append(x);
       if (options.second_moment) {
@@ -264,7 +274,11 @@ ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen
   for (const auto& p : full.moving) r.moving.push_back(basis.transpose() * p);
   r.moving_source = full.moving_source;
   r.moving_pieces = full.moving_pieces;
-  r.uniform = basis.transpose() * (full.capacity * Eigen::VectorXd::Ones(full.states()));
+  // The uniform field's coordinates: its capacity-weighted projection on the basis,
+  // (V^T C V)^{-1} V^T C 1, exact since the basis holds it. V^T C V is I for the system the basis
+  // was built on, not for another capacity projected on it (a calibrated case).
+  r.uniform = r.capacity.ldlt().solve(basis.transpose() *
+                                      (full.capacity * Eigen::VectorXd::Ones(full.states())));
   return r;
 }
 

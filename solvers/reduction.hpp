@@ -48,6 +48,13 @@ struct ReductionOptions {
   /// Width of the slices along the axis into which a moving source's pieces are grouped, as a
   /// fraction of its window [-].
   double moving_slice_fraction = 0.25;
+  /// Output rows transposed, #nodes x #outputs (e.g. sensors' interpolation rows, probes'
+  /// influence vectors), whose Krylov vectors (K(h) + s C)^{-1} L^T join the basis at every film
+  /// state and shift. The system is symmetric, so a Galerkin basis that holds them matches the
+  /// moments of L (K(h) + s C)^{-1} b for EVERY load b, not only the case's inputs: the responses
+  /// at those outputs to loads unknown when the basis is built (calibration's candidate effects)
+  /// are kept. Empty: the inputs' Krylov spaces only.
+  Eigen::MatrixXd output_columns;
 };
 
 /// What the basis was built from, for the run's summary.
@@ -55,6 +62,7 @@ struct ReductionStats {
   std::vector<double> shifts_per_s;              /// shifts used [1/s]
   std::vector<std::vector<double>> film_states;  /// per state: h per convection entry [W/(m^2 K)]
   int input_columns = 0;                         /// columns of B
+  int output_columns = 0;                        /// output rows whose Krylov vectors were added
   int candidate_columns = 0;                     /// columns offered to the basis
   int deflated_columns = 0;                      /// of those, dropped as dependent
   int factorizations = 0;

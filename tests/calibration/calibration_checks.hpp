@@ -16,7 +16,7 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
   std::vector<io::MeasuredRun> noiseless;
   const auto runs = testing::effect_runs(s, e, rng, &noiseless);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
-  const CalibrationResult res = calibrate(s.mesh, s.declared, cat, {runs[2]}, s.copt);
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
   // RMS against the test run's noise-free truth: no model removes the sensors' noise.
   const io::MeasuredRun& truth = noiseless[2];
   const Eigen::MatrixXd clean = measured_channels(truth, s.train.readout);

@@ -26,6 +26,7 @@ struct Study {
   Instrumentation inst;
   GeneratorOptions gopt;
   CalibrationOptions copt;
+  std::unique_ptr<MarchModel> model;  /// the declared model marched (reduced unless Scale says)
   Catalogue train;  /// built on the first training data; measured channels replaced per case
 };
 
@@ -40,6 +41,7 @@ struct Scale {
   double declared_step_s = 30;
   double patch_spacing = 0.14, patch_half = 0.08;
   double declared_edge_scale = 0.7;
+  bool reduced = true;  /// march the reduced model on the channels, as calibrate --case does
 };
 
 inline std::unique_ptr<Study> make_study(const Scale& sc) {
@@ -74,7 +76,12 @@ inline std::unique_ptr<Study> make_study(const Scale& sc) {
   }
   std::printf("[calibration] clean generator runs (%.1f s)\n", since());
   const Readout r = readout(s->mesh, s->declared, runs.front());
-  s->train = catalogue(s->mesh, s->declared, r, runs, s->copt);
+  s->model = sc.reduced ? std::make_unique<MarchModel>(s->mesh, s->declared, r,
+                                                       solvers::ReductionOptions{})
+                        : std::make_unique<MarchModel>(s->mesh, s->declared);
+  std::printf("[calibration] model: order %d of %ld nodes (%.1f s)\n", s->model->order(),
+              static_cast<long>(s->mesh.nodes.rows()), since());
+  s->train = catalogue(*s->model, s->declared, r, runs, s->copt);
   std::printf("[calibration] catalogue: %zu candidates (%.1f s)\n", s->train.candidates.size(),
               since());
   return s;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "calibration/model.hpp"
+#include "core/errors.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/thermal.hpp"
@@ -91,6 +92,119 @@ TEST(March, ColumnsAreLinearResponses) {
     EXPECT_LE((out.columns[1] - out.columns[0]).cwiseAbs().maxCoeff(), 1e-12) << scheme;
     EXPECT_GT(out.columns[0].bottomRows(1).minCoeff(), 0.05) << scheme;
   }
+}
+
+
+// On the reduced model whose basis holds the channels' Krylov vectors, the declared channels and
+// the response of every kind of candidate load (a heat patch, a film change, an air hat, heat
+// growing with a source's temperature, a conductivity change) equal the full model's at the
+// channels: the loads were unknown when the basis was built.
+TEST(March, ReducedOnChannelsKeepsEveryCandidateResponse) {
+  const core::CaseSpec declared = io::case_from_toml(test_toml::gantry_bar(2), "bar.toml");
+  const mesh::TetMesh m = mesh::mesh_case(declared);
+  const io::MeasuredRun run = bar_run();
+  const Readout r = readout(m, declared, run);
+  const core::CaseSpec spec = case_for_run(declared, run);
+  const MarchModel full(m, declared);
+  const MarchModel reduced(m, declared, r, solvers::ReductionOptions{});
+  ASSERT_TRUE(reduced.is_reduced());
+  ASSERT_LT(reduced.order(), m.nodes.rows() / 4);
+
+  // A patch of the bar's top face near x = 0.3 (the nodes' film areas there).
+  Eigen::VectorXd patch = full.full().film_area[0];
+  for (Eigen::Index i = 0; i < m.nodes.rows(); ++i)
+    if (std::abs(m.nodes(i, 0) - 0.3) > 0.05 || m.nodes(i, 2) < 0.049) patch(i) = 0;
+  ASSERT_GT(patch.sum(), 0);
+  const std::vector<SeparableColumn> sep{{"patch", patch, [](double t, double) {
+                                            return t < 300 ? 1.0 : 0.5;
+                                          }}};
+  const auto dk = std::make_shared<const Eigen::SparseMatrix<double>>(0.1 * full.full().conduction);
+  OperatorChange fk;
+  fk.full = dk;
+  OperatorChange rk = fk;
+  rk.reduced = std::make_shared<const Eigen::MatrixXd>(reduced.projected(*dk));
+  const double t0_k = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  const auto loads = [&](const OperatorChange& k) {
+    return std::vector<LoadColumn>{{"film", FilmChange{0, false, 1}},
+                                   {"air", SinkHat{{0}, 300, 300}},
+                                   {"nut heat", SourceGrowth{0, t0_k}},
+                                   {"bearing heat", SourceGrowth{1, t0_k}},
+                                   {"conductivity", k}};
+  };
+  const Responses a = march(full, spec, r, run.time, sep, loads(fk));
+  const Responses b = march(reduced, spec, r, run.time, sep, loads(rk));
+  const double base_gap = (a.base - b.base).cwiseAbs().maxCoeff();
+  std::printf("[march] reduced order %d of %ld nodes: declared channels within %.2e K\n",
+              reduced.order(), static_cast<long>(m.nodes.rows()), base_gap);
+  EXPECT_LE(base_gap, 1e-3);
+  ASSERT_EQ(a.columns.size(), b.columns.size());
+  for (size_t k = 0; k < a.columns.size(); ++k) {
+    const double peak = a.columns[k].cwiseAbs().maxCoeff();
+    const double gap = (a.columns[k] - b.columns[k]).cwiseAbs().maxCoeff();
+    std::printf("[march]   column %zu: peak %.3e, reduced off by %.2e (%.2e relative)\n", k, peak,
+                gap, gap / peak);
+    EXPECT_GT(peak, 0) << k;
+    EXPECT_LE(gap, 1e-2 * peak) << k;
+  }
+  // Another case's operators on the same basis (a calibrated capacity and conductivity): it
+  // starts from the uniform field and follows the full model of that case.
+  core::CaseSpec changed = declared;
+  changed.materials[0].density *= 0.65;
+  changed.materials[0].conductivity *= 1.3;
+  const core::CaseSpec changed_run = case_for_run(changed, run);
+  const Responses fc = march(MarchModel(m, changed), changed_run, r, run.time, {}, {});
+  const Responses rc = march(reduced.with_case(m, changed), changed_run, r, run.time, {}, {});
+  const double t0 = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  EXPECT_LE((rc.base.row(0).array() - t0).abs().maxCoeff(), 1e-9);
+  const double changed_gap = (fc.base - rc.base).cwiseAbs().maxCoeff();
+  std::printf("[march] another capacity and conductivity on the basis: within %.2e K\n",
+              changed_gap);
+  EXPECT_LE(changed_gap, 1e-2);
+  // A callback on the full system cannot be marched reduced: refused, not answered wrongly.
+  const std::vector<LoadColumn> callback{
+      {"cb", solvers::LoadCallback([&](const solvers::StepView&) {
+         return Eigen::VectorXd(full.full().film_area[0]);
+       })}};
+  EXPECT_THROW(march(reduced, spec, r, run.time, {}, callback), core::SolverError);
+}
+
+
+// The probes' rows split by material are exact: doubling one material's expansion coefficient
+// changes the rows by exactly that material's part (solved again with another elastic model).
+TEST(Readout, ExpansionPartsAreExactPerMaterial) {
+  const core::CaseSpec declared =
+      io::read_case(std::string(TT_SOURCE_DIR) + "/cases/sb1_coarse.toml");
+  const mesh::TetMesh m = mesh::mesh_case(declared);
+  io::MeasuredRun run;
+  run.run = "probes";
+  for (const auto& [id, dir] : std::vector<std::pair<std::string, Eigen::Vector3d>>{
+           {"tcp_dy", Eigen::Vector3d::UnitY()}, {"tcp_dz", Eigen::Vector3d::UnitZ()},
+           {"tcp_skew", Eigen::Vector3d(1, 1, 0).normalized()}})
+    run.displacements.push_back({id, Eigen::Vector3d(0.0, 0.18, 0.58), dir});
+  const Readout r = readout(m, declared, run);
+  ASSERT_EQ(r.displacement.rows(), 3);
+  ASSERT_EQ(r.expansion.size(), declared.materials.size());
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(3, m.nodes.rows());
+  for (const auto& part : r.expansion) sum += part;
+  const double scale = r.displacement.cwiseAbs().maxCoeff();
+  EXPECT_LE((sum - r.displacement).cwiseAbs().maxCoeff(), 1e-12 * scale);
+  int used = 0;
+  for (size_t k = 0; k < declared.materials.size(); ++k) {
+    if (r.expansion[k].cwiseAbs().maxCoeff() == 0) continue;  // a material no body uses
+    ++used;
+    core::CaseSpec doubled = declared;
+    doubled.materials[k].expansion *= 2;
+    const Readout r2 = readout(m, doubled, run);
+    const double gap = (r2.displacement - r.displacement - r.expansion[k]).cwiseAbs().maxCoeff();
+    std::printf("[readout] %s: part peak %.3e m/K, doubled minus base off by %.2e\n",
+                declared.materials[k].name.c_str(), r.expansion[k].cwiseAbs().maxCoeff(), gap);
+    EXPECT_LE(gap, 1e-9 * scale) << declared.materials[k].name;
+    EXPECT_LE((displacement_with_expansions(r, declared, doubled) - r2.displacement)
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-9 * scale);
+  }
+  EXPECT_GE(used, 2);
 }
 
 }  // namespace
