@@ -1,6 +1,10 @@
 // Writes measured-data sets with one undeclared effect, for `thermotwin calibrate`.
 // Usage: bench_calibration_generate CASE KIND OUT_DIR [RUNS=3] [HOURS=2] [SEED=1]
+//                                   [MESH_SCALE=0.8] [STEP_S=6]
 //   HOURS: one length for every run, or one per run separated by commas (e.g. 2,6,8)
+//   MESH_SCALE, STEP_S: the generator's mesh (bodies' max_edge times this) and time step; the
+//   defaults (GeneratorOptions) are finer than any case; coarser ones make long runs on a large
+//   mesh affordable (e.g. timing calibrate on the default SB-1)
 //   KIND: none | ambient_temperature | heat_input | speed_dependent_convection |
 //         temperature_dependent_heat | boundary_conductance | material_parameter | sensor_offset |
 //         sensor_lag
@@ -41,7 +45,9 @@ int main(int argc, char** argv) {
     }
     const std::uint64_t seed = argc > 6 ? std::stoull(argv[6]) : 1;
     const core::CaseSpec declared = io::read_case(argv[1]);
-    const calibration::GeneratorOptions options;
+    calibration::GeneratorOptions options;
+    if (argc > 7) options.mesh_scale = std::stod(argv[7]);
+    if (argc > 8) options.step_s = std::stod(argv[8]);
     const core::CaseSpec gen = calibration::generator_case(declared, options);
     const mesh::TetMesh m = mesh::mesh_case(gen);
     calibration::Instrumentation inst;
