@@ -1,8 +1,8 @@
 #include "fitting/models.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -121,7 +121,9 @@ std::string model_label(const ModelSpec& spec) {
   out << kind_name(spec.kind);
   switch (spec.kind) {
     case ModelKind::no_compensation:
+      break;
     case ModelKind::least_squares:
+      if (!spec.reject_gross_errors) out << "(no_3sigma)";
       break;
     case ModelKind::ridge:
       out << "(lambda=" << spec.ridge_lambda << ")";

@@ -126,6 +126,16 @@ TEST(Segments, SpeedCyclesStartWhereTheSpindleStartsAfterAStop) {
   EXPECT_EQ(fitting::speed_cycles(Eigen::VectorXd::Constant(5, 100.0)).size(), 1u);
 }
 
+TEST(Segments, HeldOutDataStartAtTheLastCycleStartByTheLimit) {
+  const Eigen::VectorXd time = Eigen::VectorXd::LinSpaced(60, 0, 59);
+  Eigen::VectorXd speed = Eigen::VectorXd::Zero(60);
+  for (int on : {5, 25, 45}) speed.segment(on, 10).setConstant(3000.0);
+  // Cycles start at the last stopped rows 24 and 44; the last one by 70 % of 59 s is row 24.
+  EXPECT_DOUBLE_EQ(fitting::held_out_start(time, speed, 0.7, 0.6), 24.0);
+  EXPECT_DOUBLE_EQ(fitting::held_out_start(time, speed, 0.3, 0.6), 0.6 * 59.0);
+  EXPECT_DOUBLE_EQ(fitting::held_out_start(time, Eigen::VectorXd(), 0.7, 0.7), 0.7 * 59.0);
+}
+
 TEST(Segments, SegmentsAreReZeroedAndDropIncompleteRows) {
   Eigen::VectorXd time = Eigen::VectorXd::LinSpaced(6, 0, 5);
   Eigen::VectorXd speed = Eigen::VectorXd::Constant(6, 100.0);
