@@ -161,7 +161,7 @@ int coefficient_count(const ModelSpec& spec, int sensors, int inputs) {
     case ModelKind::projection_pursuit:
       return base * std::max(1, spec.ppr.max_terms);
     case ModelKind::cnn_bigru_attention:
-      // Thousands of weights: the one-standard-error rule prefers any linear model within reach.
+      // Thousands of weights: after every linear model in the order of simplicity (ties).
       return std::numeric_limits<int>::max() / 2;
   }
   return base;
