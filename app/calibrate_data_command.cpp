@@ -11,7 +11,8 @@
 // 2. Per channel, fitting::residual_study: baseline sensors by forward selection on the
 //    leave-one-segment-out residual, then candidate terms claimed only when their share of that
 //    residual, less 1 % per coefficient, beats the best of 19 phase-randomised surrogates (and
-//    zero), and their per-segment held-out gain exceeds two standard errors.
+//    zero), and their per-segment held-out gain exceeds two standard errors, each segment's gain
+//    taken with the setting (time constant, sensor) searched on the other segments only.
 // 3. The residual on the test segments, before and after, and how it still correlates with speed
 //    (when there is one), time and temperatures; a channel whose test error is worse after than
 //    before is said to be so.
@@ -38,17 +39,6 @@ namespace tt::app {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// Default split of a run used for both training and test [s].
-double default_split(const io::MeasuredRun& run) {
-  const auto& t = run.time;
-  const double limit = t(0) + 0.7 * (t(t.size() - 1) - t(0));
-  double split = t(0) + 0.6 * (t(t.size() - 1) - t(0));
-  const auto cycles = fitting::speed_cycles(io::measured_speed(run));
-  for (const auto& c : cycles)
-    if (c.begin > 0 && t(c.begin) <= limit) split = t(c.begin);
-  return split;
-}
 
 double correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const Eigen::VectorXd x = a.array() - a.mean(), y = b.array() - b.mean();
@@ -165,7 +155,9 @@ int calibrate_data_command(const CalibrateArgs& args) {
                             ": every run must have the same inputs; hint: drop the speed column "
                             "from all runs, or give it in all");
     has_speed = speed;
-    const double split = shared ? args.split_s.value_or(default_split(run)) : kInf;
+    const double split = shared ? args.split_s.value_or(fitting::held_out_start(
+                                      run.time, io::measured_speed(run), 0.7, 0.6))
+                                : kInf;
     const std::string name = "run" + std::to_string(++index) + (is_train ? ".train" : ".test");
     auto segments = is_train ? io::measured_segments(run, name, -kInf, shared ? split : kInf)
                              : io::measured_segments(run, name, shared ? split : -kInf, kInf);

@@ -364,7 +364,9 @@ int main(int argc, char** argv) {
       const double best_ref = std::min({r.ls.rms, r.ridge.rms, r.lagged.rms});
       std::vector<std::string> missed;
       if (r.chosen.rms > best_ref * (1 + 1e-9)) missed.push_back("chosen > best reference");
-      if (r.chosen.rms > r.none.rms) missed.push_back("chosen > uncompensated");
+      // The commands' CSVs hold 10 significant digits: no compensation reads back equal to the
+      // uncompensated drift to about 1e-10, not exactly.
+      if (r.chosen.rms > r.none.rms * (1 + 1e-9)) missed.push_back("chosen > uncompensated");
       if (r.after.rms > r.before.rms * (1 + 1e-9)) missed.push_back("after > before");
       if (s.data == "fl" && r.after.rms > 2.5e-6) missed.push_back("after > 2.5 um");
       misses += static_cast<int>(missed.size());

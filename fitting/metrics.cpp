@@ -34,4 +34,11 @@ Accuracy accuracy(const std::vector<double>& s) {
   return result;
 }
 
+double mean_square(const Accuracy& a) {
+  if (a.s.empty()) throw core::DataError("mean square over 0 groups; expected at least one S_i");
+  double sum = 0.0;
+  for (double v : a.s) sum += v * v;
+  return sum / static_cast<double>(a.s.size());
+}
+
 }  // namespace tt::fitting

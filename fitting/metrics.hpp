@@ -24,4 +24,8 @@ struct Accuracy {
 /// S_M and S_σ of the per-group S_i [m]; throws DataError when s is empty.
 Accuracy accuracy(const std::vector<double>& s);
 
+/// The mean of S_i² over the groups [m²]: what an RMS over equally weighted groups squares. Unlike
+/// S_M, one group with a large S weighs in full. Throws DataError when a.s is empty.
+double mean_square(const Accuracy& a);
+
 }  // namespace tt::fitting

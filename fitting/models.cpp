@@ -1,8 +1,8 @@
 #include "fitting/models.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -121,7 +121,9 @@ std::string model_label(const ModelSpec& spec) {
   out << kind_name(spec.kind);
   switch (spec.kind) {
     case ModelKind::no_compensation:
+      break;
     case ModelKind::least_squares:
+      if (!spec.reject_gross_errors) out << "(no_3sigma)";
       break;
     case ModelKind::ridge:
       out << "(lambda=" << spec.ridge_lambda << ")";
@@ -159,7 +161,7 @@ int coefficient_count(const ModelSpec& spec, int sensors, int inputs) {
     case ModelKind::projection_pursuit:
       return base * std::max(1, spec.ppr.max_terms);
     case ModelKind::cnn_bigru_attention:
-      // Thousands of weights: the one-standard-error rule prefers any linear model within reach.
+      // Thousands of weights: after every linear model in the order of simplicity (ties).
       return std::numeric_limits<int>::max() / 2;
   }
   return base;

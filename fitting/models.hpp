@@ -71,8 +71,8 @@ std::string kind_name(ModelKind kind);
 std::string model_label(const ModelSpec& spec);
 
 /// How many coefficients (besides the intercept) the spec fits on `sensors` sensors and `inputs`
-/// inputs: the order of simplicity of the one-standard-error rule (PPR counts as its projections'
-/// inputs times its largest number of terms).
+/// inputs: the order of simplicity that breaks ties of blocked_evaluation (PPR counts as its
+/// projections' inputs times its largest number of terms).
 int coefficient_count(const ModelSpec& spec, int sensors, int inputs);
 
 /// How many fitting samples the 3σ criterion dropped.

@@ -84,8 +84,9 @@ struct ResidualStudyOptions {
   double penalty_per_parameter = 0.01;
   /// at most this many effects
   int max_effects = 4;
-  /// the mean per-segment held-out gain of a claimed term must exceed this many standard errors
-  /// (a gain that one segment carries is not claimed)
+  /// the mean per-segment held-out gain of a claimed term (nested: its setting searched without
+  /// the segment) must exceed this many standard errors (a gain that one segment carries, or that
+  /// picking the best of many settings makes, is not claimed)
   double min_gain_t = 2.0;
   /// temperature column of the ambient sensor, -1 when the run names none
   int ambient_sensor = -1;
@@ -110,7 +111,9 @@ struct Effect {
   /// term [m]; NaN when not computed
   double heldout_rms_before = std::numeric_limits<double>::quiet_NaN();
   double heldout_rms_after = std::numeric_limits<double>::quiet_NaN();
-  /// per-segment held-out gains: their mean over its standard error, and how many are positive
+  /// per-segment held-out gains, nested: for each segment the setting (time constant, sensor) is
+  /// searched on the other segments' held-out residual only; their mean over its standard error,
+  /// and how many are positive
   double gain_t = std::numeric_limits<double>::quiet_NaN();
   int segments_improved = 0;
   /// step_fraction − penalty·parameters > null_fraction and gain_t > min_gain_t

@@ -40,6 +40,18 @@ std::vector<RowRange> speed_cycles(const Eigen::VectorXd& speed, Eigen::Index mi
   return ranges;
 }
 
+double held_out_start(const Eigen::VectorXd& time, const Eigen::VectorXd& speed, double limit,
+                      double fallback) {
+  const Eigen::Index n = time.size();
+  if (n == 0) throw core::DataError("held-out start of a run with no samples");
+  const double t0 = time(0), span = time(n - 1) - time(0);
+  double start = t0 + fallback * span;
+  if (speed.size() == n)
+    for (const RowRange& c : speed_cycles(speed))
+      if (c.begin > 0 && time(c.begin) <= t0 + limit * span) start = time(c.begin);
+  return start;
+}
+
 std::vector<RowRange> ranges_at(const Eigen::VectorXd& time, const std::vector<double>& cuts) {
   std::vector<RowRange> ranges;
   Eigen::Index begin = 0;
@@ -109,7 +121,7 @@ std::vector<Group> segment_groups(const std::vector<Segment>& segments) {
 
 namespace {
 
-/// Coefficients of a candidate, then the weaker shrinkage: the order of simplicity.
+/// Coefficients of a candidate, then the stronger ridge first: the order of simplicity.
 std::pair<int, double> simplicity(const Candidate& c, int inputs) {
   return {coefficient_count(c.spec, static_cast<int>(c.sensor_set.sensors.size()), inputs),
           -c.spec.ridge_lambda};
@@ -211,34 +223,44 @@ Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vecto
       c.failure = e.what();
     }
   });
-  // One-standard-error rule: the lowest mean sets the bar (its mean plus its standard error over
-  // the folds); the simplest candidate under the bar is chosen, so that a richer model must beat
-  // a simpler one by more than the fold-to-fold scatter to be taken.
+  // The lowest held-out mean square S² (the quantity a test RMS measures; a mean of S would let
+  // a candidate that fails badly on one block through when it is good on the others), ties to the
+  // simpler candidate; then a one-standard-error guard against no compensation.
   const int inputs = static_cast<int>(groups.front().input_names.size());
-  const double folds = static_cast<double>(pool.size());
-  for (std::size_t c = 0; c < scored.size(); ++c)
-    if (scored[c].model &&
-        (result.selection.lowest < 0 ||
-         scored[c].validation.sm <
-             scored[static_cast<std::size_t>(result.selection.lowest)].validation.sm))
-      result.selection.lowest = static_cast<int>(c);
-  if (result.selection.lowest < 0)
-    throw core::DataError("target " + result.target_name +
-                          ": every candidate failed (first: " + scored.front().failure + ")");
-  const auto& lowest = scored[static_cast<std::size_t>(result.selection.lowest)].validation;
-  result.selection.threshold_sm = lowest.sm + lowest.s_sigma / std::sqrt(folds);
+  auto& sel = result.selection;
   for (std::size_t c = 0; c < scored.size(); ++c) {
-    if (!scored[c].model || scored[c].validation.sm > result.selection.threshold_sm) continue;
-    const auto& best = result.selection.best;
-    if (best < 0) {
-      result.selection.best = static_cast<int>(c);
+    if (!scored[c].model) continue;
+    if (sel.lowest < 0) {
+      sel.lowest = static_cast<int>(c);
       continue;
     }
-    const auto a = simplicity(candidates[c], inputs);
-    const auto b = simplicity(candidates[static_cast<std::size_t>(best)], inputs);
+    const auto low = static_cast<std::size_t>(sel.lowest);
+    const double a = mean_square(scored[c].validation), b = mean_square(scored[low].validation);
     if (a < b ||
-        (a == b && scored[c].validation.sm < scored[static_cast<std::size_t>(best)].validation.sm))
-      result.selection.best = static_cast<int>(c);
+        (a == b && simplicity(candidates[c], inputs) < simplicity(candidates[low], inputs)))
+      sel.lowest = static_cast<int>(c);
+  }
+  if (sel.lowest < 0)
+    throw core::DataError("target " + result.target_name +
+                          ": every candidate failed (first: " + scored.front().failure + ")");
+  sel.best = sel.lowest;
+  for (std::size_t c = 0; c < scored.size(); ++c) {
+    if (candidates[c].spec.kind != ModelKind::no_compensation || !scored[c].model) continue;
+    sel.none = static_cast<int>(c);
+    break;
+  }
+  if (sel.none >= 0 && sel.none != sel.lowest) {
+    // Per block, the gain in S² of the lowest over no compensation: its mean must exceed its
+    // standard error, or the model is not shown to beat leaving the machine alone.
+    const auto& low = scored[static_cast<std::size_t>(sel.lowest)].validation.s;
+    const auto& none = scored[static_cast<std::size_t>(sel.none)].validation.s;
+    std::vector<double> gains;
+    for (std::size_t k = 0; k < low.size(); ++k)
+      gains.push_back(none[k] * none[k] - low[k] * low[k]);
+    const Accuracy g = accuracy(gains);
+    sel.gain_over_none = g.sm;
+    sel.gain_over_none_standard_error = g.s_sigma / std::sqrt(static_cast<double>(gains.size()));
+    if (!(sel.gain_over_none > sel.gain_over_none_standard_error)) sel.best = sel.none;
   }
   const Candidate& chosen = candidates[static_cast<std::size_t>(result.selection.best)];
   result.model =

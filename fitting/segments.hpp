@@ -26,6 +26,13 @@ struct RowRange {
 /// Cycles shorter than min_rows join the one before. speed: #samples [rpm].
 std::vector<RowRange> speed_cycles(const Eigen::VectorXd& speed, Eigen::Index min_rows = 10);
 
+/// Where the held-out part of one run starts when none is given [s]: the start of the last speed
+/// cycle that begins after the run's start and by `limit` of its duration, so that the held-out
+/// data start at rest as every training piece does; `fallback` of the duration when no cycle begins
+/// there (no speed, or a single cycle). time: #samples [s]; speed: #samples [rpm], or empty.
+double held_out_start(const Eigen::VectorXd& time, const Eigen::VectorXd& speed, double limit,
+                      double fallback);
+
 /// Ranges cut at the given times: rows with time < cuts[0], then [cuts[0], cuts[1]), ...; empty
 /// pieces are left out. time: #samples [s]; cuts ascending [s].
 std::vector<RowRange> ranges_at(const Eigen::VectorXd& time, const std::vector<double>& cuts);
@@ -76,15 +83,16 @@ struct Candidate {
   ModelSpec spec;
 };
 
-/// Blocked cross-validation with the one-standard-error rule. Each group of `pool` (whole runs,
-/// speed cycles or time blocks) validates in turn while the other pool groups fit; a candidate's
-/// validation Accuracy holds its S per fold. The lowest mean S sets a threshold, that mean plus
-/// its standard error (S_σ/√K); among the candidates at or below it the one with the fewest
-/// coefficients (then the strongest ridge, then the lowest mean) is chosen, refitted on all of
-/// `pool` and measured on `test`. List a no_compensation candidate: then a model whose mean S is
-/// not below it by a standard error is never chosen. The Evaluation's sensor_sets and specs hold
-/// one entry per candidate. Throws DataError on fewer than 2 pool groups or when every candidate
-/// fails.
+/// Blocked cross-validation. Each group of `pool` (whole runs, speed cycles or time blocks)
+/// validates in turn while the other pool groups fit; a candidate's validation Accuracy holds its S
+/// per fold. The candidate of the lowest mean S² over the folds is chosen (ties: fewer
+/// coefficients, then the stronger ridge), unless it fails the one-standard-error guard against
+/// no compensation: its mean per-fold gain in S² over a listed no_compensation candidate must
+/// exceed that gain's standard error, else no compensation is chosen. So a model worse than no
+/// compensation on validation, or better only by the fold-to-fold scatter, is never chosen. The
+/// choice is refitted on all of `pool` and measured on `test`. The Evaluation's sensor_sets and
+/// specs hold one entry per candidate. Throws DataError on fewer than 2 pool groups or when every
+/// candidate fails.
 Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vector<int>& pool,
                               const std::vector<int>& test, int target,
                               const std::vector<Candidate>& candidates);

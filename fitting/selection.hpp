@@ -39,12 +39,16 @@ struct Selection {
   /// every pair, sensor-set major
   std::vector<CandidateResult> candidates;
   /// index into candidates of the chosen one: the smallest validation S_M (the first one on a
-  /// tie, so list simpler models first), or under blocked_evaluation's one-standard-error rule
+  /// tie, so list simpler models first), or under blocked_evaluation's rule
   int best = -1;
-  /// blocked_evaluation only: the candidate of the smallest mean validation S, and the threshold
-  /// (that mean plus its standard error) the chosen one is within [m]
+  /// blocked_evaluation only: the candidate of the smallest mean validation S² (ties to the fewer
+  /// coefficients), the no-compensation candidate (-1 when none was listed), and the lowest one's
+  /// mean per-block gain in S² over no compensation with its standard error [m²] (NaN when the
+  /// lowest is no compensation or none was listed)
   int lowest = -1;
-  double threshold_sm = std::numeric_limits<double>::quiet_NaN();
+  int none = -1;
+  double gain_over_none = std::numeric_limits<double>::quiet_NaN();
+  double gain_over_none_standard_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Fits every (sensor set, spec) pair on `fitting` and scores it on `validation`. It is never

@@ -160,6 +160,30 @@ TEST(DataShapes, OneRunWithSpeedCycles) {
   const auto fit = json_of(dir / "fit" / "fit.json");
   EXPECT_NE(fit["blocks"].get<std::string>().find("speed cycles"), std::string::npos);
   EXPECT_TRUE(fit["summary"]["d1"]["window_mae_continuous_um"].is_number());
+  // The held-out data start at rest, at a speed cycle's start (the last stopped sample before the
+  // start at 30 h + 600 s here), as training pieces do.
+  EXPECT_NE(fit["test_window"]["origin"].get<std::string>().find("speed cycle"), std::string::npos);
+  const double from = fit["test_window"]["from_s"].get<double>();
+  EXPECT_DOUBLE_EQ(from, 30 * 3600.0 + 480.0);
+  const auto written_run = io::read_measured_run(data);
+  for (Eigen::Index i = 0; i < written_run.time.size(); ++i)
+    if (written_run.time(i) >= from) {
+      EXPECT_EQ(written_run.input_values(i, 0), 0.0);
+      break;
+    }
+  // The reference forms are candidates: least squares without the 3 sigma criterion among them.
+  bool plain = false;
+  for (const auto& c : fit["targets"][0]["candidates"])
+    plain = plain || c["model"] == "least_squares(no_3sigma)";
+  EXPECT_TRUE(plain);
+  for (const auto& [channel, s] : fit["summary"].items()) {
+    EXPECT_LE(s["validation_rms_um"].get<double>(),
+              s["no_compensation_validation_rms_um"].get<double>())
+        << channel;
+    EXPECT_GT(s["gain_over_no_compensation_um2"].get<double>(),
+              s["gain_over_no_compensation_standard_error_um2"].get<double>())
+        << channel;
+  }
   expect_fit_helps(fit);
 }
 
@@ -253,7 +277,11 @@ TEST(DataShapes, NoCompensationIsChosenWhenNothingBeatsIt) {
   const auto e = fitting::blocked_evaluation(
       groups, pool, {}, 0, {{all, none}, {all, fitting::ModelSpec{}}, {all, lagged}});
   EXPECT_EQ(e.model.spec.kind, fitting::ModelKind::no_compensation);
-  // A channel the temperatures explain gets a model, within one standard error of the lowest.
+  EXPECT_EQ(e.selection.none, 0);
+  if (e.selection.lowest != e.selection.none)
+    EXPECT_LE(e.selection.gain_over_none, e.selection.gain_over_none_standard_error);
+  // A channel the temperatures explain gets the model of the lowest held-out mean square, which
+  // beats no compensation by more than a standard error.
   const auto cycles = fitting::segment_groups(
       fitting::cross_validation_blocks(io::measured_segments(synthetic_run(48.0, true, 41), "run"))
           .segments);
@@ -262,10 +290,13 @@ TEST(DataShapes, NoCompensationIsChosenWhenNothingBeatsIt) {
   const auto real = fitting::blocked_evaluation(
       cycles, cycle_pool, {}, 0, {{all, none}, {all, fitting::ModelSpec{}}, {all, lagged}});
   EXPECT_NE(real.model.spec.kind, fitting::ModelKind::no_compensation);
-  const auto& lowest = real.selection.candidates[static_cast<std::size_t>(real.selection.lowest)];
-  const auto& chosen = real.selection.candidates[static_cast<std::size_t>(real.selection.best)];
-  EXPECT_GE(real.selection.threshold_sm, lowest.validation.sm);
-  EXPECT_LE(chosen.validation.sm, real.selection.threshold_sm);
+  EXPECT_EQ(real.selection.best, real.selection.lowest);
+  EXPECT_GT(real.selection.gain_over_none, real.selection.gain_over_none_standard_error);
+  for (const auto& c : real.selection.candidates)
+    EXPECT_LE(
+        fitting::mean_square(
+            real.selection.candidates[static_cast<std::size_t>(real.selection.best)].validation),
+        fitting::mean_square(c.validation));
 }
 
 TEST(DataShapes, ClaimThresholdIsNeverNegative) {
