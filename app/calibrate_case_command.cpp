@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/study.hpp"
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
@@ -130,17 +131,8 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
     // run, at a few output steps (backward Euler only).
     const core::CaseSpec first = calibration::case_for_run(declared, train.front());
     if (first.thermal.scheme == core::TimeScheme::backward_euler) {
-      solvers::Twin twin;
-      twin.model = *model.reduced();
-      const auto ind = solvers::twin_indicator(model.full(), twin, first, 3);
-      model_json["indicator"] = {{"run", train.front().run},
-                                 {"max_K", ind.max_k},
-                                 {"tolerance_K", ind.tolerance_k},
-                                 {"above_tolerance", ind.above_tolerance()}};
-      if (ind.above_tolerance())
-        std::cerr << "thermotwin: warning: the reduced model's error indicator is " << ind.max_k
-                  << " K on run '" << train.front().run << "', above its tolerance of "
-                  << ind.tolerance_k << " K: check with --full\n";
+      const auto ind = solvers::twin_indicator(model.full(), *model.reduced(), first, 3);
+      model_json["indicator"] = indicator_report(ind, train.front().run);
     }
   }
   say(std::to_string(r.channels()) + " channels, responses on " + std::to_string(train.size()) +

@@ -11,6 +11,17 @@
 
 namespace tt::app {
 
+nlohmann::json indicator_report(const solvers::ErrorIndicator& ind, const std::string& run) {
+  if (ind.above_tolerance())
+    std::cerr << "thermotwin: warning: the reduced model's error indicator is " << ind.max_k
+              << " K on run '" << run << "', above its tolerance of " << ind.tolerance_k
+              << " K: check with --full\n";
+  return {{"run", run},
+          {"max_K", ind.max_k},
+          {"tolerance_K", ind.tolerance_k},
+          {"above_tolerance", ind.above_tolerance()}};
+}
+
 CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                   const std::vector<solvers::CampaignRun>& runs,
                                   const ModelChoice& choice, const std::vector<int>& sampled_nodes,
@@ -56,16 +67,9 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
   // Trust: the full-order residual at a few output steps of the first run (each distinct step
   // size and horizon costs a full factor, so few samples).
   if (spec.thermal.scheme == core::TimeScheme::backward_euler && !runs.empty()) {
-    const auto ind =
-        solvers::twin_indicator(solvers::thermal_system(mesh, spec), *twin, runs.front().spec, 3);
-    out.model["indicator"] = {{"run", runs.front().name},
-                              {"max_K", ind.max_k},
-                              {"tolerance_K", ind.tolerance_k},
-                              {"above_tolerance", ind.above_tolerance()}};
-    if (ind.above_tolerance())
-      std::cerr << "thermotwin: warning: the reduced model's error indicator is " << ind.max_k
-                << " K on run '" << runs.front().name << "', above its tolerance of "
-                << ind.tolerance_k << " K: check with --full\n";
+    const auto ind = solvers::twin_indicator(solvers::thermal_system(mesh, spec), twin->model,
+                                             runs.front().spec, 3);
+    out.model["indicator"] = indicator_report(ind, runs.front().name);
   }
   return out;
 }

@@ -245,7 +245,7 @@ int run_command(const RunArgs& args) {
   // The reduced run's own error indicator: the full-order residual at sampled output steps.
   std::optional<solvers::ErrorIndicator> indicator;
   if (rom && spec.thermal.scheme == core::TimeScheme::backward_euler) {
-    indicator = solvers::twin_indicator(run.operators, rom->twin, spec);
+    indicator = solvers::twin_indicator(run.operators, rom->twin.model, spec);
     if (indicator->above_tolerance())
       std::cerr << "thermotwin: warning: the reduced model's error indicator is "
                 << indicator->max_k << " K, above its tolerance of " << indicator->tolerance_k

@@ -11,6 +11,7 @@
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "solvers/campaign.hpp"
+#include "solvers/reduction.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -77,6 +78,11 @@ struct ModelChoice {
 
 /// A campaign's results on the chosen model, and what was used (for the report: "kind" full or
 /// reduced, its order and where it came from).
+/// The reduced model's error indicator on `run` for summary files (`max_K`, `tolerance_K`,
+/// `above_tolerance`); above its tolerance it also warns on stderr.
+nlohmann::json indicator_report(const solvers::ErrorIndicator& indicator,
+                                const std::string& run);
+
 struct CampaignOnModel {
   std::vector<solvers::CampaignResult> results;
   nlohmann::json model;

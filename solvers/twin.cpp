@@ -123,7 +123,7 @@ TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& p
   return run;
 }
 
-ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
+ErrorIndicator twin_indicator(const FullThermalSystem& full, const ReducedModel& model,
                               const core::CaseSpec& spec, int samples) {
   if (spec.thermal.scheme != core::TimeScheme::backward_euler)
     throw core::SolverError(
@@ -151,7 +151,7 @@ ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
   std::sort(request.record_times.begin(), request.record_times.end());
   request.record_times.erase(std::unique(request.record_times.begin(), request.record_times.end()),
                              request.record_times.end());
-  const SteppedHistory h = step_thermal(twin.model.system, spec, request);
+  const SteppedHistory h = step_thermal(model.system, spec, request);
   const auto state_at = [&](double t) -> Eigen::VectorXd {
     const auto it = std::find(h.times.begin(), h.times.end(), t);
     return h.states.col(it - h.times.begin());
@@ -163,7 +163,7 @@ ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
     s.dt = t1 - t0;
     s.state_old = state_at(t0);
     s.state_new = state_at(t1);
-    StepLoad load = step_load(full, spec, t0, t1, twin.model.basis * s.state_old);
+    StepLoad load = step_load(full, spec, t0, t1, model.basis * s.state_old);
     s.load = std::move(load.load);
     s.film = std::move(load.film);
     double last_switch = 0;
@@ -172,7 +172,7 @@ ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
     s.horizon = t1 - last_switch;
     steps.push_back(std::move(s));
   }
-  return error_indicator(full, twin.model, steps);
+  return error_indicator(full, model, steps);
 }
 
 Eigen::MatrixXd full_outputs_history(const FullThermalSystem& full, const TwinOutputs& outputs,

@@ -69,10 +69,10 @@ struct TwinRun {
 };
 TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& progress = {});
 
-/// The error indicator of the twin's run of `spec`: the full-order residual, in kelvin, of the
+/// The error indicator of a reduced run of `spec` (the twin's model, or any reduced model): the full-order residual, in kelvin, of the
 /// steps that end at up to `samples` output times (spread evenly, the last included). Backward
 /// Euler only: for a Crank-Nicolson case it throws SolverError (use run --verify).
-ErrorIndicator twin_indicator(const FullThermalSystem& full, const Twin& twin,
+ErrorIndicator twin_indicator(const FullThermalSystem& full, const ReducedModel& model,
                               const core::CaseSpec& spec, int samples = 12);
 
 /// The same outputs from the full system (one stepper, full order): #times x #outputs.
