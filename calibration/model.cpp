@@ -17,8 +17,6 @@ namespace tt::calibration {
 
 namespace {
 
-constexpr double kCelsius = 273.15;
-
 /// Barycentric coordinates of p in tet `e` from its corners, without throwing on bad tets.
 Eigen::Vector4d barycentric(const mesh::TetMesh& m, int e, const Eigen::Vector3d& p) {
   Eigen::Matrix3d a;
@@ -118,7 +116,7 @@ Readout located(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
   for (size_t p = 0; p < run.displacements.size(); ++p)
     if (run.displacements[p].point && run.displacements[p].direction)
       probes.push_back(static_cast<int>(p));
-  r.reference_k = spec.mechanical.reference_temperature_c + kCelsius;
+  r.reference_k = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
   r.displacement.resize(0, n);
   if (!probes.empty() && spec.mechanical.enabled) {
     for (int p : probes) {

@@ -61,7 +61,7 @@ TEST(March, DeclaredChannelsEqualRunWithMovingAndFeedPowerHeat) {
     EXPECT_LE(max_relative(simulated_channels(m, spec, r, run.time), from_run), 1e-10) << scheme;
 
     // The loads are there: the feed_power pad and the stroke warm up, the far end least.
-    const double t0 = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+    const double t0 = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
     const Eigen::RowVectorXd rise = march_out.base.row(run.time.size() - 1).array() - t0;
     EXPECT_GT(rise(3), 0.01) << scheme;  // the pad's feed_power source (2.88 W for 300 s)
     EXPECT_GT(rise(0), rise(2) + 0.05) << scheme;
