@@ -315,10 +315,6 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
                             const Checkpointing& checkpointing) {
   using Scheme = core::TimeScheme;
   const Scheme scheme = spec.thermal.scheme;
-  if (scheme == Scheme::bdf2)
-    throw core::SolverError(
-        "thermal.scheme = \"bdf2\" is not implemented: use \"backward_euler\" "
-        "or \"crank_nicolson\"");
   const Eigen::Index n = sys.states();
   const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const double end = spec.duty_cycle.end;
