@@ -318,7 +318,7 @@ solvers::LoadCallback load_callback(const solvers::LinearThermalSystem<Matrix>& 
               if (scale == 0) return Eigen::VectorXd::Zero(ops.states()).eval();
               const auto& c = conv[f.entry];
               return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {
-                const double sink = solvers::table_value(c.sink, t) + solvers::kCelsiusOffset;
+                const double sink = solvers::table_value(c.sink, t) + core::kCelsiusOffset;
                 return Eigen::VectorXd(-scale *
                                        (ops.film[f.entry] * temp - sink * ops.film_area[f.entry]));
               });
