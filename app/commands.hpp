@@ -79,7 +79,8 @@ int mesh_command(const MeshArgs& args);
 int reduce_command(const ReduceArgs& args);
 int fit_data_command(const FitDataArgs& args);
 int calibrate_data_command(const CalibrateArgs& args);
-/// calibrate --case CASE (implemented in calibration's driver; a stub until it is wired).
+/// calibrate --case CASE: the declared model's residual on measured runs traced to a missing
+/// effect, the augmented case evaluated on the test runs (app/calibrate_case_command.cpp).
 int calibrate_command_with_case(const CalibrateArgs& args);
 int fit_command(const FitArgs& args);
 int place_command(const PlaceArgs& args);

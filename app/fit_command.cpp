@@ -13,6 +13,7 @@
 #include "app/network_candidate.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "fitting/group.hpp"
 #include "fitting/metrics.hpp"
 #include "fitting/models.hpp"
@@ -47,7 +48,8 @@ fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResul
   return g;
 }
 
-std::vector<int> indices_of(const std::vector<fitting::Group>& groups, const std::vector<std::string>& names) {
+std::vector<int> indices_of(const std::vector<fitting::Group>& groups,
+                            const std::vector<std::string>& names) {
   std::vector<int> out;
   for (const auto& n : names)
     for (size_t i = 0; i < groups.size(); ++i)
@@ -56,13 +58,15 @@ std::vector<int> indices_of(const std::vector<fitting::Group>& groups, const std
 }
 
 /// Placement on the fitting groups laid end to end (times shifted so they increase).
-placement::PlacementResult placement_on(const std::vector<fitting::Group>& groups, const std::vector<int>& fit,
+placement::PlacementResult placement_on(const std::vector<fitting::Group>& groups,
+                                        const std::vector<int>& fit,
                                         const Eigen::MatrixX3d& positions, std::uint64_t seed) {
   Eigen::Index rows = 0;
   for (int i : fit) rows += groups[i].time.size();
   placement::PlacementInput in;
   const auto& g0 = groups[fit[0]];
-  for (size_t c = 0; c < g0.sensor_names.size(); ++c) in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
+  for (size_t c = 0; c < g0.sensor_names.size(); ++c)
+    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
   in.positions_m = positions;
   in.times_s.resize(rows);
   in.temperatures_K.resize(rows, g0.temperature.cols());
@@ -88,7 +92,8 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
 }
 
 /// Sensor sets per placement method and m for one target, as fitting takes them.
-std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p, int target, int max_m) {
+std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p, int target,
+                                            int max_m) {
   std::vector<fitting::SensorSet> sets;
   for (const auto& s : p.targets[target].selections) {
     if (s.m > max_m) continue;
@@ -98,7 +103,8 @@ std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p,
 }
 
 /// Mean over groups of the standard deviation of the uncompensated error [m].
-double uncompensated_std(const std::vector<fitting::Group>& groups, const std::vector<int>& which, int target) {
+double uncompensated_std(const std::vector<fitting::Group>& groups, const std::vector<int>& which,
+                         int target) {
   double sum = 0;
   for (int i : which) {
     const Eigen::VectorXd e = groups[i].error.col(target);
@@ -123,15 +129,20 @@ int fit_command(const FitArgs& args) {
   const auto& results = campaign.results;
   std::vector<fitting::Group> groups;
   for (size_t i = 0; i < results.size(); ++i)
-    groups.push_back(fitting::noisy_group(group_of(spec, results[i]), fitting::SensorNoise{}, spec.seed, i));
-  fitting::Split split{indices_of(groups, kFitting), indices_of(groups, kValidation), indices_of(groups, kTest)};
+    groups.push_back(
+        fitting::noisy_group(group_of(spec, results[i]), fitting::SensorNoise{}, spec.seed, i));
+  fitting::Split split{indices_of(groups, kFitting), indices_of(groups, kValidation),
+                       indices_of(groups, kTest)};
   fitting::require_valid_split(split, static_cast<int>(groups.size()));
   // 3. Placement on the fitting groups only.
-  const Histories first = histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
-  const placement::PlacementResult placed = placement_on(groups, split.fitting, first.positions, spec.seed);
+  const Histories first =
+      histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
+  const placement::PlacementResult placed =
+      placement_on(groups, split.fitting, first.positions, spec.seed);
   // 4. Per target: choose model, settings and placement method on validation; test; count sensors.
   std::vector<fitting::ModelSpec> specs =
-      args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}} : fitting::default_model_candidates();
+      args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
+                 : fitting::default_model_candidates();
   if (args.network) specs.push_back(driver_network_spec(spec.seed));
   std::map<std::string, NetworkFigures> networks;
   std::vector<fitting::Evaluation> evals;
@@ -142,7 +153,8 @@ int fit_command(const FitArgs& args) {
     // named apart from the placement module's correlation ranking (which leaves twins out), so
     // that the two never share a column of sensor_count_<target>.csv.
     const auto standard_sets = [&](int count) {
-      auto sets = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting), target, count);
+      auto sets = fitting::correlation_sensor_sets(fitting::group_subset(groups, split.fitting),
+                                                   target, count);
       for (auto& s : sets) s.method = "db3401_correlation";
       return sets;
     };
@@ -157,7 +169,8 @@ int fit_command(const FitArgs& args) {
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
     const auto corr6 = standard_sets(6);
     all.insert(all.end(), corr6.begin(), corr6.end());
-    tables.push_back(fitting::sensor_count_table(groups, split, target, all, specs, args.required_sm_um * 1e-6));
+    tables.push_back(
+        fitting::sensor_count_table(groups, split, target, all, specs, args.required_sm_um * 1e-6));
     const auto& e = evals.back();
     const double drift = uncompensated_std(groups, split.test, target);
     const auto& chosen = e.sensor_sets[e.selection.candidates[e.selection.best].sensor_set];
@@ -174,7 +187,8 @@ int fit_command(const FitArgs& args) {
       // The network's own held-out figures beside the chosen model's, on the same groups.
       std::vector<int> refit = split.fitting;
       refit.insert(refit.end(), split.validation.begin(), split.validation.end());
-      if (auto n = network_figures(e, fitting::group_subset(groups, refit), fitting::group_subset(groups, split.test))) {
+      if (auto n = network_figures(e, fitting::group_subset(groups, refit),
+                                   fitting::group_subset(groups, split.test))) {
         const std::string& name = groups[0].target_names[target];
         summary[name]["network"] = network_json(*n);
         summary[name]["network"]["test_sm_over_uncompensated"] = n->test.sm / drift;
@@ -191,7 +205,9 @@ int fit_command(const FitArgs& args) {
   doc["model"] = campaign.model;
   doc["campaign"] = nlohmann::json::array();
   for (const auto& r : runs)
-    doc["campaign"].push_back({{"name", r.name}, {"shape", r.shape}, {"hours", r.spec.duty_cycle.end / 3600.0},
+    doc["campaign"].push_back({{"name", r.name},
+                               {"shape", r.shape},
+                               {"hours", r.spec.duty_cycle.end / 3600.0},
                                {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
   io::write_json(dir / "fit.json", doc);
   for (const auto& [name, n] : networks)
@@ -200,12 +216,14 @@ int fit_command(const FitArgs& args) {
   conditions.machine_model = spec.machine.empty() ? spec.name : spec.machine;
   conditions.machine_number = "virtual";
   conditions.modelling_date = "2026-11-21";
-  conditions.initial_ambient_temperature = spec.thermal.initial_temperature_c + 273.15;
+  conditions.initial_ambient_temperature =
+      spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   double max_speed = 0;
   for (const auto& r : runs)
     for (const auto& s : r.spec.duty_cycle.segments) max_speed = std::max(max_speed, s.speed_rpm);
   conditions.max_spindle_speed = max_speed * 2 * 3.14159265358979323846 / 60;
-  io::write_modelling_record(dir / "modelling_record.json", dir / "modelling_record.md", conditions, evals);
+  io::write_modelling_record(dir / "modelling_record.json", dir / "modelling_record.md", conditions,
+                             evals);
   std::vector<fitting::FittedModel> models;
   for (const auto& e : evals) models.push_back(e.model);
   io::write_compensation_csv(dir / "compensation.csv", models, groups);
@@ -216,7 +234,8 @@ int fit_command(const FitArgs& args) {
     for (const auto& m : methods) header.push_back(m + "_test_sm_um");
     int max_m = 0;
     for (const auto& row : t.rows) max_m = std::max(max_m, row.m);
-    Eigen::MatrixXd rows = Eigen::MatrixXd::Constant(max_m, static_cast<Eigen::Index>(header.size()), std::nan(""));
+    Eigen::MatrixXd rows =
+        Eigen::MatrixXd::Constant(max_m, static_cast<Eigen::Index>(header.size()), std::nan(""));
     for (int m = 1; m <= max_m; ++m) rows(m - 1, 0) = m;
     for (const auto& row : t.rows) {
       const auto col = 1 + std::distance(methods.begin(), methods.find(row.method));

@@ -1,17 +1,28 @@
-// thermotwin: the command-line driver.
-//   thermotwin mesh CASE --out DIR   mesh a case: mesh.vtu, boundary.vtp, points.vtp, mesh_report.json
-//   thermotwin run CASE --out DIR    simulate it: fields.pvd, temperatures.csv, thermal_error.csv, summary.json
-//   thermotwin reduce CASE --out DIR its reduced-order twin, validated against the full model
-//   thermotwin place / fit / calibrate / probes: sensor placement, error models, the loop, probes
+// thermotwin: the command-line driver. Each command reads its flags and inputs, runs, and writes
+// one output directory (README.md "Commands" lists every file it holds):
+//   mesh CASE --out DIR            the mesh: mesh.vtu, boundary.vtp, points.vtp, mesh_report.json
+//   run CASE --out DIR             the simulation: fields.pvd, temperatures.csv, thermal_error.csv,
+//                                  summary.json (with --rom DIR, from a reduced model)
+//   reduce CASE --out DIR          the reduced-order twin, validated against the full model
+//   place CASE --out DIR           sensor placement (or --from RUNDIR): placement.json
+//   fit CASE --out DIR             error models on a virtual campaign: fit.json, modelling record;
+//                                  with --data RUN... instead of CASE, on measured runs
+//   calibrate --case CASE --train RUN... --test RUN... --out DIR
+//                                  what the model lacks on measured runs, before and after;
+//                                  without --case, from the data alone
+//   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
+//   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
+#include <string>
 
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
+#include "app/version.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
@@ -20,23 +31,34 @@ int main(int argc, char** argv) {
   using namespace tt::app;
   CLI::App cli{"thermotwin: thermal twin of a machine tool"};
   cli.require_subcommand(1);
+  const std::string git = tt::app::kGitDescribe;
+  cli.set_version_flag("--version", std::string("thermotwin ") + tt::app::kVersion +
+                                        (git.empty() ? "" : " (git " + git + ")"));
 
   MeshArgs mesh_args;
-  auto* mesh = cli.add_subcommand("mesh", "Mesh a case and write the mesh, its boundary and named points");
-  mesh->add_option("case", mesh_args.case_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
+  auto* mesh =
+      cli.add_subcommand("mesh", "Mesh a case and write the mesh, its boundary and named points");
+  mesh->add_option("case", mesh_args.case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
   mesh->add_option("--out", mesh_args.out, "output directory")->required();
 
   RunArgs run_args;
-  auto* run = cli.add_subcommand("run", "Simulate a case: heat transfer, thermo-elasticity, thermal error");
-  run->add_option("case", run_args.case_file, "case file (TOML)")->required()->check(CLI::ExistingFile);
+  auto* run =
+      cli.add_subcommand("run", "Simulate a case: heat transfer, thermo-elasticity, thermal error");
+  run->add_option("case", run_args.case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
   run->add_option("--out", run_args.out, "output directory")->required();
   run->add_flag("--quiet", run_args.quiet, "no progress on stderr");
-  run->add_flag("--resume", run_args.resume, "continue from OUT.checkpoint, left by an interrupted run");
+  run->add_flag("--resume", run_args.resume,
+                "continue from OUT.checkpoint, left by an interrupted run");
   run->add_option("--checkpoint-every-s", run_args.checkpoint_every_s,
                   "wall time between checkpoints of the time loop (default 600; negative: none)")
       ->check(finite_number());
-  run->add_option("--rom", run_args.rom,
-                  "a reduced model (thermotwin reduce CASE --out DIR): the thermal transient from it")
+  run->add_option(
+         "--rom", run_args.rom,
+         "a reduced model (thermotwin reduce CASE --out DIR): the thermal transient from it")
       ->check(CLI::ExistingDirectory);
   run->add_flag("--verify", run_args.verify,
                 "with --rom: recompute the output times with the full model and report the "
@@ -64,12 +86,16 @@ int main(int argc, char** argv) {
   reduce->add_flag("--quiet", reduce_args.quiet, "no progress on stderr");
 
   ProbesArgs probes_args;
-  auto* probes = cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
-  auto* probes_in = probes->add_option("--in", probes_args.in, "raw probe readings (CSV, see docs/probes.md)")
-                        ->check(CLI::ExistingFile);
-  auto* probes_run = probes->add_option("--from-run", probes_args.from_run,
-                                        "make a virtual probe signal from a finished run's probe points")
-                         ->check(CLI::ExistingDirectory);
+  auto* probes =
+      cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
+  auto* probes_in =
+      probes->add_option("--in", probes_args.in, "raw probe readings (CSV, see docs/probes.md)")
+          ->check(CLI::ExistingFile);
+  auto* probes_run =
+      probes
+          ->add_option("--from-run", probes_args.from_run,
+                       "make a virtual probe signal from a finished run's probe points")
+          ->check(CLI::ExistingDirectory);
   probes_in->excludes(probes_run);
   probes->add_option("--out", probes_args.out, "output directory")->required();
   probes->add_option("--truth", probes_args.truth, "true drift CSV to score the methods against");
@@ -87,13 +113,17 @@ int main(int argc, char** argv) {
       ->check(positive_number());
 
   PlaceArgs place_args;
-  auto* place = cli.add_subcommand("place", "Sensor placement: the patent's MI + GA method and stronger criteria");
-  auto* place_case = place->add_option("case", place_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
-  auto* place_from = place->add_option("--from", place_args.from_run, "a finished run directory instead of a case")
-                         ->check(CLI::ExistingDirectory);
+  auto* place = cli.add_subcommand(
+      "place", "Sensor placement: the patent's MI + GA method and stronger criteria");
+  auto* place_case =
+      place->add_option("case", place_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
+  auto* place_from =
+      place->add_option("--from", place_args.from_run, "a finished run directory instead of a case")
+          ->check(CLI::ExistingDirectory);
   place_case->excludes(place_from);
   place->add_option("--out", place_args.out, "output directory")->required();
-  place->add_option("--samples", place_args.samples, "S, samples the histories are resampled to (patent: 100)");
+  place->add_option("--samples", place_args.samples,
+                    "S, samples the histories are resampled to (patent: 100)");
   place->add_option("--bins", place_args.bins, "N = M, histogram bins (patent: 20 to 40)");
   place->add_option("--m-max", place_args.m_max, "largest number of sensors");
   place->add_flag("--sensor-noise", place_args.sensor_noise,
@@ -107,10 +137,13 @@ int main(int argc, char** argv) {
                   "simulate in full order (default: a reduced model built on the fly)");
 
   FitArgs fit_args;
-  auto* fit = cli.add_subcommand("fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
+  auto* fit = cli.add_subcommand(
+      "fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
   FitDataArgs fit_data_args;
-  auto* fit_case = fit->add_option("case", fit_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
-  auto* fit_data = fit->add_option("--data", fit_data_args.runs, "measured runs (docs/measured-data.md) instead of a case")
+  auto* fit_case =
+      fit->add_option("case", fit_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
+  auto* fit_data = fit->add_option("--data", fit_data_args.runs,
+                                   "measured runs (docs/measured-data.md) instead of a case")
                        ->check(CLI::ExistingDirectory);
   fit_case->excludes(fit_data);
   fit->add_option("--test-from-s", fit_data_args.test_from_s,
@@ -140,11 +173,15 @@ int main(int argc, char** argv) {
                 "the campaign in full order (default: a reduced model built on the fly)");
 
   CalibrateArgs calibrate_args;
-  auto* calibrate = cli.add_subcommand("calibrate", "Close the loop on measured runs: what the model lacks, before/after");
-  calibrate->add_option("--case", calibrate_args.case_file, "case file (TOML): the model-based path")
+  auto* calibrate = cli.add_subcommand(
+      "calibrate", "Close the loop on measured runs: what the model lacks, before/after");
+  calibrate
+      ->add_option("--case", calibrate_args.case_file, "case file (TOML): the model-based path")
       ->check(CLI::ExistingFile);
-  calibrate->add_option("--train", calibrate_args.train, "measured runs to fit and study on")->check(CLI::ExistingDirectory);
-  calibrate->add_option("--test", calibrate_args.test, "held-out measured runs")->check(CLI::ExistingDirectory);
+  calibrate->add_option("--train", calibrate_args.train, "measured runs to fit and study on")
+      ->check(CLI::ExistingDirectory);
+  calibrate->add_option("--test", calibrate_args.test, "held-out measured runs")
+      ->check(CLI::ExistingDirectory);
   calibrate
       ->add_option("--split-s", calibrate_args.split_s,
                    "a run in both --train and --test: train before, test from")
@@ -179,7 +216,8 @@ int main(int argc, char** argv) {
         fit_data_args.quiet = fit_args.quiet;
         return fit_data_command(fit_data_args);
       }
-      if (fit_args.case_file.empty()) throw tt::core::CaseError("fit: give a case file or --data RUN...");
+      if (fit_args.case_file.empty())
+        throw tt::core::CaseError("fit: give a case file or --data RUN...");
       return fit_command(fit_args);
     }
     if (*calibrate) {

@@ -9,6 +9,7 @@
 #include "app/commands.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/axis_out.hpp"
 #include "io/candidates_csv.hpp"
@@ -27,25 +28,31 @@ namespace tt::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
-void write_mesh_files(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const std::filesystem::path& dir) {
+void write_mesh_files(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                      const std::filesystem::path& dir) {
   io::write_mesh_vtu(mesh, dir / "mesh.vtu");
   io::write_boundary_vtp(mesh, dir / "boundary.vtp");
   io::write_points_vtp(mesh, dir / "points.vtp");
-  io::write_json(dir / "mesh_report.json", io::mesh_report_json(mesh, mesh::mesh_report(mesh, spec)));
+  io::write_json(dir / "mesh_report.json",
+                 io::mesh_report_json(mesh, mesh::mesh_report(mesh, spec)));
   io::write_file_atomically(dir / "case.resolved.toml", io::resolved_case_toml(spec));
 }
 
 /// temperatures.csv: time_s, then <id>_degC per named point.
-void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory& th, const std::filesystem::path& path) {
+void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory& th,
+                        const std::filesystem::path& path) {
   std::vector<std::string> header{"time_s"};
   for (const auto& p : mesh.points) header.push_back(p.id + "_degC");
-  Eigen::MatrixXd rows(static_cast<Eigen::Index>(th.times.size()), static_cast<Eigen::Index>(header.size()));
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(th.times.size()),
+                       static_cast<Eigen::Index>(header.size()));
   for (size_t t = 0; t < th.times.size(); ++t) {
     rows(t, 0) = th.times[t];
     for (size_t i = 0; i < mesh.points.size(); ++i)
-      rows(t, i + 1) = th.temperature(mesh.points[i].node, t) - solvers::kCelsiusOffset;
+      rows(t, i + 1) = th.temperature(mesh.points[i].node, t) - core::kCelsiusOffset;
   }
   io::write_csv(path, header, rows);
 }
@@ -61,7 +68,7 @@ void write_candidates(const CandidateSet& set, const solvers::ThermalHistory& th
                        static_cast<Eigen::Index>(header.size()));
   rows.col(0) = Eigen::Map<const Eigen::VectorXd>(th.times.data(), rows.rows());
   rows.rightCols(rows.cols() - 1) =
-      solvers::nodal_history(th, set.nodes).array() - solvers::kCelsiusOffset;
+      solvers::nodal_history(th, set.nodes).array() - core::kCelsiusOffset;
   io::write_csv(dir / kCandidateTemperaturesCsv, header, rows);
 }
 
@@ -85,18 +92,18 @@ void write_thermal_error(const solvers::ThermalHistory& th, const solvers::Therm
   io::write_csv(path, header, rows);
 }
 
-void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const solvers::VirtualRun& run,
-                  const std::filesystem::path& dir) {
+void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                  const solvers::VirtualRun& run, const std::filesystem::path& dir) {
   io::FieldSeriesWriter writer(mesh, dir, "fields");
   const auto& th = run.thermal;
-  const double t0_k = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   double next = 0;
   for (size_t t = 0; t < th.times.size(); ++t) {
     const bool last = t + 1 == th.times.size();
     if (th.times[t] + 1e-9 < next && !last) continue;
     next = th.times[t] + spec.outputs.fields_interval;
     const Eigen::VectorXd temp = th.temperature.col(static_cast<Eigen::Index>(t));
-    std::vector<io::NamedField> point{{"temperature_degC", 1, temp.array() - solvers::kCelsiusOffset},
+    std::vector<io::NamedField> point{{"temperature_degC", 1, temp.array() - core::kCelsiusOffset},
                                       {"temperature_rise_K", 1, temp.array() - t0_k}};
     if (run.elastic) {
       const Eigen::VectorXd u = run.elastic->displacement.col(static_cast<Eigen::Index>(t));
@@ -115,7 +122,8 @@ void write_dump(const solvers::VirtualRun& run, const std::filesystem::path& pat
   const auto put_matrix = [&](const Eigen::MatrixXd& m) {
     const std::int64_t shape[2] = {m.rows(), m.cols()};
     bytes.append(reinterpret_cast<const char*>(shape), sizeof shape);
-    bytes.append(reinterpret_cast<const char*>(m.data()), static_cast<size_t>(m.size()) * sizeof(double));
+    bytes.append(reinterpret_cast<const char*>(m.data()),
+                 static_cast<size_t>(m.size()) * sizeof(double));
   };
   put_matrix(run.thermal.temperature);
   if (run.elastic) put_matrix(run.elastic->displacement);
@@ -149,7 +157,8 @@ void report_progress(const std::string& stage, double done, double total) {
   const int decile = static_cast<int>(std::floor(10 * done / total + 1e-9));
   if (decile == last_decile) return;
   last_decile = decile >= 10 ? -1 : decile;
-  std::cerr << "thermotwin: " << stage << " " << 10 * decile << " % (t = " << done << " s of " << total << " s)\n";
+  std::cerr << "thermotwin: " << stage << " " << 10 * decile << " % (t = " << done << " s of "
+            << total << " s)\n";
 }
 
 int mesh_command(const MeshArgs& args) {
@@ -161,8 +170,8 @@ int mesh_command(const MeshArgs& args) {
   // 3. Write the mesh, its boundary, the named points and the report, all or nothing.
   write_mesh_files(mesh, spec, out.path());
   out.commit();
-  std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets -> "
-            << args.out.string() << "\n";
+  std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows()
+            << " tets -> " << args.out.string() << "\n";
   return 0;
 }
 
@@ -190,8 +199,8 @@ int run_command(const RunArgs& args) {
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const double mesh_s = seconds_since(t_mesh);
   if (!args.quiet)
-    std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows() << " tets ("
-              << mesh_s << " s)\n";
+    std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows()
+              << " tets (" << mesh_s << " s)\n";
   // A reduced model, when given, must have been built for this machine and mesh.
   std::optional<io::ReducedModelFile> rom;
   if (!args.rom.empty()) {
@@ -201,7 +210,8 @@ int run_command(const RunArgs& args) {
     rom = io::read_reduced_model(args.rom);
     io::check_reduced_model_fits(*rom, io::reduced_model_key(spec, mesh), args.rom);
   } else if (args.verify) {
-    throw core::CaseError("run: --verify compares a reduced run with the full model: give --rom DIR");
+    throw core::CaseError(
+        "run: --verify compares a reduced run with the full model: give --rom DIR");
   }
   // Surface vertices that are candidate sensors: their histories go to candidate_temperatures.csv.
   std::optional<CandidateSet> candidates;
@@ -214,9 +224,11 @@ int run_command(const RunArgs& args) {
   std::optional<solvers::ThermalCheckpoint> resumed;
   if (args.resume && std::filesystem::exists(checkpoint)) {
     resumed = io::read_checkpoint(checkpoint, key);
-    std::cerr << "thermotwin: resuming at t = " << resumed->time << " s (step " << resumed->steps << ")\n";
+    std::cerr << "thermotwin: resuming at t = " << resumed->time << " s (step " << resumed->steps
+              << ")\n";
   } else if (args.resume) {
-    std::cerr << "thermotwin: note: no checkpoint at " << checkpoint.string() << "; starting at t = 0\n";
+    std::cerr << "thermotwin: note: no checkpoint at " << checkpoint.string()
+              << "; starting at t = 0\n";
   }
   solvers::Checkpointing checkpointing;
   checkpointing.interval_s = args.stop_after_steps > 0 ? 0 : args.checkpoint_every_s;
@@ -272,7 +284,8 @@ int run_command(const RunArgs& args) {
     io::write_axis_polynomial_csv(dir / "axis_polynomial.csv", run.thermal.times, *axis_poly);
   }
   if (run.error)
-    write_thermal_error(run.thermal, *run.error, axis ? &*axis : nullptr, dir / "thermal_error.csv");
+    write_thermal_error(run.thermal, *run.error, axis ? &*axis : nullptr,
+                        dir / "thermal_error.csv");
   if (spec.outputs.fields) write_fields(mesh, spec, run, dir);
   const double write_s = seconds_since(t_write);
 
@@ -296,7 +309,7 @@ int run_command(const RunArgs& args) {
   }
   summary["steps"] = run.thermal.timings.steps;
   summary["factorizations"] = run.thermal.timings.factorizations;
-  summary["peak_temperature_degC"] = run.thermal.temperature.maxCoeff() - solvers::kCelsiusOffset;
+  summary["peak_temperature_degC"] = run.thermal.temperature.maxCoeff() - core::kCelsiusOffset;
   summary["energy_balance"] = {{"heat_in_J", e.heat_in},
                                {"heat_in_from_laws_J", e.heat_in_law},
                                {"stored_J", e.stored},
@@ -316,7 +329,8 @@ int run_command(const RunArgs& args) {
   }
   if (run.error) {
     const auto last = run.error->values.bottomRows(1);
-    summary["thermal_error_at_end_um"] = {{"dx", last(0, 0) * 1e6}, {"dy", last(0, 1) * 1e6}, {"dz", last(0, 2) * 1e6}};
+    summary["thermal_error_at_end_um"] = {
+        {"dx", last(0, 0) * 1e6}, {"dy", last(0, 1) * 1e6}, {"dz", last(0, 2) * 1e6}};
   }
   if (axis) summary["feed_axis_error"] = io::axis_summary_json(*axis, *axis_poly);
   timings["total_s"] = seconds_since(t_start);
@@ -326,7 +340,8 @@ int run_command(const RunArgs& args) {
   // 5. Figures (patent figures 3 and 4), when matplotlib is there.
   if (!spec.outputs.plot_points.empty()) {
     std::string cols;
-    for (const auto& id : spec.outputs.plot_points) cols += (cols.empty() ? "" : ",") + id + "_degC";
+    for (const auto& id : spec.outputs.plot_points)
+      cols += (cols.empty() ? "" : ",") + id + "_degC";
     plot({"temperatures", (dir / "temperatures.csv").string(),
           (dir / "temperature_rise.png").string(), "--columns=" + cols, "--rise-from-first",
           "--title=" + spec.name + ": temperature rise"});
@@ -338,7 +353,8 @@ int run_command(const RunArgs& args) {
   out.commit();
   std::error_code no_checkpoint;
   std::filesystem::remove(checkpoint, no_checkpoint);
-  std::cerr << "thermotwin: run: done in " << seconds_since(t_start) << " s -> " << args.out.string() << "\n";
+  std::cerr << "thermotwin: run: done in " << seconds_since(t_start) << " s -> "
+            << args.out.string() << "\n";
   return 0;
 }
 

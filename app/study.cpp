@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "io/candidates_csv.hpp"
 #include "io/case_reader.hpp"
 #include "io/csv_out.hpp"
@@ -51,7 +52,8 @@ std::vector<int> candidate_points(const core::CaseSpec& spec) {
       continue;
     out.push_back(static_cast<int>(i));
   }
-  if (out.empty()) throw core::CaseError(spec.source.string() + ": no named points to use as candidate sensors");
+  if (out.empty())
+    throw core::CaseError(spec.source.string() + ": no named points to use as candidate sensors");
   return out;
 }
 
@@ -136,10 +138,12 @@ Histories histories_from_nodes(const core::CaseSpec& spec, const CandidateSet& c
 }
 
 Histories histories_from_points(const core::CaseSpec& spec, const std::vector<double>& times,
-                                const Eigen::MatrixXd& point_temperature, const Eigen::MatrixXd& error) {
+                                const Eigen::MatrixXd& point_temperature,
+                                const Eigen::MatrixXd& error) {
   const std::vector<int> cand = candidate_points(spec);
   Histories h;
-  h.times = Eigen::Map<const Eigen::VectorXd>(times.data(), static_cast<Eigen::Index>(times.size()));
+  h.times =
+      Eigen::Map<const Eigen::VectorXd>(times.data(), static_cast<Eigen::Index>(times.size()));
   h.positions.resize(static_cast<Eigen::Index>(cand.size()), 3);
   h.temperature.resize(point_temperature.rows(), static_cast<Eigen::Index>(cand.size()));
   for (size_t c = 0; c < cand.size(); ++c) {
@@ -165,7 +169,8 @@ Histories histories_from_run(const std::filesystem::path& dir) {
                           "; hint: run the case again with this version of thermotwin");
   const io::CsvTable temps = io::read_numeric_csv(temps_file);
   const io::CsvTable err = io::read_numeric_csv(dir / "thermal_error.csv");
-  if (temps.rows.rows() != err.rows.rows() || (temps.column("time_s") - err.column("time_s")).cwiseAbs().maxCoeff() > 1e-6)
+  if (temps.rows.rows() != err.rows.rows() ||
+      (temps.column("time_s") - err.column("time_s")).cwiseAbs().maxCoeff() > 1e-6)
     throw core::DataError((dir / "thermal_error.csv").string() + ": times differ from " +
                           temps_file.filename().string());
   Eigen::MatrixXd error = Eigen::MatrixXd::Zero(err.rows.rows(), solvers::kThermalErrorColumns);
@@ -180,14 +185,15 @@ Histories histories_from_run(const std::filesystem::path& dir) {
                                      static_cast<Eigen::Index>(set.names.size()));
     for (size_t c = 0; c < set.names.size(); ++c)
       node_temperature.col(static_cast<Eigen::Index>(c)) =
-          temps.rows.col(temps.column_index(set.names[c] + "_degC")).array() +
-          solvers::kCelsiusOffset;
+          temps.rows.col(temps.column_index(set.names[c] + "_degC")).array() + core::kCelsiusOffset;
     return histories_from_nodes(spec, set, times, node_temperature, error);
   }
-  Eigen::MatrixXd point_temperature(temps.rows.rows(), static_cast<Eigen::Index>(spec.points.size()));
+  Eigen::MatrixXd point_temperature(temps.rows.rows(),
+                                    static_cast<Eigen::Index>(spec.points.size()));
   for (size_t i = 0; i < spec.points.size(); ++i) {
     const int col = temps.column_index(spec.points[i].id + "_degC");
-    point_temperature.col(static_cast<Eigen::Index>(i)) = temps.rows.col(col).array() + solvers::kCelsiusOffset;
+    point_temperature.col(static_cast<Eigen::Index>(i)) =
+        temps.rows.col(col).array() + core::kCelsiusOffset;
   }
   return histories_from_points(spec, times, point_temperature, error);
 }

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/units.hpp"
 #include "fitting/models.hpp"
 #include "fitting/segments.hpp"
 #include "io/measured_data.hpp"
@@ -96,7 +97,7 @@ std::vector<io::MeasuredRun> runs_of(const Table& t, const std::string& run_colu
       r.time(i) = row[static_cast<std::size_t>(sc)] * step_s;
       for (std::size_t c = 0; c < temperature_columns.size(); ++c)
         r.temperature(i, static_cast<Eigen::Index>(c)) =
-            row[static_cast<std::size_t>(column(t, temperature_columns[c]))] + 273.15;
+            row[static_cast<std::size_t>(column(t, temperature_columns[c]))] + core::kCelsiusOffset;
       r.displacement(i, 0) = row[static_cast<std::size_t>(ec)] * 1e-6;
     }
     runs.push_back(std::move(r));

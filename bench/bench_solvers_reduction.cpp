@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
                 static_cast<int>(mesh.tets.rows()), mesh.order, mesh_s, seconds_since(t));
     std::vector<int> points;
     for (const auto& p : spec.points) points.push_back(tt::mesh::named_node(mesh, p.id));
-    const double t0_k = spec.thermal.initial_temperature_c + s::kCelsiusOffset;
+    const double t0_k = spec.thermal.initial_temperature_c + tt::core::kCelsiusOffset;
 
     // 2. The bases.
     std::vector<Variant> variants;

@@ -17,8 +17,6 @@ namespace tt::calibration {
 
 namespace {
 
-constexpr double kCelsius = 273.15;
-
 /// Whitened residual rows of one run: vec(#samples x #channels) / sigma, with the mask of rows.
 struct Whitened {
   Eigen::VectorXd y;               /// kept rows
@@ -394,7 +392,7 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       }
     }
     // Heat that grows with the source's temperature.
-    const double t0_k = declared.thermal.initial_temperature_c + kCelsius;
+    const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
     for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
       const auto& srcspec = declared.thermal.sources[i];
       Candidate c;

@@ -6,6 +6,7 @@
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/elastic.hpp"
 #include "solvers/loads.hpp"
@@ -14,8 +15,6 @@
 namespace tt::calibration {
 
 namespace {
-
-constexpr double kCelsius = 273.15;
 
 double uniform(std::mt19937_64& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
@@ -343,10 +342,10 @@ io::MeasuredRun with_noise(const io::MeasuredRun& clean, const GeneratorOptions&
       const double dt = i ? run.time(i) - run.time(i - 1) : 0.0;
       const double a = std::exp(-dt / 600.0);
       drift = a * drift + std::sqrt(1 - a * a) * o.drift_temperature_K * normal(rng);
-      run.temperature(i, s) =
-          quantise(run.temperature(i, s) - kCelsius + o.noise_temperature_K * normal(rng) + drift,
-                   o.quantum_temperature_K) +
-          kCelsius;
+      run.temperature(i, s) = quantise(run.temperature(i, s) - core::kCelsiusOffset +
+                                           o.noise_temperature_K * normal(rng) + drift,
+                                       o.quantum_temperature_K) +
+                              core::kCelsiusOffset;
     }
   }
   for (Eigen::Index p = 0; p < run.displacement.cols(); ++p)

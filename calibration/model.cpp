@@ -17,8 +17,6 @@ namespace tt::calibration {
 
 namespace {
 
-constexpr double kCelsius = 273.15;
-
 /// Barycentric coordinates of p in tet `e` from its corners, without throwing on bad tets.
 Eigen::Vector4d barycentric(const mesh::TetMesh& m, int e, const Eigen::Vector3d& p) {
   Eigen::Matrix3d a;
@@ -118,7 +116,7 @@ Readout located(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
   for (size_t p = 0; p < run.displacements.size(); ++p)
     if (run.displacements[p].point && run.displacements[p].direction)
       probes.push_back(static_cast<int>(p));
-  r.reference_k = spec.mechanical.reference_temperature_c + kCelsius;
+  r.reference_k = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
   r.displacement.resize(0, n);
   if (!probes.empty() && spec.mechanical.enabled) {
     for (int p : probes) {
@@ -320,7 +318,7 @@ solvers::LoadCallback load_callback(const solvers::LinearThermalSystem<Matrix>& 
               if (scale == 0) return Eigen::VectorXd::Zero(ops.states()).eval();
               const auto& c = conv[f.entry];
               return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {
-                const double sink = solvers::table_value(c.sink, t) + solvers::kCelsiusOffset;
+                const double sink = solvers::table_value(c.sink, t) + core::kCelsiusOffset;
                 return Eigen::VectorXd(-scale *
                                        (ops.film[f.entry] * temp - sink * ops.film_area[f.entry]));
               });

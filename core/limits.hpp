@@ -9,6 +9,8 @@
 #include <optional>
 #include <string>
 
+#include "core/units.hpp"
+
 namespace tt::core::limits {
 
 /// Bytes of a case file (TOML). The largest shipped case is about 12 kB.
@@ -29,7 +31,7 @@ inline constexpr std::int64_t kOutputTimes = 200'000;
 inline constexpr std::uintmax_t kHistoryBytes = std::uintmax_t(16) << 30;
 
 /// Absolute zero [degC]: no temperature given in degC may lie below it.
-inline constexpr double kAbsoluteZeroDegC = -273.15;
+inline constexpr double kAbsoluteZeroDegC = -kCelsiusOffset;
 
 // Defaults of the meshing bounds that a case may raise under [mesh].
 /// mesh.max_tets: tetrahedra estimated before TetGen starts. SB-1 refined is about 254 000.

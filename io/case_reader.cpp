@@ -14,6 +14,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -335,6 +336,30 @@ E choice_or(const Tab& t, std::string_view key, E fallback, const Choices<E>& ch
   return n ? choice(*t.ctx, *n, t.at(key), choices) : fallback;
 }
 
+// The names a case file gives each enum's values, read by `choice` and written back by
+// `resolved_case_toml`. A value the solvers cannot run has no name here, so the reader refuses it.
+const Choices<core::TimeScheme> kSchemes = {{"backward_euler", core::TimeScheme::backward_euler},
+                                            {"crank_nicolson", core::TimeScheme::crank_nicolson}};
+const Choices<core::FaceSelector::Side> kSides = {
+    {"exterior", core::FaceSelector::Side::exterior},
+    {"interface", core::FaceSelector::Side::interface},
+    {"any", core::FaceSelector::Side::any}};
+const Choices<core::HeatSource::Law> kLaws = {{"speed_power", core::HeatSource::Law::speed_power},
+                                              {"constant", core::HeatSource::Law::constant},
+                                              {"palmgren", core::HeatSource::Law::palmgren},
+                                              {"feed_power", core::HeatSource::Law::feed_power}};
+const Choices<core::PlacementSpec::Candidates> kCandidateKinds = {
+    {"points", core::PlacementSpec::Candidates::points},
+    {"surface", core::PlacementSpec::Candidates::surface}};
+
+/// The name `choices` gives `e`; every value of a spec read from a case has one.
+template <class E>
+const std::string& name_of(const Choices<E>& choices, E e) {
+  for (const auto& [name, value] : choices)
+    if (value == e) return name;
+  throw std::logic_error("case_reader: an enum value with no name in its table");
+}
+
 /// Index of `n`'s string among `names`; `what` names the kind ("body", "boundary group").
 int reference(const Ctx& c, const toml::node& n, const std::string& path, const Names& names,
               const std::string& what) {
@@ -634,9 +659,7 @@ core::FaceSelector read_selector(const Tab& s, const Names& bodies) {
   using Side = core::FaceSelector::Side;
   if (const auto* b = s.get("bodies"))
     sel.bodies = references(c, *b, s.at("bodies"), bodies, "body");
-  sel.side = choice_or<Side>(
-      s, "side", Side::exterior,
-      {{"exterior", Side::exterior}, {"interface", Side::interface}, {"any", Side::any}});
+  sel.side = choice_or<Side>(s, "side", Side::exterior, kSides);
   if (const auto* o = s.get("other_bodies")) {
     if (sel.side != Side::interface)
       fail_value(c, *o, s.at("other_bodies"), "only meaningful with side = \"interface\"",
@@ -871,10 +894,7 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
   auto& th = spec.thermal;
   th.initial_temperature_c =
       temperature_or(t, "initial_temperature_degC", th.initial_temperature_c);
-  th.scheme = choice_or<core::TimeScheme>(t, "scheme", th.scheme,
-                                          {{"backward_euler", core::TimeScheme::backward_euler},
-                                           {"crank_nicolson", core::TimeScheme::crank_nicolson},
-                                           {"bdf2", core::TimeScheme::bdf2}});
+  th.scheme = choice_or<core::TimeScheme>(t, "scheme", th.scheme, kSchemes);
   th.step = number_or(t, "step_s", th.step, Sign::positive, "the time step in s");
   th.output_interval = number_or(t, "output_interval_s", th.output_interval, Sign::positive,
                                  "time between written samples in s");
@@ -937,16 +957,12 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
     src.name = name(h, "name");
     unique(h, "name", src.name, names_of(th.sources), "heat source");
     src.body = reference(h, "body", bodies, "body");
-    src.law = choice_or<Law>(h, "law", Law::speed_power,
-                             {{"speed_power", Law::speed_power},
-                              {"constant", Law::constant},
-                              {"palmgren", Law::palmgren},
-                              {"feed_power", Law::feed_power}});
+    src.law = choice_or<Law>(h, "law", Law::speed_power, kLaws);
     const Names& used = src.law == Law::speed_power  ? law_keys_speed
                         : src.law == Law::constant   ? law_keys_const
                         : src.law == Law::feed_power ? law_keys_feed
                                                      : law_keys_palm;
-    const std::string law_name = h.get("law") ? as_string(c, *h.get("law"), "") : "speed_power";
+    const std::string& law_name = name_of(kLaws, src.law);
     for (auto&& [k, v] : *h.t) {
       const bool law_key = k.str() != "moving" && std::find(all_keys.begin() + 4, all_keys.end(),
                                                             k.str()) != all_keys.end();
@@ -1208,9 +1224,7 @@ void read_placement(const Tab& root, CaseSpec& spec) {
   const Ctx& c = *p.ctx;
   p.allow({"candidates", "points", "bodies", "groups", "max_candidates"});
   auto& pl = spec.placement;
-  pl.candidates =
-      choice_or<Candidates>(p, "candidates", pl.candidates,
-                            {{"points", Candidates::points}, {"surface", Candidates::surface}});
+  pl.candidates = choice_or<Candidates>(p, "candidates", pl.candidates, kCandidateKinds);
   const bool surface = pl.candidates == Candidates::surface;
   const auto& me = spec.mechanical;
   if (const auto* a = p.get("points")) {
@@ -1334,10 +1348,8 @@ std::string primitives_text(const std::vector<core::Primitive>& ps) {
 
 std::string selector_text(const core::FaceSelector& s, const Names& bodies) {
   using Side = core::FaceSelector::Side;
-  std::string t = "{ bodies = " + names_text(s.bodies, bodies) + ", side = " +
-                  toml_string(s.side == Side::exterior    ? "exterior"
-                              : s.side == Side::interface ? "interface"
-                                                          : "any");
+  std::string t = "{ bodies = " + names_text(s.bodies, bodies) +
+                  ", side = " + toml_string(name_of(kSides, s.side));
   if (s.side == Side::interface) t += ", other_bodies = " + names_text(s.other_bodies, bodies);
   if (s.plane) {
     t += ", plane = { normal = " + vec_text(s.plane->head<3>()) +
@@ -1461,11 +1473,9 @@ std::string resolved_case_toml(const CaseSpec& spec) {
     o << "]\n";
   }
   const auto& th = spec.thermal;
-  const char* scheme = th.scheme == core::TimeScheme::backward_euler   ? "backward_euler"
-                       : th.scheme == core::TimeScheme::crank_nicolson ? "crank_nicolson"
-                                                                       : "bdf2";
   o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
-    << "\nscheme = " << toml_string(scheme) << "\nstep_s = " << number_text(th.step)
+    << "\nscheme = " << toml_string(name_of(kSchemes, th.scheme))
+    << "\nstep_s = " << number_text(th.step)
     << "\noutput_interval_s = " << number_text(th.output_interval)
     << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
   for (const auto& c : th.convection) {
@@ -1486,19 +1496,20 @@ std::string resolved_case_toml(const CaseSpec& spec) {
   }
   for (const auto& s : th.sources) {
     o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
-      << "\nbody = " << toml_string(bodies.at(s.body)) << "\nlaw = ";
+      << "\nbody = " << toml_string(bodies.at(s.body))
+      << "\nlaw = " << toml_string(name_of(kLaws, s.law)) << "\n";
     if (s.law == Law::speed_power) {
-      o << "\"speed_power\"\npower_ref_W = " << number_text(s.power_ref)
+      o << "power_ref_W = " << number_text(s.power_ref)
         << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
         << "\nexponent = " << number_text(s.exponent) << "\n";
     } else if (s.law == Law::constant) {
-      o << "\"constant\"\npower_ref_W = " << number_text(s.power_ref) << "\n";
+      o << "power_ref_W = " << number_text(s.power_ref) << "\n";
     } else if (s.law == Law::feed_power) {
-      o << "\"feed_power\"\npower_ref_W = " << number_text(s.power_ref)
+      o << "power_ref_W = " << number_text(s.power_ref)
         << "\nref_feed_m_s = " << number_text(s.ref_feed)
         << "\nexponent = " << number_text(s.exponent) << "\n";
     } else {
-      o << "\"palmgren\"\npalmgren_f0 = " << number_text(s.palmgren_f0)
+      o << "palmgren_f0 = " << number_text(s.palmgren_f0)
         << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
         << "\npalmgren_dm = " << number_text(s.palmgren_dm)
         << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
@@ -1552,8 +1563,7 @@ std::string resolved_case_toml(const CaseSpec& spec) {
     << "\nfields = " << (spec.outputs.fields ? "true" : "false")
     << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
   const auto& pl = spec.placement;
-  o << "\n[placement]\ncandidates = "
-    << (pl.candidates == core::PlacementSpec::Candidates::surface ? "\"surface\"" : "\"points\"")
+  o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
     << "\npoints = " << strings_text(pl.points) << "\n";
   if (pl.candidates == core::PlacementSpec::Candidates::surface)
     o << "bodies = " << names_text(pl.bodies, bodies)

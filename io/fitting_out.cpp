@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 
 namespace tt::io {
@@ -299,7 +300,8 @@ json modelling_record_json(const ModellingConditions& c,
         {"number", c.machine_number},
         {"travel_mm", {{"x", c.travel_x * mm}, {"y", c.travel_y * mm}, {"z", c.travel_z * mm}}}}},
       {"modelling_date", c.modelling_date},
-      {"initial_ambient_temperature_degC", number(c.initial_ambient_temperature - 273.15)},
+      {"initial_ambient_temperature_degC",
+       number(c.initial_ambient_temperature - core::kCelsiusOffset)},
       {"max_spindle_speed_rpm", number(c.max_spindle_speed * 60.0 / (2.0 * std::numbers::pi))},
       {"max_feed_rate_mm_per_min", number(c.max_feed_rate * mm * 60.0)},
       {"models", models},
@@ -327,8 +329,8 @@ std::string modelling_record_markdown(const ModellingConditions& c,
   out << "| travel X / Y / Z [mm] | " << c.travel_x * mm << " / " << c.travel_y * mm << " / "
       << c.travel_z * mm << " |\n";
   out << "| modelling date | " << c.modelling_date << " |\n";
-  out << "| initial ambient temperature [°C] | " << c.initial_ambient_temperature - 273.15
-      << " |\n";
+  out << "| initial ambient temperature [°C] | "
+      << c.initial_ambient_temperature - core::kCelsiusOffset << " |\n";
   out << "| maximum spindle speed [rpm] | " << j["max_spindle_speed_rpm"].dump() << " |\n";
   out << "| maximum feed rate [mm/min] | " << j["max_feed_rate_mm_per_min"].dump() << " |\n";
   if (c.cutting) {

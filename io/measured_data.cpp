@@ -12,6 +12,7 @@
 
 #include "core/errors.hpp"
 #include "core/limits.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 
 namespace tt::io {
@@ -22,7 +23,6 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "thermal-measurement/1";
-constexpr double kCelsiusOffset = 273.15;
 constexpr double kMetresPerMicrometre = 1e-6;
 
 /// What a data.csv column holds, once the header has been matched against meta.json.
@@ -437,7 +437,7 @@ void read_samples(const fs::path& file, const MeasuredReadLimits& limits, Measur
           run.input_values(r, slot.index) = v;
           break;
         case ColumnRole::sensor:
-          run.temperature(r, slot.index) = v + kCelsiusOffset;
+          run.temperature(r, slot.index) = v + core::kCelsiusOffset;
           break;
         case ColumnRole::probe:
           run.displacement(r, slot.index) = v * kMetresPerMicrometre;
@@ -572,7 +572,7 @@ void write_measured_run(const fs::path& folder, const MeasuredRun& run) {
     }
     for (Eigen::Index c = 0; c < run.temperature.cols(); ++c) {
       csv += ',';
-      append_number(csv, run.temperature(r, c) - kCelsiusOffset);
+      append_number(csv, run.temperature(r, c) - core::kCelsiusOffset);
     }
     for (Eigen::Index c = 0; c < run.displacement.cols(); ++c) {
       csv += ',';

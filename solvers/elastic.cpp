@@ -35,8 +35,8 @@ k::ElasticMaterial elastic_material(const mesh::TetMesh& m, const core::CaseSpec
 /// Stiffness K (3n x 3n, upper triangle only: K is symmetric and CHOLMOD reads no more) and
 /// thermal coupling G (3n x n): f_thermal = G (T - T_ref).
 template <int N>
-std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(const mesh::TetMesh& m,
-                                                                             const core::CaseSpec& spec) {
+std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(
+    const mesh::TetMesh& m, const core::CaseSpec& spec) {
   for (int t = 0; t < m.tets.rows(); ++t) {
     if (!(k::min_jacobian_determinant(coords<N>(m, t)) > 0))
       throw core::SolverError("element " + std::to_string(t) + " is inverted or degenerate");
@@ -86,9 +86,9 @@ std::pair<Eigen::SparseMatrix<double>, Eigen::SparseMatrix<double>> assemble(con
 }
 
 template <int N>
-Eigen::VectorXd von_mises_impl(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& u,
-                               const Eigen::VectorXd& temp) {
-  const double tref = spec.mechanical.reference_temperature_c + kCelsiusOffset;
+Eigen::VectorXd von_mises_impl(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                               const Eigen::VectorXd& u, const Eigen::VectorXd& temp) {
+  const double tref = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
   const int n = static_cast<int>(m.nodes.rows());
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(n), count = Eigen::VectorXd::Zero(n);
   for (int t = 0; t < m.tets.rows(); ++t) {
@@ -98,7 +98,8 @@ Eigen::VectorXd von_mises_impl(const mesh::TetMesh& m, const core::CaseSpec& spe
       te(a) = temp(m.tets(t, a));
       for (int d = 0; d < 3; ++d) ue(3 * a + d) = u(3 * m.tets(t, a) + d);
     }
-    const auto s = k::nodal_stresses(coords<N>(m, t), elastic_material(m, spec, t), ue, te, tref, t);
+    const auto s =
+        k::nodal_stresses(coords<N>(m, t), elastic_material(m, spec, t), ue, te, tref, t);
     for (int a = 0; a < N; ++a) {
       sum(m.tets(t, a)) += k::von_mises(s.col(a));
       count(m.tets(t, a)) += 1;
@@ -141,7 +142,8 @@ std::vector<char> constrained_dofs(const mesh::TetMesh& m, const core::CaseSpec&
   }
   Eigen::MatrixXd c(static_cast<Eigen::Index>(rows.size()), 6);
   for (size_t i = 0; i < rows.size(); ++i) c.row(static_cast<Eigen::Index>(i)) = rows[i];
-  const int rank = rows.empty() ? 0 : static_cast<int>(Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(c).rank());
+  const int rank =
+      rows.empty() ? 0 : static_cast<int>(Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(c).rank());
   if (rank < 6)
     throw core::SolverError("mechanical constraints leave " + std::to_string(6 - rank) +
                             " rigid motion(s) free (" + std::to_string(rows.size()) +
@@ -157,7 +159,8 @@ struct ElasticModel::Impl {
   std::unique_ptr<cholmod::Factor> factor;
 };
 
-ElasticModel::ElasticModel(const mesh::TetMesh& m, const core::CaseSpec& spec) : impl_(std::make_unique<Impl>()) {
+ElasticModel::ElasticModel(const mesh::TetMesh& m, const core::CaseSpec& spec)
+    : impl_(std::make_unique<Impl>()) {
   const auto t0 = Clock::now();
   const std::vector<char> fixed = constrained_dofs(m, spec);
   // The free-dof stiffness, upper triangle only (all CHOLMOD reads), built in a scope of its own
@@ -194,7 +197,7 @@ ElasticModel::ElasticModel(const mesh::TetMesh& m, const core::CaseSpec& spec) :
   impl_->factor = std::make_unique<cholmod::Factor>(kf, "elastic stiffness");
   kf = Eigen::SparseMatrix<double>();
   timings_.factor_s = std::chrono::duration<double>(Clock::now() - t1).count();
-  reference_k_ = spec.mechanical.reference_temperature_c + kCelsiusOffset;
+  reference_k_ = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
 }
 
 ElasticModel::~ElasticModel() = default;
@@ -203,7 +206,8 @@ ElasticModel::ElasticModel(ElasticModel&&) noexcept = default;
 Eigen::MatrixXd ElasticModel::displacements(const Eigen::MatrixXd& temperature) const {
   if (temperature.rows() != impl_->coupling.cols())
     throw core::SolverError("temperature fields have " + std::to_string(temperature.rows()) +
-                            " rows, expected one per mesh node (" + std::to_string(impl_->coupling.cols()) +
+                            " rows, expected one per mesh node (" +
+                            std::to_string(impl_->coupling.cols()) +
                             "). Hint: on a 10-node mesh give mid-edge nodes too.");
   // The output times go through the factor as multi-right-hand-side blocks of a bounded width:
   // one block for all times would hold five dense copies of #dofs x #times beside the factor.
@@ -304,24 +308,27 @@ ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spe
   core::require_finite(h.displacement,
                        "the displacement [m] (row: 3 x node + direction, column: output time)",
                        "the thermal strain of the temperatures overflowed (peak " +
-                           std::to_string(temperature.maxCoeff() - kCelsiusOffset) +
+                           std::to_string(temperature.maxCoeff() - core::kCelsiusOffset) +
                            " degC); check the heat loads and expansion_per_K, youngs_modulus_Pa");
   return h;
 }
 
-Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& u,
-                                const Eigen::VectorXd& temp) {
+Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                                const Eigen::VectorXd& u, const Eigen::VectorXd& temp) {
   if (u.size() != 3 * m.nodes.rows() || temp.size() != m.nodes.rows())
     throw core::SolverError("von Mises: " + std::to_string(u.size()) + " displacements and " +
-                            std::to_string(temp.size()) + " temperatures, expected 3 and 1 per node (" +
+                            std::to_string(temp.size()) +
+                            " temperatures, expected 3 and 1 per node (" +
                             std::to_string(m.nodes.rows()) + " nodes)");
   return m.order == 1 ? von_mises_impl<4>(m, spec, u, temp) : von_mises_impl<10>(m, spec, u, temp);
 }
 
-Eigen::Vector3d displacement_at(const mesh::TetMesh& m, const Eigen::VectorXd& u, const Eigen::Vector3d& p) {
+Eigen::Vector3d displacement_at(const mesh::TetMesh& m, const Eigen::VectorXd& u,
+                                const Eigen::Vector3d& p) {
   if (u.size() != 3 * m.nodes.rows())
-    throw core::SolverError("displacement vector has " + std::to_string(u.size()) + " entries, expected " +
-                            std::to_string(3 * m.nodes.rows()) + " (3 per node)");
+    throw core::SolverError("displacement vector has " + std::to_string(u.size()) +
+                            " entries, expected " + std::to_string(3 * m.nodes.rows()) +
+                            " (3 per node)");
   for (int t = 0; t < m.tets.rows(); ++t) {
     const auto x4 = coords<4>(m, t);
     Eigen::Vector3d lo = x4.rowwise().minCoeff(), hi = x4.rowwise().maxCoeff();

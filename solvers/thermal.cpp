@@ -76,15 +76,18 @@ FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
           const auto& mat = material_of(m, spec, ti);
           const auto kc = k::conductivity_matrix(x, mat.conductivity, ti);
           for (int i = 0; i < N; ++i)
-            for (int j = 0; j < N; ++j) out.first.emplace_back(m.tets(ti, i), m.tets(ti, j), kc(i, j));
+            for (int j = 0; j < N; ++j)
+              out.first.emplace_back(m.tets(ti, i), m.tets(ti, j), kc(i, j));
           const double rc = mat.density * mat.specific_heat;
           if (lumped) {
             const auto ml = k::lumped_capacity(x, rc, ti);
-            for (int i = 0; i < N; ++i) out.second.emplace_back(m.tets(ti, i), m.tets(ti, i), ml(i));
+            for (int i = 0; i < N; ++i)
+              out.second.emplace_back(m.tets(ti, i), m.tets(ti, i), ml(i));
           } else {
             const auto mc = k::capacity_matrix(x, rc, ti);
             for (int i = 0; i < N; ++i)
-              for (int j = 0; j < N; ++j) out.second.emplace_back(m.tets(ti, i), m.tets(ti, j), mc(i, j));
+              for (int j = 0; j < N; ++j)
+                out.second.emplace_back(m.tets(ti, i), m.tets(ti, j), mc(i, j));
           }
         }
         return out;
@@ -150,20 +153,22 @@ FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
 }
 
 template <int N>
-double stored_heat_total(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::VectorXd& t_k,
-                         double t0_k) {
+double stored_heat_total(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                         const Eigen::VectorXd& t_k, double t0_k) {
   const int nt = static_cast<int>(m.tets.rows());
-  auto parts = core::parallel_chunks<double>(nt, 4096, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
-    double sum = 0;
-    for (auto t = b; t < e; ++t) {
-      const int ti = static_cast<int>(t);
-      const auto& mat = material_of(m, spec, ti);
-      Eigen::Matrix<double, N, 1> te;
-      for (int a = 0; a < N; ++a) te(a) = t_k(m.tets(ti, a));
-      sum += k::stored_heat(tet_coords<N>(m, ti), mat.density * mat.specific_heat, te, t0_k, ti);
-    }
-    return sum;
-  });
+  auto parts = core::parallel_chunks<double>(
+      nt, 4096, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
+        double sum = 0;
+        for (auto t = b; t < e; ++t) {
+          const int ti = static_cast<int>(t);
+          const auto& mat = material_of(m, spec, ti);
+          Eigen::Matrix<double, N, 1> te;
+          for (int a = 0; a < N; ++a) te(a) = t_k(m.tets(ti, a));
+          sum +=
+              k::stored_heat(tet_coords<N>(m, ti), mat.density * mat.specific_heat, te, t0_k, ti);
+        }
+        return sum;
+      });
   double total = 0;
   for (double p : parts) total += p;
   return total;
@@ -177,7 +182,8 @@ double heat_in_law(const core::CaseSpec& spec, const FullThermalSystem& sys) {
   const auto& segs = spec.duty_cycle.segments;
   for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {
     const auto& fl = spec.thermal.fluxes[j];
-    double seconds = end;  // flux-weighted time: n / n_ref over the cycle for a speed-following flux
+    // Flux-weighted time: n / n_ref over the cycle for a speed-following flux.
+    double seconds = end;
     if (fl.follows_speed) {
       seconds = 0;
       for (size_t i = 0; i < segs.size(); ++i) {
@@ -220,7 +226,7 @@ ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
 
 double stored_heat(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                    const Eigen::VectorXd& temperature) {
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   return mesh.order == 1 ? stored_heat_total<4>(mesh, spec, temperature, t0_k)
                          : stored_heat_total<10>(mesh, spec, temperature, t0_k);
 }
@@ -240,7 +246,8 @@ Eigen::MatrixXd nodal_history(const ThermalHistory& history, const std::vector<i
 
 Eigen::Matrix<double, 3, Eigen::Dynamic> element_coordinates(const mesh::TetMesh& mesh, int tet) {
   Eigen::Matrix<double, 3, Eigen::Dynamic> x(3, mesh.nodes_per_tet());
-  for (int a = 0; a < mesh.nodes_per_tet(); ++a) x.col(a) = mesh.nodes.row(mesh.tets(tet, a)).transpose();
+  for (int a = 0; a < mesh.nodes_per_tet(); ++a)
+    x.col(a) = mesh.nodes.row(mesh.tets(tet, a)).transpose();
   return x;
 }
 

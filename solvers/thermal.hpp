@@ -10,13 +10,12 @@
 #include <vector>
 
 #include "core/case_spec.hpp"
+#include "core/units.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "solvers/feed_axis.hpp"
 #include "solvers/thermal_system.hpp"
 
 namespace tt::solvers {
-
-constexpr double kCelsiusOffset = 273.15;
 
 /// Heat in, stored and lost, each computed on its own path [J].
 struct EnergyBalance {

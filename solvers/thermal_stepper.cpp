@@ -77,7 +77,7 @@ LoadState load_state(const core::CaseSpec& spec, const LinearThermalSystem<Matri
   s.speed = speed_at(spec.duty_cycle, t_load);
   for (const auto& c : spec.thermal.convection) {
     s.h.push_back(film_coefficient(c, s.speed));
-    s.sink_k.push_back(table_value(c.sink, t_sink) + kCelsiusOffset);
+    s.sink_k.push_back(table_value(c.sink, t_sink) + core::kCelsiusOffset);
   }
   const double feed = feed_speed_at(spec.feed_axis, t_load);
   for (size_t i = 0; i < spec.thermal.sources.size(); ++i) {
@@ -260,7 +260,7 @@ core::SolverError non_finite_temperature(const core::CaseSpec& spec, const LoadS
     o << " heat source '" << spec.thermal.sources[k].name << "' " << s.power[k] << " W;";
   for (std::size_t k = 0; k < s.h.size(); ++k)
     o << " convection[" << k << "] h = " << s.h[k] << " W/(m^2 K), sink "
-      << s.sink_k[k] - kCelsiusOffset << " degC;";
+      << s.sink_k[k] - core::kCelsiusOffset << " degC;";
   o << " Hint: a power, flux or coefficient far beyond a machine's (thermal.heat_sources "
        "power_ref_W, surface_flux flux_W_m2, h_W_m2K, the material values) overflows a double.";
   return core::SolverError(o.str());
@@ -304,7 +304,7 @@ Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec, const LinearThermal
 template <class Matrix>
 StepLoad step_load(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec, double t0,
                    double t1, const Eigen::VectorXd& state0) {
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const LoadState s = load_state(spec, sys, 0.5 * (t0 + t1), t1, state0, t0_k);
   return {load_vector(spec, sys, s) + moving_heat_load(spec, sys, t0, t1), s.h};
 }
@@ -315,12 +315,8 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
                             const Checkpointing& checkpointing) {
   using Scheme = core::TimeScheme;
   const Scheme scheme = spec.thermal.scheme;
-  if (scheme == Scheme::bdf2)
-    throw core::SolverError(
-        "thermal.scheme = \"bdf2\" is not implemented: use \"backward_euler\" "
-        "or \"crank_nicolson\"");
   const Eigen::Index n = sys.states();
-  const double t0_k = spec.thermal.initial_temperature_c + kCelsiusOffset;
+  const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const double end = spec.duty_cycle.end;
   check_request(sys, q, end);
   const std::vector<double> grid = time_grid(spec, spec.thermal.step);

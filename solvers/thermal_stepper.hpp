@@ -75,8 +75,8 @@ struct SteppedHistory {
 /// Steps `system` under `spec`'s duty cycle, feed axis, sinks and fluxes from the uniform
 /// initial temperature (or from `checkpointing.resume`; checkpoints hold the base state and the
 /// recorded states, and are refused with caller columns or readouts). Throws SolverError for
-/// bdf2, for record times not ascending in (0, end], for columns or readouts whose size is not the
-/// system's, for a resume state that does not fit, and when a factorisation fails.
+/// record times not ascending in (0, end], for columns or readouts whose size is not the system's,
+/// for a resume state that does not fit, and when a factorisation fails.
 template <class Matrix>
 SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& system, const core::CaseSpec& spec,
                             const StepperRequest& request, const Progress& progress = {},

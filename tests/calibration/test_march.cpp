@@ -61,7 +61,7 @@ TEST(March, DeclaredChannelsEqualRunWithMovingAndFeedPowerHeat) {
     EXPECT_LE(max_relative(simulated_channels(m, spec, r, run.time), from_run), 1e-10) << scheme;
 
     // The loads are there: the feed_power pad and the stroke warm up, the far end least.
-    const double t0 = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+    const double t0 = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
     const Eigen::RowVectorXd rise = march_out.base.row(run.time.size() - 1).array() - t0;
     EXPECT_GT(rise(3), 0.01) << scheme;  // the pad's feed_power source (2.88 W for 300 s)
     EXPECT_GT(rise(0), rise(2) + 0.05) << scheme;
@@ -123,7 +123,7 @@ TEST(March, ReducedOnChannelsKeepsEveryCandidateResponse) {
   fk.full = dk;
   OperatorChange rk = fk;
   rk.reduced = std::make_shared<const Eigen::MatrixXd>(reduced.projected(*dk));
-  const double t0_k = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
   const auto loads = [&](const OperatorChange& k) {
     return std::vector<LoadColumn>{{"film", FilmChange{0, false, 1}},
                                    {"air", SinkHat{{0}, 300, 300}},
@@ -154,7 +154,7 @@ TEST(March, ReducedOnChannelsKeepsEveryCandidateResponse) {
   const core::CaseSpec changed_run = case_for_run(changed, run);
   const Responses fc = march(MarchModel(m, changed), changed_run, r, run.time, {}, {});
   const Responses rc = march(reduced.with_case(m, changed), changed_run, r, run.time, {}, {});
-  const double t0 = declared.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  const double t0 = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
   EXPECT_LE((rc.base.row(0).array() - t0).abs().maxCoeff(), 1e-9);
   const double changed_gap = (fc.base - rc.base).cwiseAbs().maxCoeff();
   std::printf("[march] another capacity and conductivity on the basis: within %.2e K\n",

@@ -524,8 +524,8 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
                   "[\"block\"], on_cylinder = { axis = [50, 50], radius = 10 }, within = "
                   "{ min = [0, 0, 90], max = [100, 100, 100] } } ]");
   text = replaced(text, "step_s = 10.0",
-                  "step_s = 5.0\noutput_interval_s = 15.0\nscheme = \"bdf2\"\nlumped_mass = "
-                  "true\ninitial_temperature_degC = 21.5");
+                  "step_s = 5.0\noutput_interval_s = 15.0\nscheme = \"crank_nicolson\"\n"
+                  "lumped_mass = true\ninitial_temperature_degC = 21.5");
   text = replaced(text, "sink_degC = 20.0",
                   "h_speed_gain_W_m2K = 4.0\nspeed_ref_rpm = 3000.0\nspeed_exponent = 0.8\n"
                   "sink_table = [[0.0, 20.0], [40.0, 23.5]]");
@@ -569,7 +569,7 @@ TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
   EXPECT_EQ(*s.groups[0].select[0].plane, Eigen::Vector4d(0, 0, -1, 0));
   EXPECT_EQ(s.groups[2].select[0].other_bodies, std::vector<int>{0});
   EXPECT_EQ(s.groups[2].select[0].within_min->z(), 0.09);
-  EXPECT_EQ(s.thermal.scheme, tt::core::TimeScheme::bdf2);
+  EXPECT_EQ(s.thermal.scheme, tt::core::TimeScheme::crank_nicolson);
   EXPECT_EQ(s.thermal.convection[0].sink.value, (std::vector<double>{20.0, 23.5}));
   EXPECT_EQ(s.thermal.sources.at(2).palmgren_dm, 0.07);
   EXPECT_EQ(s.thermal.sources.at(2).palmgren_p1, 500);

@@ -92,7 +92,7 @@ inline Eigen::VectorXd nodal_temperature_k(
     const mesh::TetMesh& mesh, const std::function<double(const Eigen::Vector3d&)>& t_c) {
   Eigen::VectorXd t(mesh.nodes.rows());
   for (Eigen::Index i = 0; i < t.size(); ++i)
-    t(i) = t_c(mesh.nodes.row(i).transpose()) + solvers::kCelsiusOffset;
+    t(i) = t_c(mesh.nodes.row(i).transpose()) + core::kCelsiusOffset;
   return t;
 }
 

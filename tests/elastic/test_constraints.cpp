@@ -117,7 +117,7 @@ TEST(MultiTime, BlockSolveEqualsSingleSolvesAndIsLinear) {
     return tref + 15.0 * std::sin(80.0 * x.x()) * std::cos(60.0 * x.y()) +
            5.0 * std::exp(30.0 * x.z());
   });
-  const double tref_k = tref + solvers::kCelsiusOffset;
+  const double tref_k = tref + core::kCelsiusOffset;
   const Eigen::VectorXd t3 =
       (tref_k + 2.0 * (t0.array() - tref_k) - 0.5 * (t1.array() - tref_k)).matrix();
   Eigen::MatrixXd temp(mesh.nodes.rows(), 4);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "fitting/features.hpp"
 #include "fitting/group.hpp"
 
@@ -45,7 +46,7 @@ inline Group thermal_run(int index, std::uint64_t seed, int sensors = 6,
   const double ambient[] = {0.2, 0.5, 0.8, 0.3, 1.0, 0.6, 0.1, 0.9};
   g.temperature.resize(n, sensors);
   for (int k = 0; k < sensors; ++k) {
-    g.temperature.col(k) = (20.0 + 273.15) +
+    g.temperature.col(k) = (20.0 + core::kCelsiusOffset) +
                            gains[k % 8] * low_pass(g.time, duty, taus[k % 8]).array() +
                            ambient[k % 8] * drift.array();
     g.sensor_names.push_back("t" + std::to_string(k + 1));

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "fitting/features.hpp"
 #include "fitting/residual_study.hpp"
 #include "fitting/segments.hpp"
@@ -65,7 +66,8 @@ io::MeasuredRun synthetic_run(double hours, bool speed, std::uint64_t stream, do
   const double taus[] = {900.0, 2400.0, 5000.0, 12000.0};
   for (int c = 0; c < 4; ++c)
     r.temperature.col(c) =
-        (ambient + (8.0 - c) * fitting::low_pass(r.time, heat, taus[c])).array() + 273.15;
+        (ambient + (8.0 - c) * fitting::low_pass(r.time, heat, taus[c])).array() +
+        core::kCelsiusOffset;
   const Eigen::VectorXd d1 =
       2.0 * (r.temperature.col(0).array() - r.temperature(0, 0)).matrix() +
       1.5 * fitting::low_pass(r.time, (r.temperature.col(1).array() - r.temperature(0, 1)).matrix(),

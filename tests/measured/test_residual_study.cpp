@@ -10,6 +10,7 @@
 
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "fitting/features.hpp"
 #include "fitting/residual_study.hpp"
 #include "fitting/segments.hpp"
@@ -54,10 +55,10 @@ io::MeasuredRun synthetic_run(const std::vector<double>& speeds_rpm, Missing mis
   const Eigen::VectorXd heat = krpm.array().square() / 25.0;
   run.temperature.resize(n, 3);
   run.temperature.col(0) =
-      (ambient + 12.0 * fitting::low_pass(run.time, heat, 1500.0)).array() + 273.15;
+      (ambient + 12.0 * fitting::low_pass(run.time, heat, 1500.0)).array() + core::kCelsiusOffset;
   run.temperature.col(1) =
-      (ambient + 6.0 * fitting::low_pass(run.time, heat, 6000.0)).array() + 273.15;
-  run.temperature.col(2) = ambient.array() + 273.15;
+      (ambient + 6.0 * fitting::low_pass(run.time, heat, 6000.0)).array() + core::kCelsiusOffset;
+  run.temperature.col(2) = ambient.array() + core::kCelsiusOffset;
   for (Eigen::Index i = 0; i < run.temperature.size(); ++i) run.temperature(i) += 0.02 * noise(rng);
   Eigen::VectorXd d = 3.0 * (run.temperature.col(0).array() - run.temperature(0, 0)) -
                       2.0 * (run.temperature.col(1).array() - run.temperature(0, 1));

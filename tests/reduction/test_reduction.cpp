@@ -28,7 +28,7 @@
 namespace tt::reduction_test {
 namespace {
 
-using solvers::kCelsiusOffset;
+using core::kCelsiusOffset;
 
 /// A block with a bearing pad (speed-power source whose heat grows with its temperature), a top
 /// film that follows the speed, a bottom film whose sink temperature varies, and still air

@@ -106,6 +106,18 @@ TEST(HostileCase, ZeroConductivityIsRefused) {
   EXPECT_NE(msg.find("must be > 0"), std::string::npos) << msg;
 }
 
+// bdf2 used to be read and refused only by the stepper, after meshing: a scheme the solver cannot
+// run is refused when the case is read, naming the file, the key and the value.
+TEST(HostileCase, SchemeTheSolverCannotRunIsRefusedWhenRead) {
+  const std::string msg =
+      case_error(coarse_with("scheme = \"backward_euler\"", "scheme = \"bdf2\""));
+  EXPECT_NE(msg.find("sb1_coarse.toml"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("thermal.scheme = \"bdf2\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'backward_euler', 'crank_nicolson'"), std::string::npos) << msg;
+  EXPECT_EQ(case_error(coarse_with("scheme = \"backward_euler\"", "scheme = \"crank_nicolson\"")),
+            "");
+}
+
 TEST(HostileCase, HeatSourceOnARegionWithoutElementsIsRefused) {
   // Two boxes, the source on the second; then every tet is given to the first, as a mesh that
   // lost a thin body would be.

@@ -105,7 +105,7 @@ TEST(ThermalEnergy, LumpedQuadraticTetsConserveTheirOwnEnergy) {
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const auto ops = solvers::thermal_system(mesh, spec);
   const auto h = solvers::thermal_history(mesh, spec, ops);
-  const double t0 = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+  const double t0 = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const Eigen::VectorXd rise = h.temperature.col(h.temperature.cols() - 1) -
                                Eigen::VectorXd::Constant(mesh.nodes.rows(), t0);
   const double stored_discrete = (ops.capacity * rise).sum();
@@ -166,7 +166,7 @@ TEST(ThermalEnergy, SuddenHeatInputUndershootStaysBounded) {
     const mesh::TetMesh mesh = mesh::mesh_case(spec);
     const auto ops = solvers::thermal_system(mesh, spec);
     const auto h = solvers::thermal_history(mesh, spec, ops);
-    const double t0 = spec.thermal.initial_temperature_c + solvers::kCelsiusOffset;
+    const double t0 = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
     const double volume = 0.13 * 0.05 * 0.04, rho_c = 7250.0 * 510.0;
     const Eigen::VectorXd lid_weight = ops.flux_area[0] / ops.flux_area[0].sum();
     ASSERT_NEAR(ops.flux_area[0].sum(), lid_area, 1e-12);

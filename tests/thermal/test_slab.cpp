@@ -107,7 +107,7 @@ TEST(ThermalLumped, SmallBiotCubeDecaysExponentially) {
       double theta = 1;
       for (int d = 0; d < 3; ++d)
         theta *= slab_theta(std::abs(p(d) - 0.5 * a) / (0.5 * a), fo, slab_biot, 4);
-      const double fe = temp(n, col) - solvers::kCelsiusOffset;
+      const double fe = temp(n, col) - core::kCelsiusOffset;
       worst_lumped = std::max(worst_lumped, std::abs(fe - lumped));
       worst_exact = std::max(worst_exact, std::abs(fe - (t_inf + (t_i - t_inf) * theta)));
     }
@@ -124,7 +124,7 @@ TEST(ThermalLumped, SmallBiotCubeDecaysExponentially) {
   EXPECT_GT(spread, 0.0);  // the cube is not isothermal: conduction is really solved
   // The exponential itself, checked at the end where a wrong tau (or a wrong area) shows most.
   const double end_lumped = t_inf + (t_i - t_inf) * std::exp(-3.0);
-  EXPECT_NEAR(temp.col(temp.cols() - 1).mean() - solvers::kCelsiusOffset, end_lumped, 0.03);
+  EXPECT_NEAR(temp.col(temp.cols() - 1).mean() - core::kCelsiusOffset, end_lumped, 0.03);
 }
 
 }  // namespace

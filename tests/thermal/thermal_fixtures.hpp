@@ -111,7 +111,7 @@ inline int time_column(const std::vector<double>& times, double t) {
 inline double celsius_at(const Solution& run, const std::string& id, double t) {
   const int node = mesh::named_node(run.mesh, id);
   EXPECT_GE(node, 0) << "no named point " << id;
-  return run.history.temperature(node, time_column(run.history.times, t)) - solvers::kCelsiusOffset;
+  return run.history.temperature(node, time_column(run.history.times, t)) - core::kCelsiusOffset;
 }
 
 /// Roots of zeta tan(zeta) = Bi, one in each (n pi, n pi + pi/2), by bisection.
