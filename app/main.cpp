@@ -162,18 +162,21 @@ int main(int argc, char** argv) {
   compensate->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
       ->required()
       ->check(CLI::ExistingFile);
-  compensate->add_option("--in", compensate_args.in,
-                         "CSV samples (default: standard input); followed as it grows");
+  auto* compensate_in = compensate->add_option(
+      "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
   compensate->add_option("--out", compensate_args.out, "output CSV (default: standard output)");
   auto* until_eof = compensate->add_flag("--until-eof", compensate_args.until_eof,
-                                         "with --in: stop at the file's end, do not follow it");
+                                         "with --in: stop at the file's end, do not follow it")
+                       ->needs(compensate_in);
   compensate->add_option("--idle-s", compensate_args.idle_s,
                          "with --in: stop when the file has not grown for this long [s]")
       ->check(positive_number())
-      ->excludes(until_eof);
+      ->excludes(until_eof)
+      ->needs(compensate_in);
   compensate->add_option("--poll-ms", compensate_args.poll_ms,
                          "with --in: how often to look for new lines at its end [ms] (default 5)")
-      ->check(CLI::Range(1, 10000));
+      ->check(CLI::Range(1, 10000))
+      ->needs(compensate_in);
   compensate->add_flag("--flush", compensate_args.flush,
                        "flush after every line (default: when the input pauses; always on a "
                        "terminal)");

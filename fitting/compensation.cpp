@@ -46,6 +46,7 @@ std::string status_name(SampleStatus status) {
 
 Compensator::Compensator(const std::vector<FittedModel>& models,
                          const std::vector<std::string>& columns) {
+  if (models.empty()) throw core::DataError("compensator: no model to step");
   for (const FittedModel& model : models) {
     const bool linear = std::holds_alternative<LinearFit>(model.body);
     if (!linear && !std::holds_alternative<PprModel>(model.body))
