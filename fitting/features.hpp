@@ -55,8 +55,9 @@ class FeatureStream {
   const Eigen::VectorXd& next(double time, const Eigen::Ref<const Eigen::VectorXd>& temperature,
                               const Eigen::Ref<const Eigen::VectorXd>& inputs);
 
-  /// The time of the last sample taken [s]; false before the first.
+  /// false before the first sample
   bool started() const { return started_; }
+  /// the time of the last sample taken [s]
   double last_time() const { return last_time_; }
 
  private:
