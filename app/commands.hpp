@@ -75,7 +75,19 @@ struct ReduceArgs {
   bool quiet = false;
 };
 
+/// compensate --model FIT.json: live compensation (app/compensate_command.cpp).
+struct CompensateArgs {
+  std::filesystem::path model;
+  std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input
+  std::filesystem::path out;  /// empty: standard output
+  bool until_eof = false;     /// with in: stop at its end instead of following it
+  double idle_s = 0.0;        /// with in: stop when it has not grown for this long [s]; 0: never
+  int poll_ms = 5;            /// with in: how often to look for new lines at its end [ms]
+  bool flush = false;         /// flush after every line (always on a terminal)
+};
+
 int mesh_command(const MeshArgs& args);
+int compensate_command(const CompensateArgs& args);
 int reduce_command(const ReduceArgs& args);
 int fit_data_command(const FitDataArgs& args);
 int calibrate_data_command(const CalibrateArgs& args);

@@ -11,6 +11,7 @@
 //                                  what the model lacks on measured runs, before and after;
 //                                  without --case, from the data alone
 //   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
+//   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file)
 //   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
@@ -192,6 +193,31 @@ int main(int argc, char** argv) {
                       "the runs' channels)");
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
 
+  CompensateArgs compensate_args;
+  auto* compensate = cli.add_subcommand(
+      "compensate", "Live compensation: drift per sample from a fitted model (docs/compensate.md)");
+  compensate->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
+      ->required()
+      ->check(CLI::ExistingFile);
+  auto* compensate_in = compensate->add_option(
+      "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
+  compensate->add_option("--out", compensate_args.out, "output CSV (default: standard output)");
+  auto* until_eof = compensate->add_flag("--until-eof", compensate_args.until_eof,
+                                         "with --in: stop at the file's end, do not follow it")
+                       ->needs(compensate_in);
+  compensate->add_option("--idle-s", compensate_args.idle_s,
+                         "with --in: stop when the file has not grown for this long [s]")
+      ->check(positive_number())
+      ->excludes(until_eof)
+      ->needs(compensate_in);
+  compensate->add_option("--poll-ms", compensate_args.poll_ms,
+                         "with --in: how often to look for new lines at its end [ms] (default 5)")
+      ->check(CLI::Range(1, 10000))
+      ->needs(compensate_in);
+  compensate->add_flag("--flush", compensate_args.flush,
+                       "flush after every line (default: when the input pauses; always on a "
+                       "terminal)");
+
   CLI11_PARSE(cli, argc, argv);
   // Ctrl-C or a kill (SIGINT, SIGTERM, SIGHUP) while a command works removes its DIR.partial and
   // DIR.lock; DIR keeps the previous result and DIR.checkpoint stays for --resume.
@@ -228,6 +254,7 @@ int main(int argc, char** argv) {
       return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
                                               : calibrate_command_with_case(calibrate_args);
     }
+    if (*compensate) return compensate_command(compensate_args);
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

@@ -30,6 +30,48 @@ struct FeatureMap {
 /// it holds on a non-uniform time grid.
 Eigen::VectorXd low_pass(const Eigen::VectorXd& time, const Eigen::VectorXd& u, double tau);
 
+/// One interval of low_pass: y at the end of an interval of h > 0 [s] over which u goes linearly
+/// from u_previous to u, given y_previous at its start and decay = exp(−h/τ). The one formula that
+/// low_pass and FeatureStream both step with.
+inline double low_pass_step(double y_previous, double u_previous, double u, double h, double tau,
+                            double decay) {
+  const double slope = (u - u_previous) / h;
+  // e = y − u obeys τe' = −e − τu' with u' constant over the interval.
+  return u + (y_previous - u_previous) * decay - tau * slope * (1.0 - decay);
+}
+
+/// feature_matrix's rows one sample at a time, for a model read beside the machine: the first
+/// sample is the reference of the increments, and every later one advances the low-pass filters
+/// over the interval since the one before. feature_matrix is this stream run over a group.
+class FeatureStream {
+ public:
+  /// map.sensors index the temperatures and map.inputs the inputs handed to next(); throws
+  /// DataError on a time constant that is not > 0.
+  explicit FeatureStream(const FeatureMap& map);
+
+  /// The regressors of the next sample (a row of feature_matrix, in its column order).
+  /// time [s] must exceed the previous sample's (throws DataError otherwise); temperature [K] and
+  /// inputs (speed [rpm]) are one sample's values, read at the map's columns.
+  const Eigen::VectorXd& next(double time, const Eigen::Ref<const Eigen::VectorXd>& temperature,
+                              const Eigen::Ref<const Eigen::VectorXd>& inputs);
+
+  /// false before the first sample
+  bool started() const { return started_; }
+  /// the time of the last sample taken [s]
+  double last_time() const { return last_time_; }
+
+ private:
+  FeatureMap map_;
+  /// #sensors + #inputs readings of the first sample
+  Eigen::VectorXd reference_;
+  /// #sensors + #inputs increments of the current and of the previous sample
+  Eigen::VectorXd increments_, previous_;
+  /// the regressors of the last sample
+  Eigen::VectorXd features_;
+  double last_time_ = 0.0;
+  bool started_ = false;
+};
+
 /// #samples x ((#sensors + #inputs)·(1 + #time_constants)) regressors of one group: first the
 /// increments ΔT_k [K], then the input increments (speed [rpm]), then for each time constant the
 /// filtered versions of all of them in the same order.

@@ -164,6 +164,7 @@ json model_json(const FittedModel& model) {
          {"settings", settings_json(model.spec)},
          {"target", model.target_name},
          {"sensors", model.features.sensor_names},
+         {"operating_inputs", model.features.input_names},
          {"fitted_on", model.fitted_on},
          {"gross_error_rejection",
           {{"samples", model.rejection.samples},

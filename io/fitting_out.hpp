@@ -50,7 +50,8 @@ struct ModellingConditions {
 };
 
 /// A fitted model's coefficients: intercept and named terms [µm, µm/K] for linear models, the
-/// ridge functions for PPR.
+/// ridge functions for PPR; with the sensors and the operating inputs (e.g. "speed_rpm") it reads,
+/// so that io/fit_model_in.hpp can evaluate it again.
 nlohmann::json model_json(const fitting::FittedModel& model);
 
 /// fit.json: per target the groups' roles, every (method, m, model) candidate with its

@@ -1,0 +1,241 @@
+#include "io/fit_model_in.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "fitting/features.hpp"
+
+namespace tt::io {
+
+namespace {
+
+using fitting::ModelKind;
+using nlohmann::json;
+
+constexpr double um = 1e-6;  // micrometres to metres
+
+/// Where a key sits, for messages: "fit.json: targets[0] (z): chosen.coefficients.kind".
+struct Place {
+  std::string origin, target;
+  std::string at(const std::string& key) const {
+    return origin + ": target '" + target + "': " + key;
+  }
+};
+
+const json& member(const json& j, const std::string& key, const Place& p, const std::string& path) {
+  if (!j.is_object() || !j.contains(key))
+    throw core::DataError(p.at(path + key) +
+                          " is missing; hint: give a fit.json written by "
+                          "`thermotwin fit` or `thermotwin fit --data`");
+  return j.at(key);
+}
+
+double number_at(const json& j, const std::string& key, const Place& p, const std::string& path) {
+  const json& v = member(j, key, p, path);
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a finite number");
+  return v.get<double>();
+}
+
+std::vector<std::string> names_at(const json& j, const std::string& key, const Place& p,
+                                  const std::string& path) {
+  const json& v = member(j, key, p, path);
+  std::vector<std::string> names;
+  if (v.is_array())
+    for (const json& n : v)
+      if (n.is_string()) names.push_back(n.get<std::string>());
+  if (!v.is_array() || names.size() != v.size())
+    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a list of names");
+  return names;
+}
+
+Eigen::VectorXd vector_at(const json& j, const std::string& key, const Place& p,
+                          const std::string& path, double factor = 1.0) {
+  const json& v = member(j, key, p, path);
+  if (!v.is_array())
+    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a list of numbers");
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
+      throw core::DataError(p.at(path + key) + "[" + std::to_string(i) + "] = " + v[i].dump() +
+                            ": expected a finite number");
+    out(static_cast<Eigen::Index>(i)) = v[i].get<double>() * factor;
+  }
+  return out;
+}
+
+ModelKind kind_of(const std::string& name, const Place& p) {
+  for (ModelKind k :
+       {ModelKind::no_compensation, ModelKind::least_squares, ModelKind::ridge,
+        ModelKind::projection_pursuit, ModelKind::distributed_lag, ModelKind::cnn_bigru_attention})
+    if (fitting::kind_name(k) == name) return k;
+  throw core::DataError(p.at("chosen.coefficients.kind") + " = '" + name +
+                        "': not a model kind thermotwin writes");
+}
+
+/// The operating inputs a model reads: the key written since compensate exists, else the names
+/// of its "d[...]" terms (fit.json files written before it).
+std::vector<std::string> operating_inputs(const json& c, const Place& p) {
+  if (c.contains("operating_inputs"))
+    return names_at(c, "operating_inputs", p, "chosen.coefficients.");
+  std::vector<std::string> inputs;
+  if (!c.contains("terms") || !c["settings"].value("inputs", false)) return inputs;
+  for (const json& t : c["terms"]) {
+    const std::string name = t.value("name", std::string());
+    if (name.rfind("d[", 0) == 0 && name.back() == ']')
+      inputs.push_back(name.substr(2, name.size() - 3));
+  }
+  return inputs;
+}
+
+fitting::PprModel ppr_of(const json& c, const Place& p) {
+  const std::string at = "chosen.coefficients.";
+  fitting::PprModel m;
+  m.center = vector_at(c, "input_center_K", p, at);
+  m.scale = vector_at(c, "input_scale_K", p, at);
+  m.mean = number_at(c, "mean_um", p, at) * um;
+  const json& ridges = member(c, "ridge_functions", p, at);
+  for (std::size_t r = 0; r < ridges.size(); ++r) {
+    const std::string here = at + "ridge_functions[" + std::to_string(r) + "].";
+    fitting::RidgeFunction f;
+    f.direction = vector_at(ridges[r], "direction", p, here);
+    f.z_low = number_at(ridges[r], "z_low", p, here);
+    f.z_high = number_at(ridges[r], "z_high", p, here);
+    f.polynomial = vector_at(ridges[r], "polynomial_um", p, here, um);
+    if (f.direction.size() != m.center.size())
+      throw core::DataError(p.at(here + "direction") + " has " +
+                            std::to_string(f.direction.size()) + " entries; expected " +
+                            std::to_string(m.center.size()));
+    m.terms.push_back(std::move(f));
+  }
+  return m;
+}
+
+DeployedModel deployed_model(const json& target, const Place& p) {
+  const json& chosen = member(target, "chosen", p, "");
+  const json& c = member(chosen, "coefficients", p, "chosen.");
+  const std::string at = "chosen.coefficients.";
+  const json& kind_json = member(c, "kind", p, at);
+  const ModelKind kind =
+      kind_of(kind_json.is_string() ? kind_json.get<std::string>() : kind_json.dump(), p);
+  if (kind == ModelKind::cnn_bigru_attention)
+    throw core::DataError(p.at(at + "kind") +
+                          " = 'cnn_bigru_attention': compensate does not evaluate the network "
+                          "(its weights are in network_<target>.pt, not in fit.json); hint: refit "
+                          "without --network, or use the linear, ridge, distributed_lag or "
+                          "projection_pursuit kinds");
+  DeployedModel d;
+  fitting::FittedModel& m = d.model;
+  m.target_name = p.target;
+  m.spec.kind = kind;
+  const json& settings = member(c, "settings", p, at);
+  m.spec.use_inputs = settings.value("inputs", false);
+  if (kind == ModelKind::ridge || kind == ModelKind::distributed_lag)
+    m.spec.ridge_lambda = number_at(settings, "ridge_lambda", p, at + "settings.");
+  if (kind == ModelKind::distributed_lag) {
+    const Eigen::VectorXd taus = vector_at(settings, "time_constants_s", p, at + "settings.");
+    m.spec.time_constants.assign(taus.data(), taus.data() + taus.size());
+    for (double tau : m.spec.time_constants)
+      if (!(tau > 0.0))
+        throw core::DataError(p.at(at + "settings.time_constants_s") + " holds " +
+                              std::to_string(tau) + ": every time constant must be > 0");
+  }
+  m.features.sensor_names = names_at(c, "sensors", p, at);
+  m.features.input_names = operating_inputs(c, p);
+  m.features.time_constants = m.spec.time_constants;
+  for (std::size_t k = 0; k < m.features.sensor_names.size(); ++k)
+    m.features.sensors.push_back(static_cast<int>(k));
+  for (std::size_t k = 0; k < m.features.input_names.size(); ++k)
+    m.features.inputs.push_back(static_cast<int>(k));
+  const std::vector<std::string> expected = fitting::feature_names(m.features);
+  if (kind == ModelKind::projection_pursuit) {
+    const std::vector<std::string> inputs = names_at(c, "inputs", p, at);
+    if (inputs != expected)
+      throw core::DataError(p.at(at + "inputs") + " = " + json(inputs).dump() +
+                            "; the model's sensors and inputs give " + json(expected).dump());
+    m.body = ppr_of(c, p);
+    if (std::get<fitting::PprModel>(m.body).center.size() !=
+        static_cast<Eigen::Index>(expected.size()))
+      throw core::DataError(p.at(at + "input_center_K") + " has " +
+                            std::to_string(std::get<fitting::PprModel>(m.body).center.size()) +
+                            " entries; expected " + std::to_string(expected.size()));
+  } else {
+    fitting::LinearFit fit;
+    fit.intercept = number_at(c, "intercept_um", p, at) * um;
+    const json& terms = member(c, "terms", p, at);
+    if (!terms.is_array() || terms.size() != expected.size())
+      throw core::DataError(p.at(at + "terms") + " has " + std::to_string(terms.size()) +
+                            " entries; the model's sensors, inputs and time constants give " +
+                            std::to_string(expected.size()) + ": " + json(expected).dump());
+    fit.coefficients.resize(static_cast<Eigen::Index>(terms.size()));
+    for (std::size_t k = 0; k < terms.size(); ++k) {
+      const std::string here = at + "terms[" + std::to_string(k) + "].";
+      const std::string name = terms[k].value("name", std::string());
+      if (name != expected[k])
+        throw core::DataError(p.at(here + "name") + " = '" + name + "'; expected '" + expected[k] +
+                              "' (the order feature_names gives)");
+      fit.coefficients(static_cast<Eigen::Index>(k)) =
+          number_at(terms[k], "um_per_K", p, here) * um;
+    }
+    m.body = fit;
+  }
+  // The uncertainty: held-out residuals, test groups first.
+  for (const char* groups : {"test", "validation"}) {
+    if (!chosen.contains(groups) || !chosen[groups].contains("S_um")) continue;
+    const json& s = chosen[groups]["S_um"];
+    double sum = 0.0;
+    int count = 0;
+    for (const auto& [group, value] : s.items())
+      if (value.is_number()) {
+        sum += value.get<double>() * value.get<double>();
+        ++count;
+      }
+    if (count == 0) continue;
+    d.uncertainty = std::sqrt(sum / count) * um;
+    d.uncertainty_groups = groups;
+    return d;
+  }
+  throw core::DataError(p.at("chosen.test.S_um") +
+                        " and chosen.validation.S_um hold no figure: no uncertainty to report");
+}
+
+}  // namespace
+
+std::vector<DeployedModel> deployed_models(const json& fit, const std::string& origin) {
+  if (!fit.is_object() || !fit.contains("targets") || !fit["targets"].is_array() ||
+      fit["targets"].empty())
+    throw core::DataError(origin +
+                          ": no \"targets\" list; hint: give the fit.json that `thermotwin fit` "
+                          "or `thermotwin fit --data` wrote");
+  std::vector<DeployedModel> models;
+  for (std::size_t t = 0; t < fit["targets"].size(); ++t) {
+    const json& target = fit["targets"][t];
+    Place p{origin, "targets[" + std::to_string(t) + "]"};
+    const json& name = member(target, "target", p, "");
+    if (!name.is_string() || name.get<std::string>().empty())
+      throw core::DataError(p.at("target") + " = " + name.dump() + ": expected a name");
+    p.target = name.get<std::string>();
+    models.push_back(deployed_model(target, p));
+    models.back().model.target = static_cast<int>(t);
+  }
+  return models;
+}
+
+std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in || std::filesystem::is_directory(path))
+    throw core::IoError(path.string() + ": cannot read (expected a fit.json file)");
+  std::stringstream text;
+  text << in.rdbuf();
+  json fit;
+  try {
+    fit = json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    throw core::DataError(path.string() + ": not JSON: " + e.what());
+  }
+  return deployed_models(fit, path.string());
+}
+
+}  // namespace tt::io

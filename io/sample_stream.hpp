@@ -1,0 +1,76 @@
+// The CSV stream that `thermotwin compensate` reads and writes: lines of a file descriptor taken as
+// they arrive (a pipe, or a file that still grows, followed like tail -f), the header and samples
+// of the measured-data format (docs/measured-data.md: time_s, then inputs and sensor ids), and the
+// output lines. Strings stop here: a sample leaves as a time and a vector of values, NaN where a
+// cell is empty or not a finite number.
+#pragma once
+
+#include <Eigen/Dense>
+#include <csignal>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fitting/compensation.hpp"
+
+namespace tt::io {
+
+/// How a LineReader treats the end of what has been written so far.
+struct FollowOptions {
+  /// wait for more lines at the end of the data (a file that grows); false: the end is the end
+  bool follow = false;
+  /// with follow: stop when nothing new arrived for this long [s]; <= 0: never
+  double idle_s = 0.0;
+  /// with follow: how often to look for new data at the end [ms]
+  int poll_ms = 5;
+};
+
+/// Complete lines of a file descriptor, read in large blocks as they arrive.
+class LineReader {
+ public:
+  /// fd stays owned by the caller; name is used in messages; stop (may be null) ends reading at
+  /// the next line or wait when it becomes nonzero (a signal handler sets it).
+  LineReader(int fd, std::string name, FollowOptions options,
+             const volatile std::sig_atomic_t* stop = nullptr);
+
+  /// The next line without its line break ("\r\n" too). false at the end: end of data (not
+  /// following), the idle time passed, or stop was set. A last line with no line break is returned
+  /// at the end of data when not following; when following it waits for its line break.
+  /// before_wait is called whenever no data is ready and the reader is about to block or sleep.
+  bool next(std::string_view& line, const std::function<void()>& before_wait);
+
+ private:
+  bool fill(const std::function<void()>& before_wait);
+  int fd_;
+  std::string name_;
+  FollowOptions options_;
+  const volatile std::sig_atomic_t* stop_;
+  std::vector<char> buffer_;
+  std::size_t begin_ = 0, end_ = 0;
+  long long offset_ = 0;
+  bool eof_ = false;
+};
+
+/// The columns after time_s of a stream's header line. Throws DataError naming `origin` when the
+/// first column is not time_s, or a column name is empty or repeated.
+std::vector<std::string> stream_columns(std::string_view header, const std::string& origin);
+
+/// One sample line: false when it does not have 1 + values.size() fields. Otherwise time [s] (NaN
+/// when not a finite number) and values (NaN where a cell is empty or not a finite number).
+bool parsed_sample(std::string_view line, double& time, Eigen::Ref<Eigen::VectorXd> values);
+
+/// The output header: time_s, then per target <target>_predicted_um and <target>_sigma_um, then
+/// status.
+std::string output_header(const std::vector<std::string>& targets);
+
+/// The status field of a step: "ok", "late", "held:T07;T08" or "waiting:T07" (the columns held
+/// or still missing, by name). columns: the stream's columns.
+std::string status_text(const fitting::LiveStep& step, const std::vector<std::string>& columns);
+
+/// Appends one output line: the time, predicted errors and their 1-σ [µm] (empty fields where
+/// predicted is NaN, as while waiting), and the status. predicted, sigma: #targets [m].
+void append_output_line(std::string& out, double time, const Eigen::VectorXd& predicted,
+                        const Eigen::VectorXd& sigma, std::string_view status);
+
+}  // namespace tt::io

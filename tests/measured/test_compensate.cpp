@@ -1,0 +1,225 @@
+// thermotwin compensate end to end: a measured run fitted with fit --data --quick, then a held-out
+// run replayed through compensate, from a finished file and from one that grows while it is
+// followed, must give compensation.csv's predictions; a blank cell is held and flagged, and a
+// stream that lacks a model's column is refused with the column named.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "core/rng.hpp"
+#include "fitting/features.hpp"
+#include "io/measured_data.hpp"
+#include "tests/reliability/process.hpp"
+
+namespace fs = std::filesystem;
+using namespace tt;
+using reliability_test::read_text;
+using reliability_test::run;
+using reliability_test::scratch;
+
+namespace {
+
+/// `hours` at one sample a minute: the spindle at 2500 rpm for 4 of every 6 hours; a, b, c heat
+/// with 20, 50 and 100 min lags over an ambient swing; drift p = 2 µm/K Δa + 1 µm/K lp2400(Δb)
+/// + 0.001 µm/rpm speed, q = −1.5 µm/K Δc; 0.1 µm noise.
+io::MeasuredRun spindle_run(double hours, std::uint64_t stream) {
+  std::mt19937_64 rng = core::generator(5, stream);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  const auto n = static_cast<Eigen::Index>(hours * 60.0);
+  io::MeasuredRun r;
+  r.machine = "synthetic";
+  r.run = "compensate test " + std::to_string(stream);
+  r.sensors = {{"a", {}}, {"b", {}}, {"c", {}}};
+  r.displacements = {{"p", {}, {}}, {"q", {}, {}}};
+  r.inputs = {"speed_rpm"};
+  r.time = Eigen::VectorXd::LinSpaced(n, 0.0, 60.0 * static_cast<double>(n - 1));
+  Eigen::VectorXd on(n), ambient(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    on(i) = std::fmod(r.time(i), 6 * 3600.0) < 4 * 3600.0 && r.time(i) >= 600.0 ? 1.0 : 0.0;
+    ambient(i) = 20.0 + 0.4 * std::sin(r.time(i) / 20000.0 + static_cast<double>(stream));
+  }
+  r.input_values = 2500.0 * on;
+  r.temperature.resize(n, 3);
+  const double lags[] = {1200.0, 3000.0, 6000.0};
+  for (int c = 0; c < 3; ++c)
+    r.temperature.col(c) = ambient + (6.0 - c) * fitting::low_pass(r.time, on, lags[c]);
+  const auto rise = [&](int c) {
+    return Eigen::VectorXd(r.temperature.col(c).array() - r.temperature(0, c));
+  };
+  const Eigen::VectorXd p =
+      2.0 * rise(0) + fitting::low_pass(r.time, rise(1), 2400.0) + 0.001 * r.input_values.col(0);
+  r.displacement.resize(n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    r.displacement(i, 0) = (p(i) + noise(rng)) * 1e-6;
+    r.displacement(i, 1) = (-1.5 * rise(2)(i) + noise(rng)) * 1e-6;
+  }
+  return r;
+}
+
+/// Rows of a CSV with a header, as maps from column to text.
+std::vector<std::map<std::string, std::string>> csv_rows(const fs::path& file) {
+  std::istringstream in(read_text(file));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream h(line);
+  for (std::string c; std::getline(h, c, ',');) header.push_back(c);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::map<std::string, std::string> row;
+    std::stringstream s(line);
+    std::string cell;
+    for (std::size_t c = 0; c < header.size(); ++c) {
+      if (!std::getline(s, cell, ',')) cell.clear();
+      row[header[c]] = cell;
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// A fitted model of a training run, and a held-out run of one speed cycle (one test group,
+/// re-zeroed at the run's start as compensate's increments are).
+struct Fitted {
+  fs::path dir, fit, test_run;
+};
+
+const Fitted& fitted() {
+  static const Fitted f = [] {
+    Fitted f;
+    f.dir = scratch("compensate");
+    io::write_measured_run(f.dir / "train", spindle_run(30.0, 1));
+    f.test_run = f.dir / "test";
+    io::write_measured_run(f.test_run, spindle_run(5.5, 2));
+    f.fit = f.dir / "fit";
+    EXPECT_EQ(run({"fit", "--data", (f.dir / "train").string(), "--test", f.test_run.string(),
+                   "--out", f.fit.string(), "--quick", "--quiet"},
+                  {}, f.dir / "fit.log"),
+              0)
+        << read_text(f.dir / "fit.log");
+    return f;
+  }();
+  return f;
+}
+
+/// compensation.csv's predicted_um keyed by (target, time_s).
+std::map<std::pair<std::string, double>, double> offline(const Fitted& f) {
+  std::map<std::pair<std::string, double>, double> out;
+  for (const auto& r : csv_rows(f.fit / "compensation.csv"))
+    out[{r.at("target"), std::stod(r.at("time_s"))}] = std::stod(r.at("predicted_um"));
+  return out;
+}
+
+/// Every output row before `before_s` matches compensation.csv to 1e-9 of the largest prediction
+/// (compensation.csv has 10 significant digits); returns the number of values compared.
+int expect_offline_predictions(const fs::path& live_csv, const Fitted& f,
+                               double before_s = std::numeric_limits<double>::infinity()) {
+  const auto off = offline(f);
+  double scale = 0.0;
+  for (const auto& [key, v] : off) scale = std::max(scale, std::abs(v));
+  EXPECT_GT(scale, 5.0);  // the models do predict a drift of several µm
+  int compared = 0;
+  for (const auto& r : csv_rows(live_csv)) {
+    if (r.at("status") != "ok" || !(std::stod(r.at("time_s")) < before_s)) continue;
+    for (const std::string target : {"p", "q"}) {
+      const auto it = off.find({target, std::stod(r.at("time_s"))});
+      if (it == off.end()) continue;
+      EXPECT_NEAR(std::stod(r.at(target + "_predicted_um")), it->second, 1e-9 * scale)
+          << target << " at " << r.at("time_s");
+      EXPECT_GT(std::stod(r.at(target + "_sigma_um")), 0.0);
+      ++compared;
+    }
+  }
+  return compared;
+}
+
+}  // namespace
+
+TEST(Compensate, ReplayedRunGivesTheOfflinePredictions) {
+  const Fitted& f = fitted();
+  const fs::path live = f.dir / "replay.csv";
+  ASSERT_EQ(run({"compensate", "--model", (f.fit / "fit.json").string(), "--in",
+                 (f.test_run / "data.csv").string(), "--until-eof", "--out", live.string()},
+                {}, f.dir / "replay.log"),
+            0)
+      << read_text(f.dir / "replay.log");
+  EXPECT_EQ(csv_rows(live).size(), 330u);
+  EXPECT_EQ(expect_offline_predictions(live, f), 2 * 330);
+}
+
+TEST(Compensate, FollowsAGrowingFileAndHoldsABlankCell) {
+  const Fitted& f = fitted();
+  std::istringstream data(read_text(f.test_run / "data.csv"));
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(data, l);) lines.push_back(l);
+  const fs::path growing = f.dir / "growing.csv", live = f.dir / "followed.csv";
+  {
+    std::ofstream out(growing);
+    for (std::size_t i = 0; i < 50; ++i) out << lines[i] << "\n";
+  }
+  const pid_t pid =
+      reliability_test::start({"compensate", "--model", (f.fit / "fit.json").string(), "--in",
+                               growing.string(), "--idle-s", "1.5", "--out", live.string()},
+                              {}, f.dir / "follow.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  {
+    std::ofstream out(growing, std::ios::app);
+    // Line 60's (sample 59's) reading of c is lost; half a line is written before the rest.
+    for (std::size_t i = 50; i < lines.size(); ++i) {
+      std::string l = lines[i];
+      if (i == 60) {
+        // columns in the writer's order: time_s, speed_rpm, a, b, c, p, q
+        std::vector<std::string> cells;
+        std::stringstream s(l);
+        for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+        ASSERT_EQ(cells.size(), 7u) << l;
+        cells[4].clear();
+        l = cells[0];
+        for (std::size_t c = 1; c < cells.size(); ++c) l += "," + cells[c];
+      }
+      if (i == 100) {
+        out << l.substr(0, 5) << std::flush;
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        out << l.substr(5) << "\n";
+      } else {
+        out << l << "\n";
+      }
+    }
+  }
+  ASSERT_EQ(reliability_test::wait_for(pid), 0) << read_text(f.dir / "follow.log");
+  const auto rows = csv_rows(live);
+  ASSERT_EQ(rows.size(), lines.size() - 1);
+  EXPECT_EQ(rows[59].at("status"), "held:c");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (i != 59) {
+      EXPECT_EQ(rows[i].at("status"), "ok") << i;
+    }
+    EXPECT_FALSE(rows[i].at("p_predicted_um").empty()) << i;
+  }
+  // Before the gap every prediction is the offline one; from it on, the held reading of c (a
+  // value the offline fit never saw: it drops the row) changes the prediction there.
+  EXPECT_EQ(expect_offline_predictions(live, f, std::stod(rows[59].at("time_s"))), 2 * 59);
+  const double t59 = std::stod(rows[59].at("time_s"));
+  EXPECT_GT(std::abs(std::stod(rows[59].at("q_predicted_um")) - offline(f).at({"q", t59})), 1e-3);
+}
+
+TEST(Compensate, StreamLackingAModelColumnIsRefusedNamingIt) {
+  const Fitted& f = fitted();
+  const fs::path stream = f.dir / "no_b.csv";
+  std::ofstream(stream) << "time_s,speed_rpm,a,c\n0,0,20,20\n";
+  const fs::path log = f.dir / "refused.log", out = f.dir / "refused.csv";
+  EXPECT_NE(run({"compensate", "--model", (f.fit / "fit.json").string(), "--in", stream.string(),
+                 "--until-eof", "--out", out.string()},
+                {}, log),
+            0);
+  EXPECT_NE(read_text(log).find("column 'b' is missing"), std::string::npos) << read_text(log);
+  EXPECT_FALSE(fs::exists(out));
+}
