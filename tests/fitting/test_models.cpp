@@ -34,7 +34,7 @@ std::vector<Group> last(const std::vector<Group>& groups, int count) {
 /// Standard errors of [β0, β...] from σ²(AᵀA)⁻¹ on the stacked fitting rows.
 Eigen::VectorXd standard_errors(const std::vector<Group>& groups, const std::vector<int>& sensors,
                                 double sigma) {
-  FeatureMap map{sensors, {}, {}};
+  FeatureMap map{sensors, {}, {}, {}, {}};
   for (int s : sensors) map.sensor_names.push_back(groups[0].sensor_names[s]);
   const StackedRows rows = stacked_rows(map, groups, 0);
   Eigen::MatrixXd a(rows.features.rows(), rows.features.cols() + 1);
