@@ -74,7 +74,48 @@ nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p)
   return j;
 }
 
+bool speed_law(const nlohmann::json& c) {
+  const std::string k = c.at("kind");
+  return k == "speed_dependent_convection" || k == "temperature_dependent_heat" ||
+         (k == "heat_input" && c.at("parameters").value("law", "") == "speed");
+}
+
 }  // namespace
+
+std::string telling_apart(const nlohmann::json& a, const nlohmann::json& b) {
+  std::vector<std::string> hints;
+  auto either = [&](const std::string& kind) { return a.at("kind") == kind || b.at("kind") == kind; };
+  if (either("ambient_temperature"))
+    hints.push_back(
+        "an air temperature sensor beside the machine (meta.json `ambient_sensor`): the air is "
+        "then read, not fitted");
+  if (speed_law(a) != speed_law(b))
+    hints.push_back(
+        "a duty cycle whose speed changes while the air does not, with holds of an hour or more "
+        "at standstill and at the top speed: a speed-driven mechanism follows the steps, the "
+        "other does not");
+  if (either("temperature_dependent_heat") && speed_law(a) && speed_law(b))
+    hints.push_back(
+        "a long hold at one speed: heat that grows with temperature keeps rising after a film's "
+        "change has settled");
+  for (const auto* c : {&a, &b}) {
+    const std::string k = c->at("kind");
+    if (k == "heat_input" && c->at("location").contains("centre_m"))
+      hints.push_back("a temperature sensor at the heat input's place " +
+                      c->at("location").at("centre_m").dump() + " m");
+    if ((k == "sensor_offset" || k == "sensor_lag") && c->at("location").contains("sensor"))
+      hints.push_back("a second sensor beside " +
+                      c->at("location").at("sensor").get<std::string>());
+    if (k == "temperature_dependent_heat" && c->at("location").contains("body"))
+      hints.push_back("a sensor on " + c->at("location").at("body").get<std::string>());
+  }
+  if (a.at("location").value("field", "") == "expansion" ||
+      b.at("location").value("field", "") == "expansion")
+    hints.push_back("a displacement probe in another direction or at another point");
+  std::string out;
+  for (const auto& h : hints) out += (out.empty() ? "" : "; ") + h;
+  return out.empty() ? "a run with another duty cycle, and sensors where the two differ most" : out;
+}
 
 AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
                              const std::vector<double>& p, const Readout& r) {
@@ -306,6 +347,9 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
         runs.push_back(
             {{"run", cat.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
       j["parameters"] = {{"per_training_run", runs}};
+      for (size_t k = 0; k < f.run_parameters.size() && k < cat.runs.size(); ++k)
+        j["parameters"]["per_training_run"][k]["air"] =
+            cat.runs[k].air.size() ? "ambient sensor" : "fitted within bounds";
       if (claimed) {
         nlohmann::json tests = nlohmann::json::array();
         for (const auto& t : res.tests) {
@@ -326,6 +370,9 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
     j["heldout_gain"] = f.heldout_gain;
     j["score"] = f.score;
     j["model_form_floor"] = f.floor;
+    j["heldout_gain_per_training_run"] = f.fold_gains;
+    if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
+    if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
     j["claimed"] = claimed;
     return j;
   };
@@ -336,6 +383,18 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
     const bool is_claimed =
         !res.selection.claimed.empty() && f.candidate == res.selection.claimed.front().candidate;
     if (!is_claimed) res.runners_up.push_back(describe(f, false));
+  }
+  res.ambiguous = nlohmann::json::array();
+  for (const auto& a : res.selection.ambiguous) {
+    const nlohmann::json first = describe(a.first, false), second = describe(a.second, false);
+    res.ambiguous.push_back(
+        {{"candidates", {first, second}},
+         {"score_difference", a.difference},
+         {"spread", a.spread},
+         {"distinguishing_channel",
+          {{"channel", r.ids.at(static_cast<size_t>(a.channel))},
+           {"rms_difference_sigmas", a.channel_difference}}},
+         {"hint", telling_apart(first, second)}});
   }
   return res;
 }
@@ -354,6 +413,7 @@ nlohmann::json calibration_json(const CalibrationResult& res,
                 {"displacement_rms_um", res.after.displacement_rms_um}};
   j["effects"] = res.effects;
   j["runners_up"] = res.runners_up;
+  j["ambiguous"] = res.ambiguous;
   nlohmann::json sigma = nlohmann::json::array();
   for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
     sigma.push_back(res.selection.sigma(c));
@@ -362,7 +422,11 @@ nlohmann::json calibration_json(const CalibrationResult& res,
        "an effect is claimed when its leave-one-run-out gain minus the complexity penalty "
        "(whitened sum "
        "of squares) beats both the best score of every candidate fitted to pure white noise at the "
-       "estimated noise level and the model-form floor of the channels it moves"},
+       "estimated noise level and the model-form floor of the channels it moves; a candidate whose "
+       "fitted parameters are unphysical (field `unphysical`) is never claimed; when the best "
+       "candidate of another kind that would be claimed too scores less than the spread of the "
+       "two candidates' per-run held-out gain differences (sqrt(#runs) x their standard "
+       "deviation) below the best, neither is claimed and both are reported as `ambiguous`"},
       {"null_score", res.selection.null_score},
       {"training_residual_whitened_ss", res.selection.residual_ss},
       {"noise_sigma_per_channel", sigma}};

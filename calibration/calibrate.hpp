@@ -61,7 +61,14 @@ struct CalibrationResult {
   std::vector<std::vector<double>> training_run_parameters;  /// per claimed effect, per-run fits
   nlohmann::json effects;  /// claimed: {kind, parameters, location, explained_fraction, ...}
   nlohmann::json runners_up;
+  /// Mechanisms the choice could not tell apart (Selection::ambiguous): each {candidates: [two
+  /// descriptions as in `effects`], score_difference, spread, distinguishing_channel, hint}.
+  nlohmann::json ambiguous;
 };
+
+/// What measurement would tell candidates of kinds `a` and `b` apart (`a_candidate` and
+/// `b_candidate` their descriptions as in CalibrationResult::effects).
+std::string telling_apart(const nlohmann::json& a_candidate, const nlohmann::json& b_candidate);
 
 /// Selects effects on `train` (a catalogue built from the training runs) and evaluates the
 /// augmented model on `test` runs through the project's pipeline (mesh_case of the augmented case,

@@ -313,6 +313,22 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
     for (Eigen::Index i = 0; i < ns; ++i)
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
   }
+  if (inst.ambient_sensor) {
+    const auto& fixed = truth.mechanical.fixed_groups;
+    const auto air = std::find_if(
+        truth.thermal.convection.begin(), truth.thermal.convection.end(), [&](const auto& c) {
+          return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end();
+        });
+    if (air == truth.thermal.convection.end())
+      throw core::DataError("generator: an ambient sensor needs a convection entry on a group "
+                            "that is not fixed (the air); the case has none");
+    const Eigen::Index k = run.temperature.cols();
+    run.temperature.conservativeResize(ns, k + 1);
+    for (Eigen::Index i = 0; i < ns; ++i)
+      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + kCelsius;
+    run.sensors.push_back({"AIR", std::nullopt});
+    run.ambient_sensor = "AIR";
+  }
   if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
     const int tcp = point_node(m, truth.mechanical.tcp_point);
     const solvers::ElasticModel model(m, truth);

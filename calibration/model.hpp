@@ -50,6 +50,10 @@ core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRu
 /// Measured channels of `run` in the readout's order: #samples x #channels [K | m], NaN missing.
 Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r);
 
+/// The air temperature `run`'s ambient sensor reads: #samples [K], NaN missing; empty when the run
+/// names no ambient sensor.
+Eigen::VectorXd ambient_reading(const io::MeasuredRun& run);
+
 /// A load added to the declared model, whose channel response the march computes. `rhs` gets the
 /// step (its ends, speed, scheme weight and the base states at both ends) and returns the step's
 /// weighted load, #nodes [W per unit] (solvers::StepView says how it enters the response).
