@@ -173,10 +173,10 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
          << ") from **" << c[1]["name"].get<std::string>() << "** ("
          << c[1]["kind"].get<std::string>() << ", score " << c[1]["score"].get<double>()
          << "): their scores differ by " << a["score_difference"].get<double>()
-         << ", less than the spread of their per-run held-out gains ("
-         << a["spread"].get<double>() << "), so neither is claimed. Their fitted predictions "
-         << "differ most on `" << a["distinguishing_channel"]["channel"].get<std::string>()
-         << "` (" << a["distinguishing_channel"]["rms_difference_sigmas"].get<double>()
+         << ", less than the spread of their per-run held-out gains (" << a["spread"].get<double>()
+         << "), so neither is claimed. Their fitted predictions "
+         << "differ most on `" << a["distinguishing_channel"]["channel"].get<std::string>() << "` ("
+         << a["distinguishing_channel"]["rms_difference_sigmas"].get<double>()
          << " noise sigmas RMS). To tell them apart: " << a["hint"].get<std::string>() << ".\n\n";
     }
   }

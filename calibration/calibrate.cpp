@@ -84,7 +84,9 @@ bool speed_law(const nlohmann::json& c) {
 
 std::string telling_apart(const nlohmann::json& a, const nlohmann::json& b) {
   std::vector<std::string> hints;
-  auto either = [&](const std::string& kind) { return a.at("kind") == kind || b.at("kind") == kind; };
+  auto either = [&](const std::string& kind) {
+    return a.at("kind") == kind || b.at("kind") == kind;
+  };
   if (either("ambient_temperature"))
     hints.push_back(
         "an air temperature sensor beside the machine (meta.json `ambient_sensor`): the air is "
@@ -387,14 +389,13 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
   res.ambiguous = nlohmann::json::array();
   for (const auto& a : res.selection.ambiguous) {
     const nlohmann::json first = describe(a.first, false), second = describe(a.second, false);
-    res.ambiguous.push_back(
-        {{"candidates", {first, second}},
-         {"score_difference", a.difference},
-         {"spread", a.spread},
-         {"distinguishing_channel",
-          {{"channel", r.ids.at(static_cast<size_t>(a.channel))},
-           {"rms_difference_sigmas", a.channel_difference}}},
-         {"hint", telling_apart(first, second)}});
+    res.ambiguous.push_back({{"candidates", {first, second}},
+                             {"score_difference", a.difference},
+                             {"spread", a.spread},
+                             {"distinguishing_channel",
+                              {{"channel", r.ids.at(static_cast<size_t>(a.channel))},
+                               {"rms_difference_sigmas", a.channel_difference}}},
+                             {"hint", telling_apart(first, second)}});
   }
   return res;
 }

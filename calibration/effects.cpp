@@ -190,7 +190,8 @@ Eigen::VectorXd bounded_air(const Eigen::MatrixXd& g0, const Eigen::VectorXd& b,
                             const std::vector<double>& knots, const CalibrationOptions& o) {
   const Eigen::Index p = g0.rows();
   const double scale = std::max(g0.diagonal().mean(), 1e-300);
-  const Eigen::MatrixXd g = g0 + (std::max(o.ridge, 1e-6) * scale) * Eigen::MatrixXd::Identity(p, p);
+  const Eigen::MatrixXd g =
+      g0 + (std::max(o.ridge, 1e-6) * scale) * Eigen::MatrixXd::Identity(p, p);
   // Bounds on M x: the change at each knot, then its change between neighbouring knots.
   const Eigen::Index m = p + std::max<Eigen::Index>(p - 1, 0);
   Eigen::MatrixXd mat = Eigen::MatrixXd::Zero(m, p);
@@ -273,8 +274,8 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
     case EffectKind::material_parameter:
       if (p.at(0) < o.material_change_min || p.at(0) > o.material_change_max)
         return c.field + " changed by " + number(100 * p.at(0)) + " %: outside " +
-               number(100 * o.material_change_min) + " .. " +
-               number(100 * o.material_change_max) + " %";
+               number(100 * o.material_change_min) + " .. " + number(100 * o.material_change_max) +
+               " %";
       return {};
     case EffectKind::sensor_offset:
     case EffectKind::sensor_lag:
@@ -851,7 +852,8 @@ double gain_spread(const EffectFit& a, const EffectFit& b) {
   const size_t n = std::min(a.fold_gains.size(), b.fold_gains.size());
   if (n < 2) return 0;
   double mean = 0, ss = 0;
-  for (size_t r = 0; r < n; ++r) mean += (a.fold_gains[r] - b.fold_gains[r]) / static_cast<double>(n);
+  for (size_t r = 0; r < n; ++r)
+    mean += (a.fold_gains[r] - b.fold_gains[r]) / static_cast<double>(n);
   for (size_t r = 0; r < n; ++r) {
     const double d = a.fold_gains[r] - b.fold_gains[r] - mean;
     ss += d * d;
@@ -867,8 +869,8 @@ void distinguishing_channel(const Catalogue& cat, const Eigen::VectorXd& sigma, 
   const Eigen::Index nc = sigma.size();
   Eigen::VectorXd ss = Eigen::VectorXd::Zero(nc), count = Eigen::VectorXd::Zero(nc);
   for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
-    const Eigen::VectorXd d =
-        a.columns[ri] * fitted_theta(a, amb.first, ri) - b.columns[ri] * fitted_theta(b, amb.second, ri);
+    const Eigen::VectorXd d = a.columns[ri] * fitted_theta(a, amb.first, ri) -
+                              b.columns[ri] * fitted_theta(b, amb.second, ri);
     const Eigen::Index ns = cat.runs[ri].times.size();
     for (Eigen::Index ch = 0; ch < nc; ++ch) {
       ss(ch) += d.segment(ch * ns, ns).squaredNorm() / (sigma(ch) * sigma(ch));
@@ -1044,8 +1046,8 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
     auto claimable = [&](const EffectFit& f) {
       return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
     };
-    const auto best_at = std::find_if(order.begin(), order.end(),
-                                      [&](int i) { return fits[i].unphysical.empty(); });
+    const auto best_at =
+        std::find_if(order.begin(), order.end(), [&](int i) { return fits[i].unphysical.empty(); });
     if (best_at == order.end() || !claimable(fits[*best_at])) break;
     const EffectFit& best = fits[*best_at];
     const auto second_at = std::find_if(best_at + 1, order.end(), [&](int i) {

@@ -56,8 +56,9 @@ struct CalibrationOptions {
   /// |correlation| of a fitted air with the run's speed (both averaged over the knots' hats,
   /// centred per run) from which the air is taken for a speed mechanism's shadow, not the shop's.
   double air_duty_correlation = 0.7;
-  /// Relative change of a conductivity, heat capacity or expansion coefficient.
-  double material_change_min = -0.3, material_change_max = 0.5;
+  /// Relative change of a conductivity, heat capacity or expansion coefficient: a factor of at
+  /// most 1.5 either way.
+  double material_change_min = -1.0 / 3, material_change_max = 0.5;
   /// Temperature coefficient of a heat source after the change [1/K].
   double temperature_coefficient_min_per_K = -0.05, temperature_coefficient_max_per_K = 0.15;
 };

@@ -154,7 +154,9 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
       const int body = pick(rng, std::min(2, static_cast<int>(declared.bodies.size())));
       const int mi = declared.bodies[body].material;
       e.target = declared.materials[mi].name + "." + fields[pick(rng, 3)];
-      e.magnitude = signed_factor(rng, 0.25, 0.6);
+      // Within the calibrator's physical bounds (a factor of 1.5 either way), with room for the
+      // linearised fit's error.
+      e.magnitude = signed_factor(rng, 0.15, 0.4);
       break;
     }
     case EffectKind::sensor_offset:
@@ -320,8 +322,9 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
           return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end();
         });
     if (air == truth.thermal.convection.end())
-      throw core::DataError("generator: an ambient sensor needs a convection entry on a group "
-                            "that is not fixed (the air); the case has none");
+      throw core::DataError(
+          "generator: an ambient sensor needs a convection entry on a group "
+          "that is not fixed (the air); the case has none");
     const Eigen::Index k = run.temperature.cols();
     run.temperature.conservativeResize(ns, k + 1);
     for (Eigen::Index i = 0; i < ns; ++i)

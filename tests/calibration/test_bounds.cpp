@@ -26,7 +26,8 @@ RunModel run_model(const std::string& name, double hours, double block_s, int sh
   rm.spec.duty_cycle.end = hours * 3600;
   const double speeds[] = {3000, 0, 1500, 0};
   int k = shift;
-  for (double t = 0; t < rm.spec.duty_cycle.end; t += block_s) rm.spec.duty_cycle.segments.push_back({t, speeds[k++ % 4]});
+  for (double t = 0; t < rm.spec.duty_cycle.end; t += block_s)
+    rm.spec.duty_cycle.segments.push_back({t, speeds[k++ % 4]});
   core::Convection cv;
   cv.group = 0;
   cv.h = 8;
@@ -237,8 +238,8 @@ TEST(Physics, UnphysicalCandidatesAreReportedNotClaimed) {
   std::vector<RunModel> runs{run_model("a", 3, 1800, 0), run_model("b", 3, 2400, 1)};
   std::vector<Eigen::VectorXd> shape, other;
   for (size_t r = 0; r < runs.size(); ++r) {
-    const Eigen::VectorXd x = speed_response(runs[r], 900) +
-                              0.5 * (runs[r].times.array() / 10800).matrix();
+    const Eigen::VectorXd x =
+        speed_response(runs[r], 900) + 0.5 * (runs[r].times.array() / 10800).matrix();
     shape.push_back(x);
     other.push_back(0.1 * (x + 0.05 * speed_response(runs[r], 300)));
     runs[r].measured.col(0) += -0.6 * x;
@@ -279,9 +280,8 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   auto with = [&](double on_a, double on_b) {
     Catalogue cat = one_channel(runs);
     cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", x));
-    cat.candidates.push_back(candidate(
-        EffectKind::material_parameter, "conductivity",
-        {2.5 * (x[0] + on_a * w[0]), 2.5 * (x[1] + on_b * w[1])}));
+    cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity",
+                                       {2.5 * (x[0] + on_a * w[0]), 2.5 * (x[1] + on_b * w[1])}));
     return cat;
   };
   // The heat input is right on run a, the conductivity on run b.
@@ -304,7 +304,8 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
 }
 
 TEST(Ambiguity, HintNamesTheAmbientSensorAndADutyCycle) {
-  const nlohmann::json air = {{"kind", "ambient_temperature"}, {"location", nlohmann::json::object()},
+  const nlohmann::json air = {{"kind", "ambient_temperature"},
+                              {"location", nlohmann::json::object()},
                               {"parameters", nlohmann::json::object()}};
   const nlohmann::json speed = {{"kind", "speed_dependent_convection"},
                                 {"location", {{"group", "air_gap"}}},
