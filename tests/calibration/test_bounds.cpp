@@ -264,6 +264,13 @@ TEST(Physics, UnphysicalCandidatesAreReportedNotClaimed) {
   ASSERT_FALSE(sel.claimed.empty());
   EXPECT_EQ(sel.claimed[0].kind, EffectKind::boundary_conductance);
   EXPECT_GT(sel.claimed[0].parameters.at(0), -8);  // h = 8 W/m2K stays positive
+  // calibration.json: the unphysical ones among the runners-up with their reasons.
+  const nlohmann::json j = calibration_json(calibrate({}, {}, cat, {}, CalibrationOptions{}), {});
+  ASSERT_EQ(j["effects"].size(), 1u);
+  EXPECT_EQ(j["effects"][0]["kind"], "boundary_conductance");
+  int unphysical = 0;
+  for (const auto& e : j["runners_up"]) unphysical += e.contains("unphysical");
+  EXPECT_EQ(unphysical, 3) << j["runners_up"].dump(1);
 }
 
 // The same response under two kinds, each fitting one run a little better: ambiguous, neither
@@ -280,6 +287,7 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   auto with = [&](double on_a, double on_b) {
     Catalogue cat = one_channel(runs);
     cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", x));
+    cat.candidates.back().location = {{"centre_m", {0.1, 0.2, 0.3}}};
     cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity",
                                        {2.5 * (x[0] + on_a * w[0]), 2.5 * (x[1] + on_b * w[1])}));
     return cat;
@@ -296,6 +304,16 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   EXPECT_LT(amb.difference, amb.spread);
   EXPECT_EQ(amb.channel, 0);
   EXPECT_GT(amb.channel_difference, 0);
+  // calibration.json: both under `ambiguous` with the channel and a hint, nothing claimed.
+  const CalibrationResult res = calibrate({}, {}, cat, {}, CalibrationOptions{});
+  const nlohmann::json j = calibration_json(res, {"a", "b"});
+  EXPECT_TRUE(j["effects"].empty());
+  ASSERT_EQ(j["ambiguous"].size(), 1u);
+  EXPECT_EQ(j["ambiguous"][0]["candidates"].size(), 2u);
+  EXPECT_EQ(j["ambiguous"][0]["distinguishing_channel"]["channel"], "T1");
+  EXPECT_NE(j["ambiguous"][0]["hint"].get<std::string>().find("heat input's place"),
+            std::string::npos)
+      << j["ambiguous"][0].dump(1);
   // The conductivity wrong on both runs: the heat input is claimed.
   const Selection one = select_effects(with(3, -3), CalibrationOptions{});
   EXPECT_TRUE(one.ambiguous.empty());
