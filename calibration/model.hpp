@@ -47,12 +47,12 @@ Eigen::MatrixXd displacement_readout(const mesh::TetMesh& mesh, const core::Case
 /// it gives one, and its end at the last sample. Throws DataError without a speed column.
 core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRun& run);
 
-/// Measured channels of `run` in the readout's order: #samples x #channels [K | m], NaN missing.
-Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r);
-
 /// The air temperature `run`'s ambient sensor reads: #samples [K], NaN missing; empty when the run
 /// names no ambient sensor.
 Eigen::VectorXd ambient_reading(const io::MeasuredRun& run);
+
+/// Measured channels of `run` in the readout's order: #samples x #channels [K | m], NaN missing.
+Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r);
 
 /// A load added to the declared model, whose channel response the march computes. `rhs` gets the
 /// step (its ends, speed, scheme weight and the base states at both ends) and returns the step's
