@@ -1,7 +1,8 @@
 // Calibration against generated runs with undeclared effects (CI scale: coarse meshes, 2-hour
 // runs). For each effect kind: the right kind comes first, a heat input is placed within 0.1 m,
 // and the test-run RMS after is at most 30 % of before; on clean runs at most 1 in 10 is given an
-// effect. Plus small unit checks of the pieces.
+// effect; the air is read from a run's ambient sensor, and heat loss following the speed on every
+// film is not claimed as air. Plus small unit checks of the pieces.
 #include <gtest/gtest.h>
 
 #include <algorithm>
