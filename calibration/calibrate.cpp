@@ -339,43 +339,19 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
 
   auto describe = [&](const EffectFit& f, bool claimed) {
     const Candidate& c = cat.candidates[f.candidate];
-    nlohmann::json j;
-    j["kind"] = kind_name(c.kind);
-    j["name"] = c.name;
-    j["location"] = c.location;
-    if (c.per_run) {
-      nlohmann::json runs = nlohmann::json::array();
-      for (size_t k = 0; k < f.run_parameters.size(); ++k)
-        runs.push_back(
-            {{"run", cat.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
-      j["parameters"] = {{"per_training_run", runs}};
-      for (size_t k = 0; k < f.run_parameters.size() && k < cat.runs.size(); ++k)
-        j["parameters"]["per_training_run"][k]["air"] =
-            cat.runs[k].air.size() ? "ambient sensor" : "fitted within bounds";
-      if (claimed) {
-        nlohmann::json tests = nlohmann::json::array();
-        for (const auto& t : res.tests) {
-          const auto& sinks = t.augmented.spec.thermal.convection;
-          nlohmann::json table = nlohmann::json::array();
-          if (!c.entries.empty())
-            for (size_t k = 0; k < sinks[c.entries[0]].sink.time.size(); ++k)
-              table.push_back(
-                  {sinks[c.entries[0]].sink.time[k], sinks[c.entries[0]].sink.value[k]});
-          tests.push_back({{"run", t.name}, {"sink_table_s_degC", table}});
-        }
-        j["parameters"]["per_test_run"] = tests;
+    nlohmann::json j = effect_json(cat, f, claimed);
+    if (c.per_run && claimed) {
+      nlohmann::json tests = nlohmann::json::array();
+      for (const auto& t : res.tests) {
+        const auto& sinks = t.augmented.spec.thermal.convection;
+        nlohmann::json table = nlohmann::json::array();
+        if (!c.entries.empty())
+          for (size_t k = 0; k < sinks[c.entries[0]].sink.time.size(); ++k)
+            table.push_back({sinks[c.entries[0]].sink.time[k], sinks[c.entries[0]].sink.value[k]});
+        tests.push_back({{"run", t.name}, {"sink_table_s_degC", table}});
       }
-    } else {
-      j["parameters"] = parameters_json(c, f.parameters);
+      j["parameters"]["per_test_run"] = tests;
     }
-    j["explained_fraction"] = f.explained_fraction;
-    j["heldout_gain"] = f.heldout_gain;
-    j["score"] = f.score;
-    j["model_form_floor"] = f.floor;
-    j["heldout_gain_per_training_run"] = f.fold_gains;
-    if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
-    if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
-    j["claimed"] = claimed;
     return j;
   };
   res.effects = nlohmann::json::array();
@@ -386,18 +362,51 @@ CalibrationResult calibrate(const mesh::TetMesh& mesh, const core::CaseSpec& dec
         !res.selection.claimed.empty() && f.candidate == res.selection.claimed.front().candidate;
     if (!is_claimed) res.runners_up.push_back(describe(f, false));
   }
-  res.ambiguous = nlohmann::json::array();
-  for (const auto& a : res.selection.ambiguous) {
-    const nlohmann::json first = describe(a.first, false), second = describe(a.second, false);
-    res.ambiguous.push_back({{"candidates", {first, second}},
-                             {"score_difference", a.difference},
-                             {"spread", a.spread},
-                             {"distinguishing_channel",
-                              {{"channel", r.ids.at(static_cast<size_t>(a.channel))},
-                               {"rms_difference_sigmas", a.channel_difference}}},
-                             {"hint", telling_apart(first, second)}});
-  }
+  res.ambiguous = ambiguity_json(cat, res.selection);
   return res;
+}
+
+nlohmann::json effect_json(const Catalogue& cat, const EffectFit& f, bool claimed) {
+  const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+  nlohmann::json j;
+  j["kind"] = kind_name(c.kind);
+  j["name"] = c.name;
+  j["location"] = c.location;
+  if (c.per_run) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (size_t k = 0; k < f.run_parameters.size() && k < cat.runs.size(); ++k)
+      runs.push_back({{"run", cat.runs[k].name},
+                      {"parameters", parameters_json(c, f.run_parameters[k])},
+                      {"air", cat.runs[k].air.size() ? "ambient sensor" : "fitted within bounds"}});
+    j["parameters"] = {{"per_training_run", runs}};
+  } else {
+    j["parameters"] = parameters_json(c, f.parameters);
+  }
+  j["explained_fraction"] = f.explained_fraction;
+  j["heldout_gain"] = f.heldout_gain;
+  j["score"] = f.score;
+  j["model_form_floor"] = f.floor;
+  j["heldout_gain_per_training_run"] = f.fold_gains;
+  if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
+  if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
+  j["claimed"] = claimed;
+  return j;
+}
+
+nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& sel) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& a : sel.ambiguous) {
+    const nlohmann::json first = effect_json(cat, a.first, false),
+                         second = effect_json(cat, a.second, false);
+    out.push_back({{"candidates", {first, second}},
+                   {"score_difference", a.difference},
+                   {"spread", a.spread},
+                   {"distinguishing_channel",
+                    {{"channel", cat.readout.ids.at(static_cast<size_t>(a.channel))},
+                     {"rms_difference_sigmas", a.channel_difference}}},
+                   {"hint", telling_apart(first, second)}});
+  }
+  return out;
 }
 
 nlohmann::json calibration_json(const CalibrationResult& res,

@@ -66,6 +66,15 @@ struct CalibrationResult {
   nlohmann::json ambiguous;
 };
 
+/// The description of a fitted candidate in calibration.json (`effects`, `runners_up`): kind, name,
+/// location, parameters (a per-run air's per training run, with where its air came from), scores,
+/// `unphysical` when it is. A claimed air's test-run sink tables are added by calibrate().
+nlohmann::json effect_json(const Catalogue& cat, const EffectFit& fit, bool claimed);
+
+/// calibration.json's `ambiguous`: per Selection::ambiguous, {candidates: [two effect_json],
+/// score_difference, spread, distinguishing_channel {channel, rms_difference_sigmas}, hint}.
+nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& selection);
+
 /// What measurement would tell candidates of kinds `a` and `b` apart (`a_candidate` and
 /// `b_candidate` their descriptions as in CalibrationResult::effects).
 std::string telling_apart(const nlohmann::json& a_candidate, const nlohmann::json& b_candidate);

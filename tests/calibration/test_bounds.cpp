@@ -264,13 +264,11 @@ TEST(Physics, UnphysicalCandidatesAreReportedNotClaimed) {
   ASSERT_FALSE(sel.claimed.empty());
   EXPECT_EQ(sel.claimed[0].kind, EffectKind::boundary_conductance);
   EXPECT_GT(sel.claimed[0].parameters.at(0), -8);  // h = 8 W/m2K stays positive
-  // calibration.json: the unphysical ones among the runners-up with their reasons.
-  const nlohmann::json j = calibration_json(calibrate({}, {}, cat, {}, CalibrationOptions{}), {});
-  ASSERT_EQ(j["effects"].size(), 1u);
-  EXPECT_EQ(j["effects"][0]["kind"], "boundary_conductance");
+  // calibration.json's descriptions: the unphysical ones with their reasons.
   int unphysical = 0;
-  for (const auto& e : j["runners_up"]) unphysical += e.contains("unphysical");
-  EXPECT_EQ(unphysical, 3) << j["runners_up"].dump(1);
+  for (const auto& f : sel.ranking) unphysical += effect_json(cat, f, false).contains("unphysical");
+  EXPECT_EQ(unphysical, 3);
+  EXPECT_FALSE(effect_json(cat, sel.claimed[0], true).contains("unphysical"));
 }
 
 // The same response under two kinds, each fitting one run a little better: ambiguous, neither
@@ -304,16 +302,13 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   EXPECT_LT(amb.difference, amb.spread);
   EXPECT_EQ(amb.channel, 0);
   EXPECT_GT(amb.channel_difference, 0);
-  // calibration.json: both under `ambiguous` with the channel and a hint, nothing claimed.
-  const CalibrationResult res = calibrate({}, {}, cat, {}, CalibrationOptions{});
-  const nlohmann::json j = calibration_json(res, {"a", "b"});
-  EXPECT_TRUE(j["effects"].empty());
-  ASSERT_EQ(j["ambiguous"].size(), 1u);
-  EXPECT_EQ(j["ambiguous"][0]["candidates"].size(), 2u);
-  EXPECT_EQ(j["ambiguous"][0]["distinguishing_channel"]["channel"], "T1");
-  EXPECT_NE(j["ambiguous"][0]["hint"].get<std::string>().find("heat input's place"),
-            std::string::npos)
-      << j["ambiguous"][0].dump(1);
+  // calibration.json's `ambiguous`: both candidates, the channel and a hint.
+  const nlohmann::json j = ambiguity_json(cat, sel);
+  ASSERT_EQ(j.size(), 1u);
+  EXPECT_EQ(j[0]["candidates"].size(), 2u);
+  EXPECT_EQ(j[0]["distinguishing_channel"]["channel"], "T1");
+  EXPECT_NE(j[0]["hint"].get<std::string>().find("heat input's place"), std::string::npos)
+      << j[0].dump(1);
   // The conductivity wrong on both runs: the heat input is claimed.
   const Selection one = select_effects(with(3, -3), CalibrationOptions{});
   EXPECT_TRUE(one.ambiguous.empty());
