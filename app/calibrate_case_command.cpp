@@ -210,9 +210,27 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
      << " |\n";
   md << "| after | " << res.after.temperature_rms_K << " | " << res.after.displacement_rms_um
      << " |\n\n";
+  if (!res.ambiguous.empty()) {
+    md << "## Ambiguous\n\n";
+    for (const auto& a : res.ambiguous) {
+      const auto& c = a["candidates"];
+      md << "The data do not tell **" << c[0]["name"].get<std::string>() << "** ("
+         << c[0]["kind"].get<std::string>() << ", score " << c[0]["score"].get<double>()
+         << ") from **" << c[1]["name"].get<std::string>() << "** ("
+         << c[1]["kind"].get<std::string>() << ", score " << c[1]["score"].get<double>()
+         << "): their scores differ by " << a["score_difference"].get<double>()
+         << ", less than the spread of their per-run held-out gains (" << a["spread"].get<double>()
+         << "), so neither is claimed. Their fitted predictions "
+         << "differ most on `" << a["distinguishing_channel"]["channel"].get<std::string>() << "` ("
+         << a["distinguishing_channel"]["rms_difference_sigmas"].get<double>()
+         << " noise sigmas RMS). To tell them apart: " << a["hint"].get<std::string>() << ".\n\n";
+    }
+  }
   if (res.effects.empty()) {
-    md << "No effect claimed: no candidate's held-out gain beat both the noise threshold ("
-       << res.selection.null_score << ") and its model-form floor.\n\n";
+    if (res.ambiguous.empty())
+      md << "No effect claimed: no physical candidate's held-out gain beat both the noise "
+            "threshold ("
+         << res.selection.null_score << ") and its model-form floor.\n\n";
   } else {
     md << "## Claimed effects\n\n";
     for (const auto& e : res.effects)
@@ -222,11 +240,14 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
          << ", floor " << e["model_form_floor"].get<double>() << ")\n  - parameters: `"
          << e["parameters"].dump() << "`\n  - location: `" << e["location"].dump() << "`\n";
   }
-  md << "\n## Runners-up\n\n| kind | name | explained fraction | score |\n| --- | --- | --- | --- "
+  md << "\n## Runners-up\n\nA candidate marked unphysical needs a value outside its bounds "
+        "(docs/calibration.md) to fit and is never claimed, however well it scores.\n\n"
+        "| kind | name | explained fraction | score | unphysical |\n| --- | --- | --- | --- | --- "
         "|\n";
   for (const auto& e : res.runners_up)
     md << "| " << e["kind"].get<std::string>() << " | " << e["name"].get<std::string>() << " | "
-       << e["explained_fraction"].get<double>() << " | " << e["score"].get<double>() << " |\n";
+       << e["explained_fraction"].get<double>() << " | " << e["score"].get<double>() << " | "
+       << e.value("unphysical", "") << " |\n";
   md << "\n## Figures\n\n![residual before and after](residual_before_after.png)\n\n![identified "
         "effect](effect.png)\n\n";
   md << "The augmented case for each test run is in `augmented/`; `augmented_case.toml` is the "

@@ -80,7 +80,50 @@ nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p)
   return j;
 }
 
+bool speed_law(const nlohmann::json& c) {
+  const std::string k = c.at("kind");
+  return k == "speed_dependent_convection" || k == "temperature_dependent_heat" ||
+         (k == "heat_input" && c.at("parameters").value("law", "") == "speed");
+}
+
 }  // namespace
+
+std::string telling_apart(const nlohmann::json& a, const nlohmann::json& b) {
+  std::vector<std::string> hints;
+  auto either = [&](const std::string& kind) {
+    return a.at("kind") == kind || b.at("kind") == kind;
+  };
+  if (either("ambient_temperature"))
+    hints.push_back(
+        "an air temperature sensor beside the machine (meta.json `ambient_sensor`): the air is "
+        "then read, not fitted");
+  if (speed_law(a) != speed_law(b))
+    hints.push_back(
+        "a duty cycle whose speed changes while the air does not, with holds of an hour or more "
+        "at standstill and at the top speed: a speed-driven mechanism follows the steps, the "
+        "other does not");
+  if (either("temperature_dependent_heat") && speed_law(a) && speed_law(b))
+    hints.push_back(
+        "a long hold at one speed: heat that grows with temperature keeps rising after a film's "
+        "change has settled");
+  for (const auto* c : {&a, &b}) {
+    const std::string k = c->at("kind");
+    if (k == "heat_input" && c->at("location").contains("centre_m"))
+      hints.push_back("a temperature sensor at the heat input's place " +
+                      c->at("location").at("centre_m").dump() + " m");
+    if ((k == "sensor_offset" || k == "sensor_lag") && c->at("location").contains("sensor"))
+      hints.push_back("a second sensor beside " +
+                      c->at("location").at("sensor").get<std::string>());
+    if (k == "temperature_dependent_heat" && c->at("location").contains("body"))
+      hints.push_back("a sensor on " + c->at("location").at("body").get<std::string>());
+  }
+  if (a.at("location").value("field", "") == "expansion" ||
+      b.at("location").value("field", "") == "expansion")
+    hints.push_back("a displacement probe in another direction or at another point");
+  std::string out;
+  for (const auto& h : hints) out += (out.empty() ? "" : "; ") + h;
+  return out.empty() ? "a run with another duty cycle, and sensors where the two differ most" : out;
+}
 
 AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
                              const std::vector<double>& p, const Readout& r) {
@@ -316,37 +359,19 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
 
   auto describe = [&](const EffectFit& f, bool claimed) {
     const Candidate& c = cat.candidates[f.candidate];
-    nlohmann::json j;
-    j["kind"] = kind_name(c.kind);
-    j["name"] = c.name;
-    j["location"] = c.location;
-    if (c.per_run) {
-      nlohmann::json runs = nlohmann::json::array();
-      for (size_t k = 0; k < f.run_parameters.size(); ++k)
-        runs.push_back(
-            {{"run", cat.runs[k].name}, {"parameters", parameters_json(c, f.run_parameters[k])}});
-      j["parameters"] = {{"per_training_run", runs}};
-      if (claimed) {
-        nlohmann::json tests = nlohmann::json::array();
-        for (const auto& t : res.tests) {
-          const auto& sinks = t.augmented.spec.thermal.convection;
-          nlohmann::json table = nlohmann::json::array();
-          if (!c.entries.empty())
-            for (size_t k = 0; k < sinks[c.entries[0]].sink.time.size(); ++k)
-              table.push_back(
-                  {sinks[c.entries[0]].sink.time[k], sinks[c.entries[0]].sink.value[k]});
-          tests.push_back({{"run", t.name}, {"sink_table_s_degC", table}});
-        }
-        j["parameters"]["per_test_run"] = tests;
+    nlohmann::json j = effect_json(cat, f, claimed);
+    if (c.per_run && claimed) {
+      nlohmann::json tests = nlohmann::json::array();
+      for (const auto& t : res.tests) {
+        const auto& sinks = t.augmented.spec.thermal.convection;
+        nlohmann::json table = nlohmann::json::array();
+        if (!c.entries.empty())
+          for (size_t k = 0; k < sinks[c.entries[0]].sink.time.size(); ++k)
+            table.push_back({sinks[c.entries[0]].sink.time[k], sinks[c.entries[0]].sink.value[k]});
+        tests.push_back({{"run", t.name}, {"sink_table_s_degC", table}});
       }
-    } else {
-      j["parameters"] = parameters_json(c, f.parameters);
+      j["parameters"]["per_test_run"] = tests;
     }
-    j["explained_fraction"] = f.explained_fraction;
-    j["heldout_gain"] = f.heldout_gain;
-    j["score"] = f.score;
-    j["model_form_floor"] = f.floor;
-    j["claimed"] = claimed;
     return j;
   };
   res.effects = nlohmann::json::array();
@@ -357,7 +382,51 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
         !res.selection.claimed.empty() && f.candidate == res.selection.claimed.front().candidate;
     if (!is_claimed) res.runners_up.push_back(describe(f, false));
   }
+  res.ambiguous = ambiguity_json(cat, res.selection);
   return res;
+}
+
+nlohmann::json effect_json(const Catalogue& cat, const EffectFit& f, bool claimed) {
+  const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+  nlohmann::json j;
+  j["kind"] = kind_name(c.kind);
+  j["name"] = c.name;
+  j["location"] = c.location;
+  if (c.per_run) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (size_t k = 0; k < f.run_parameters.size() && k < cat.runs.size(); ++k)
+      runs.push_back({{"run", cat.runs[k].name},
+                      {"parameters", parameters_json(c, f.run_parameters[k])},
+                      {"air", cat.runs[k].air.size() ? "ambient sensor" : "fitted within bounds"}});
+    j["parameters"] = {{"per_training_run", runs}};
+  } else {
+    j["parameters"] = parameters_json(c, f.parameters);
+  }
+  j["explained_fraction"] = f.explained_fraction;
+  j["heldout_gain"] = f.heldout_gain;
+  j["score"] = f.score;
+  j["model_form_floor"] = f.floor;
+  j["heldout_gain_per_training_run"] = f.fold_gains;
+  if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
+  if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
+  j["claimed"] = claimed;
+  return j;
+}
+
+nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& sel) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& a : sel.ambiguous) {
+    const nlohmann::json first = effect_json(cat, a.first, false),
+                         second = effect_json(cat, a.second, false);
+    out.push_back({{"candidates", {first, second}},
+                   {"score_difference", a.difference},
+                   {"spread", a.spread},
+                   {"distinguishing_channel",
+                    {{"channel", cat.readout.ids.at(static_cast<size_t>(a.channel))},
+                     {"rms_difference_sigmas", a.channel_difference}}},
+                   {"hint", telling_apart(first, second)}});
+  }
+  return out;
 }
 
 nlohmann::json calibration_json(const CalibrationResult& res,
@@ -374,6 +443,7 @@ nlohmann::json calibration_json(const CalibrationResult& res,
                 {"displacement_rms_um", res.after.displacement_rms_um}};
   j["effects"] = res.effects;
   j["runners_up"] = res.runners_up;
+  j["ambiguous"] = res.ambiguous;
   nlohmann::json sigma = nlohmann::json::array();
   for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
     sigma.push_back(res.selection.sigma(c));
@@ -382,7 +452,11 @@ nlohmann::json calibration_json(const CalibrationResult& res,
        "an effect is claimed when its leave-one-run-out gain minus the complexity penalty "
        "(whitened sum "
        "of squares) beats both the best score of every candidate fitted to pure white noise at the "
-       "estimated noise level and the model-form floor of the channels it moves"},
+       "estimated noise level and the model-form floor of the channels it moves; a candidate whose "
+       "fitted parameters are unphysical (field `unphysical`) is never claimed; when the best "
+       "candidate of another kind that would be claimed too scores less than the spread of the "
+       "two candidates' per-run held-out gain differences (sqrt(#runs) x their standard "
+       "deviation) below the best, neither is claimed and both are reported as `ambiguous`"},
       {"null_score", res.selection.null_score},
       {"training_residual_whitened_ss", res.selection.residual_ss},
       {"noise_sigma_per_channel", sigma}};

@@ -61,7 +61,23 @@ struct CalibrationResult {
   std::vector<std::vector<double>> training_run_parameters;  /// per claimed effect, per-run fits
   nlohmann::json effects;  /// claimed: {kind, parameters, location, explained_fraction, ...}
   nlohmann::json runners_up;
+  /// Mechanisms the choice could not tell apart (Selection::ambiguous): each {candidates: [two
+  /// descriptions as in `effects`], score_difference, spread, distinguishing_channel, hint}.
+  nlohmann::json ambiguous;
 };
+
+/// The description of a fitted candidate in calibration.json (`effects`, `runners_up`): kind, name,
+/// location, parameters (a per-run air's per training run, with where its air came from), scores,
+/// `unphysical` when it is. A claimed air's test-run sink tables are added by calibrate().
+nlohmann::json effect_json(const Catalogue& cat, const EffectFit& fit, bool claimed);
+
+/// calibration.json's `ambiguous`: per Selection::ambiguous, {candidates: [two effect_json],
+/// score_difference, spread, distinguishing_channel {channel, rms_difference_sigmas}, hint}.
+nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& selection);
+
+/// What measurement would tell candidates of kinds `a` and `b` apart (`a_candidate` and
+/// `b_candidate` their descriptions as in CalibrationResult::effects).
+std::string telling_apart(const nlohmann::json& a_candidate, const nlohmann::json& b_candidate);
 
 /// Selects effects on `train` (a catalogue built from the training runs) and evaluates the
 /// declared and the augmented model on `test` runs as the written case file reads back (the

@@ -79,7 +79,196 @@ std::vector<char> touched(const Candidate& c, Eigen::Index samples_first_run,
   return t;
 }
 
+double hat(double t, double tk, double dk) {
+  return std::max(0.0, 1 - std::abs(t - tk) / dk);
+}
+
+double knot_spacing(const std::vector<double>& knots) {
+  return knots.size() > 1 ? knots[1] - knots[0] : 1e300;
+}
+
+/// The air change at `c`'s knots that the run's ambient sensor reads: least squares of the hats
+/// to the reading minus the sink of the candidate's first entry [K].
+Eigen::VectorXd air_from_sensor(const Candidate& c, const RunModel& run) {
+  const Eigen::Index p = static_cast<Eigen::Index>(c.knots.size());
+  const double dk = knot_spacing(c.knots);
+  const auto& sink = run.spec.thermal.convection.at(static_cast<size_t>(c.entries.at(0))).sink;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
+  for (Eigen::Index i = 0; i < run.times.size(); ++i) {
+    if (!std::isfinite(run.air(i))) continue;
+    Eigen::VectorXd h(p);
+    for (Eigen::Index k = 0; k < p; ++k) h(k) = hat(run.times(i), c.knots[k], dk);
+    g += h * h.transpose();
+    b += h * (run.air(i) - 273.15 - solvers::table_value(sink, run.times(i)));  // K - degC
+  }
+  // Knots the run does not reach keep no change.
+  return solve_ridge(g, b, 1e-9);
+}
+
+/// A per-run air on one run: from its ambient sensor when it has one, else the bounded fit to the
+/// normal equations (g, b).
+Eigen::VectorXd per_run_theta(const Candidate& c, const RunModel& run, const Eigen::MatrixXd& g,
+                              const Eigen::VectorXd& b, const CalibrationOptions& o) {
+  if (run.air.size() > 0) return air_from_sensor(c, run);
+  return bounded_air(g, b, c.knots, o);
+}
+
+/// Parameters of `c` fitted on run `ri` as `f` holds them (in-sample).
+Eigen::VectorXd fitted_theta(const Candidate& c, const EffectFit& f, size_t ri) {
+  if (c.fixed) return Eigen::VectorXd::Ones(1);
+  const std::vector<double>& p = c.per_run ? f.run_parameters.at(ri) : f.parameters;
+  return Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
+}
+
+/// Speeds the runs' duty cycles use [rpm].
+std::set<double> speeds_used(const std::vector<RunModel>& runs) {
+  std::set<double> out;
+  for (const auto& rm : runs)
+    for (const auto& seg : rm.spec.duty_cycle.segments) out.insert(seg.speed_rpm);
+  return out;
+}
+
+/// Correlation of a per-run air with the run's speed, each averaged over the knots' hats and
+/// centred per run, pooled over the runs.
+double duty_correlation(const Candidate& c, const std::vector<std::vector<double>>& air,
+                        const std::vector<RunModel>& runs) {
+  const double dk = knot_spacing(c.knots);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t ri = 0; ri < runs.size() && ri < air.size(); ++ri) {
+    const RunModel& rm = runs[ri];
+    std::vector<double> x, y;
+    for (size_t k = 0; k < c.knots.size(); ++k) {
+      double w = 0, ws = 0;
+      for (Eigen::Index i = 0; i < rm.times.size(); ++i) {
+        const double h = hat(rm.times(i), c.knots[k], dk);
+        w += h;
+        ws += h * solvers::speed_at(rm.spec.duty_cycle, rm.times(i));
+      }
+      if (w <= 0) continue;  // a knot past the run's end
+      x.push_back(air[ri].at(k));
+      y.push_back(ws / w);
+    }
+    if (x.size() < 2) continue;
+    double mx = 0, my = 0;
+    for (size_t k = 0; k < x.size(); ++k) {
+      mx += x[k] / static_cast<double>(x.size());
+      my += y[k] / static_cast<double>(y.size());
+    }
+    for (size_t k = 0; k < x.size(); ++k) {
+      sxy += (x[k] - mx) * (y[k] - my);
+      sxx += (x[k] - mx) * (x[k] - mx);
+      syy += (y[k] - my) * (y[k] - my);
+    }
+  }
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
 }  // namespace
+
+Eigen::VectorXd bounded_air(const Eigen::MatrixXd& g0, const Eigen::VectorXd& b,
+                            const std::vector<double>& knots, const CalibrationOptions& o) {
+  const Eigen::Index p = g0.rows();
+  const double scale = std::max(g0.diagonal().mean(), 1e-300);
+  const Eigen::MatrixXd g =
+      g0 + (std::max(o.ridge, 1e-6) * scale) * Eigen::MatrixXd::Identity(p, p);
+  // Bounds on M x: the change at each knot, then its change between neighbouring knots.
+  const Eigen::Index m = p + std::max<Eigen::Index>(p - 1, 0);
+  Eigen::MatrixXd mat = Eigen::MatrixXd::Zero(m, p);
+  Eigen::VectorXd hi(m);
+  for (Eigen::Index k = 0; k < p; ++k) {
+    mat(k, k) = 1;
+    hi(k) = o.air_range_K;
+  }
+  for (Eigen::Index k = 0; k + 1 < p; ++k) {
+    mat(p + k, k) = -1;
+    mat(p + k, k + 1) = 1;
+    hi(p + k) = o.air_rate_K_per_h * (knots.at(k + 1) - knots.at(k)) / 3600;
+  }
+  auto clip = [&](const Eigen::VectorXd& v) { return v.cwiseMax(-hi).cwiseMin(hi).eval(); };
+  Eigen::VectorXd x = g.ldlt().solve(b);
+  if (((mat * x).cwiseAbs().array() <= hi.array()).all()) return x;
+  // ADMM on min x'gx/2 - b'x subject to Mx = z, |z| <= hi.
+  const double rho = scale;
+  const Eigen::LDLT<Eigen::MatrixXd> step(g + rho * mat.transpose() * mat);
+  Eigen::VectorXd z = clip(mat * x), u = Eigen::VectorXd::Zero(m);
+  const double tol = 1e-7 * std::max(1.0, b.cwiseAbs().maxCoeff());
+  for (int it = 0; it < 20000; ++it) {
+    x = step.solve(b + rho * mat.transpose() * (z - u));
+    const Eigen::VectorXd mx = mat * x, z0 = z;
+    z = clip(mx + u);
+    u += mx - z;
+    if ((mx - z).cwiseAbs().maxCoeff() < 1e-7 &&
+        rho * (mat.transpose() * (z - z0)).cwiseAbs().maxCoeff() < tol)
+      break;
+  }
+  return z.head(p);
+}
+
+std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
+                              const std::vector<std::vector<double>>& run_parameters,
+                              const std::vector<RunModel>& runs, const CalibrationOptions& o,
+                              double* correlation) {
+  if (runs.empty()) return {};
+  const core::CaseSpec& spec = runs.front().spec;
+  switch (c.kind) {
+    case EffectKind::ambient_temperature: {
+      bool fitted = false;  // the air of a run with an ambient sensor is read, not fitted
+      for (size_t ri = 0; ri < runs.size(); ++ri) fitted |= runs[ri].air.size() == 0;
+      const double r = fitted ? duty_correlation(c, run_parameters, runs) : 0.0;
+      if (correlation) *correlation = r;
+      if (std::abs(r) >= o.air_duty_correlation)
+        return "the fitted air follows the duty cycle (correlation " + number(r) +
+               " with the speed): a sign of a speed-dependent mechanism, not of the shop's air";
+      return {};
+    }
+    case EffectKind::heat_input:
+      if (p.at(0) < 0)
+        return "a heat input of " + number(p.at(0) * c.area) + " W: heat cannot be negative";
+      return {};
+    case EffectKind::speed_dependent_convection:
+    case EffectKind::boundary_conductance: {
+      const core::Convection& cv = spec.thermal.convection.at(static_cast<size_t>(c.group));
+      const bool speed_law = c.kind == EffectKind::speed_dependent_convection;
+      if (speed_law && cv.h_speed_gain + p.at(0) < 0)
+        return "a film falling with speed (gain " + number(cv.h_speed_gain + p.at(0)) +
+               " W/m2K at " + number(c.ref_speed_rpm) + " rpm): the gain must be >= 0";
+      for (double n : speeds_used(runs)) {
+        const double h = solvers::film_coefficient(cv, n) +
+                         p.at(0) * (speed_law ? (n > 0 ? n / c.ref_speed_rpm : 0.0) : 1.0);
+        if (h <= 0)
+          return "film coefficient after the change " + number(h) + " W/m2K at " + number(n) +
+                 " rpm: must be > 0";
+      }
+      return {};
+    }
+    case EffectKind::temperature_dependent_heat: {
+      const double a =
+          spec.thermal.sources.at(static_cast<size_t>(c.source)).temperature_coefficient + p.at(0);
+      if (a < o.temperature_coefficient_min_per_K || a > o.temperature_coefficient_max_per_K)
+        return "temperature coefficient after the change " + number(a) + " 1/K: outside " +
+               number(o.temperature_coefficient_min_per_K) + " .. " +
+               number(o.temperature_coefficient_max_per_K) + " 1/K";
+      return {};
+    }
+    case EffectKind::material_parameter:
+      if (p.at(0) < o.material_change_min || p.at(0) > o.material_change_max)
+        return c.field + " changed by " + number(100 * p.at(0)) + " %: outside " +
+               number(100 * o.material_change_min) + " .. " + number(100 * o.material_change_max) +
+               " %";
+      return {};
+    case EffectKind::sensor_offset:
+    case EffectKind::sensor_lag:
+      return {};
+  }
+  return {};
+}
 
 std::string kind_name(EffectKind kind) {
   switch (kind) {
@@ -506,6 +695,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(cat.runs, r, s, tau));
     }
   }
+  // The air the runs' ambient sensors read (the readout leaves them out of the channels).
+  for (size_t k = 0; k < runs.size(); ++k) cat.runs[k].air = ambient_reading(runs[k]);
   cat.candidates = std::move(cands);
   return cat;
 }
@@ -525,8 +716,7 @@ std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunMod
     a.row(static_cast<Eigen::Index>(k)) = a_all.row(keep[k]);
     y(static_cast<Eigen::Index>(k)) = w.y(keep[k]);
   }
-  const Eigen::VectorXd theta =
-      solve_ridge(a.transpose() * a, a.transpose() * y, std::max(o.ridge, 1e-6));
+  const Eigen::VectorXd theta = per_run_theta(c, model, a.transpose() * a, a.transpose() * y, o);
   return std::vector<double>(theta.data(), theta.data() + theta.size());
 }
 
@@ -557,9 +747,11 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
       total_s += normals[ri].s;
     }
     double heldout = 0, insample = 0;
+    f.fold_gains.assign(nr, 0.0);
     if (c.fixed) {
       const Eigen::VectorXd one = Eigen::VectorXd::Ones(1);
-      for (const auto& nm : normals) heldout += gain_of(nm, one);
+      for (size_t ri = 0; ri < nr; ++ri) f.fold_gains[ri] = gain_of(normals[ri], one);
+      for (double g : f.fold_gains) heldout += g;
       insample = heldout;
       f.heldout_gain = heldout;
       f.score = heldout - o.penalty_per_parameter;
@@ -578,16 +770,19 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
           at.row(static_cast<Eigen::Index>(k)) = a.row(keep[k]);
           yt(static_cast<Eigen::Index>(k)) = ys[ri](keep[k]);
         }
+        const RunModel& rm = cat.runs[ri];
         const Eigen::VectorXd th =
-            solve_ridge(at.transpose() * at, at.transpose() * yt, std::max(o.ridge, 1e-6));
-        heldout += gain_of(normals[ri], th);
-        const Eigen::VectorXd full =
-            solve_ridge(normals[ri].g, normals[ri].b, std::max(o.ridge, 1e-6));
+            per_run_theta(c, rm, at.transpose() * at, at.transpose() * yt, o);
+        f.fold_gains[ri] = gain_of(normals[ri], th);
+        heldout += f.fold_gains[ri];
+        const Eigen::VectorXd full = per_run_theta(c, rm, normals[ri].g, normals[ri].b, o);
         insample += gain_of(normals[ri], full);
         if (with_parameters) f.run_parameters.emplace_back(th.data(), th.data() + th.size());
+        // A run's air read from its ambient sensor is not fitted: no parameters to pay for.
+        if (rm.air.size() == 0) f.score -= o.penalty_per_parameter * p;
       }
       f.heldout_gain = heldout;
-      f.score = heldout - o.penalty_per_parameter * p * static_cast<double>(nr);
+      f.score += heldout;
     } else {
       Normal sum{Eigen::MatrixXd::Zero(normals[0].g.rows(), normals[0].g.cols()),
                  Eigen::VectorXd::Zero(normals[0].b.size()), 0};
@@ -598,7 +793,8 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
       for (size_t ri = 0; ri < nr; ++ri) {
         const Eigen::VectorXd th =
             solve_ridge(sum.g - normals[ri].g, sum.b - normals[ri].b, o.ridge);
-        heldout += gain_of(normals[ri], th);
+        f.fold_gains[ri] = gain_of(normals[ri], th);
+        heldout += f.fold_gains[ri];
       }
       const Eigen::VectorXd full = solve_ridge(sum.g, sum.b, o.ridge);
       for (const auto& nm : normals) insample += gain_of(nm, full);
@@ -609,6 +805,43 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
     f.explained_fraction = total_s > 0 ? insample / total_s : 0;
   }
   return fits;
+}
+
+/// sqrt(#runs) x the standard deviation of the per-run held-out gain differences of a and b: how
+/// much their score difference could change with other runs. With two runs it exceeds the
+/// difference exactly when b gains more than a on one of them.
+double gain_spread(const EffectFit& a, const EffectFit& b) {
+  const size_t n = std::min(a.fold_gains.size(), b.fold_gains.size());
+  if (n < 2) return 0;
+  double mean = 0, ss = 0;
+  for (size_t r = 0; r < n; ++r)
+    mean += (a.fold_gains[r] - b.fold_gains[r]) / static_cast<double>(n);
+  for (size_t r = 0; r < n; ++r) {
+    const double d = a.fold_gains[r] - b.fold_gains[r] - mean;
+    ss += d * d;
+  }
+  return std::sqrt(static_cast<double>(n) * ss / static_cast<double>(n - 1));
+}
+
+/// The channel on which the two candidates' in-sample responses differ most, in sigmas (RMS over
+/// the training runs' samples).
+void distinguishing_channel(const Catalogue& cat, const Eigen::VectorXd& sigma, Ambiguity& amb) {
+  const Candidate& a = cat.candidates[static_cast<size_t>(amb.first.candidate)];
+  const Candidate& b = cat.candidates[static_cast<size_t>(amb.second.candidate)];
+  const Eigen::Index nc = sigma.size();
+  Eigen::VectorXd ss = Eigen::VectorXd::Zero(nc), count = Eigen::VectorXd::Zero(nc);
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    const Eigen::VectorXd d = a.columns[ri] * fitted_theta(a, amb.first, ri) -
+                              b.columns[ri] * fitted_theta(b, amb.second, ri);
+    const Eigen::Index ns = cat.runs[ri].times.size();
+    for (Eigen::Index ch = 0; ch < nc; ++ch) {
+      ss(ch) += d.segment(ch * ns, ns).squaredNorm() / (sigma(ch) * sigma(ch));
+      count(ch) += static_cast<double>(ns);
+    }
+  }
+  const Eigen::VectorXd rms = (ss.array() / count.array().max(1.0)).sqrt();
+  rms.maxCoeff(&amb.channel);
+  amb.channel_difference = rms(amb.channel);
 }
 
 }  // namespace
@@ -754,6 +987,8 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
       double left = 0;
       for (const auto& y : current) left += y.squaredNorm();
       f.explained_fraction *= total > 0 ? left / total : 0;
+      f.unphysical =
+          unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
     }
     std::vector<int> order(fits.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
@@ -769,8 +1004,28 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
         if (sel.ranking.size() >= 8) break;
       }
     }
-    const EffectFit& best = fits[order.front()];
-    if (!(best.score > sel.null_score && best.score > best.floor && best.score > 0)) break;
+    // The best physical candidate, claimed when it beats noise and floor and no candidate of
+    // another kind that would be claimed too comes within the spread of their per-run gains.
+    auto claimable = [&](const EffectFit& f) {
+      return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
+    };
+    const auto best_at =
+        std::find_if(order.begin(), order.end(), [&](int i) { return fits[i].unphysical.empty(); });
+    if (best_at == order.end() || !claimable(fits[*best_at])) break;
+    const EffectFit& best = fits[*best_at];
+    const auto second_at = std::find_if(best_at + 1, order.end(), [&](int i) {
+      return fits[i].kind != best.kind && claimable(fits[i]);
+    });
+    if (second_at != order.end()) {
+      Ambiguity amb{best, fits[*second_at]};
+      amb.difference = best.score - amb.second.score;
+      amb.spread = gain_spread(best, amb.second);
+      if (amb.difference < amb.spread) {
+        distinguishing_channel(cat, sel.sigma, amb);
+        sel.ambiguous.push_back(std::move(amb));
+        break;
+      }
+    }
     sel.claimed.push_back(best);
     // Remove the claimed effect's in-sample fit before looking for the next one.
     const Candidate& c = cat.candidates[best.candidate];
@@ -780,7 +1035,7 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
       if (c.fixed)
         th = Eigen::VectorXd::Ones(1);
       else if (c.per_run)
-        th = solve_ridge(a.transpose() * a, a.transpose() * current[ri], std::max(o.ridge, 1e-6));
+        th = per_run_theta(c, cat.runs[ri], a.transpose() * a, a.transpose() * current[ri], o);
       else
         th = Eigen::Map<const Eigen::VectorXd>(best.parameters.data(),
                                                static_cast<Eigen::Index>(best.parameters.size()));

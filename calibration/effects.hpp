@@ -47,6 +47,20 @@ struct CalibrationOptions {
   int null_trials = 10;                                   /// fits to pure noise for the threshold
   int max_effects = 2;
   std::uint64_t seed = 20260107;
+  // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
+  // that needs a value outside these to fit is reported as unphysical and never claimed.
+  /// A per-run air temperature is the shop's: at most this far from the declared sink [K] ...
+  double air_range_K = 5;
+  /// ... changing at most this fast between knots [K/h] (a run's ambient sensor overrides both).
+  double air_rate_K_per_h = 3;
+  /// |correlation| of a fitted air with the run's speed (both averaged over the knots' hats,
+  /// centred per run) from which the air is taken for a speed mechanism's shadow, not the shop's.
+  double air_duty_correlation = 0.7;
+  /// Relative change of a conductivity, heat capacity or expansion coefficient: a factor of at
+  /// most 1.5 either way.
+  double material_change_min = -1.0 / 3, material_change_max = 0.5;
+  /// Temperature coefficient of a heat source after the change [1/K].
+  double temperature_coefficient_min_per_K = -0.05, temperature_coefficient_max_per_K = 0.15;
 };
 
 /// One run reduced to what the fit needs.
@@ -56,6 +70,7 @@ struct RunModel {
   Eigen::VectorXd times;     /// #samples [s]
   Eigen::MatrixXd base;      /// #samples x #channels: declared model [K | m]
   Eigen::MatrixXd measured;  /// #samples x #channels [K | m], NaN missing
+  Eigen::VectorXd air;       /// #samples: the run's ambient sensor [K], NaN missing; empty: none
 };
 
 /// A candidate effect: its identity, where it acts, and its channel responses per run.
@@ -132,11 +147,25 @@ struct EffectFit {
   double score = 0;               /// heldout_gain - penalty
   double explained_fraction = 0;  /// share of the training residual's whitened SS removed alone
   double floor = 0;               /// model-form allowance for this candidate
+  std::vector<double> fold_gains;  /// held-out gain per training run (sums to heldout_gain)
+  std::string unphysical;          /// why the fitted parameters are not physical; empty: they are
+  double duty_correlation = 0;     /// per-run air: correlation of the fitted air with the speed
+};
+
+/// Two candidates of different kinds whose scores differ by less than the spread of their
+/// per-run held-out gains: neither is claimed.
+struct Ambiguity {
+  EffectFit first, second;  /// best, and best of another kind
+  double difference = 0;    /// first.score - second.score
+  double spread = 0;        /// sqrt(#runs) x standard deviation of the per-run gain differences
+  int channel = -1;         /// channel on which their fitted responses differ most (in sigmas)
+  double channel_difference = 0;  /// that difference's RMS over the training runs [sigmas]
 };
 
 struct Selection {
   std::vector<EffectFit> claimed;  /// claimed effects, most important first
   std::vector<EffectFit> ranking;  /// best candidate per (kind, place) of the first round
+  std::vector<Ambiguity> ambiguous;  /// the round at which the choice stopped undecided, if any
   double null_score = 0;           /// best score over fits to pure noise
   Eigen::VectorXd sigma;           /// per channel noise estimate [K | m]
   double residual_ss = 0;          /// training residual, whitened
@@ -150,7 +179,21 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
 /// over up to options.max_effects effects. Needs at least two runs.
 Selection select_effects(const Catalogue& cat, const CalibrationOptions& options);
 
-/// Fits a per-run candidate (the air temperature) to one run from its temperature channels.
+/// Why `p` (fitted parameters of `c`; for a per-run air, `run_parameters` per run) is not
+/// physical on `runs` (the speeds their duty cycles use), empty when it is. Sets `duty_correlation`
+/// of a per-run air.
+std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
+                              const std::vector<std::vector<double>>& run_parameters,
+                              const std::vector<RunModel>& runs, const CalibrationOptions& options,
+                              double* duty_correlation = nullptr);
+
+/// Least squares min |A x - y|^2 (normal matrix g = A^T A, b = A^T y) of an air change at `knots`
+/// within options.air_range_K and options.air_rate_K_per_h (ADMM on the bounds).
+Eigen::VectorXd bounded_air(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
+                            const std::vector<double>& knots, const CalibrationOptions& options);
+
+/// Fits a per-run candidate (the air temperature) to one run from its temperature channels,
+/// within the air's bounds; a run with an ambient sensor gives its air from the sensor instead.
 std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,
                                        const Readout& r, const Eigen::VectorXd& sigma,
                                        const CalibrationOptions& options);

@@ -153,7 +153,9 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
       const int body = pick(rng, std::min(2, static_cast<int>(declared.bodies.size())));
       const int mi = declared.bodies[body].material;
       e.target = declared.materials[mi].name + "." + fields[pick(rng, 3)];
-      e.magnitude = signed_factor(rng, 0.25, 0.6);
+      // Within the calibrator's physical bounds (a factor of 1.5 either way), with room for the
+      // linearised fit's error.
+      e.magnitude = signed_factor(rng, 0.15, 0.4);
       break;
     }
     case EffectKind::sensor_offset:
@@ -311,6 +313,23 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
       x.array() += e.magnitude;
     for (Eigen::Index i = 0; i < ns; ++i)
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
+  }
+  if (inst.ambient_sensor) {
+    const auto& fixed = truth.mechanical.fixed_groups;
+    const auto air = std::find_if(
+        truth.thermal.convection.begin(), truth.thermal.convection.end(), [&](const auto& c) {
+          return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end();
+        });
+    if (air == truth.thermal.convection.end())
+      throw core::DataError(
+          "generator: an ambient sensor needs a convection entry on a group "
+          "that is not fixed (the air); the case has none");
+    const Eigen::Index k = run.temperature.cols();
+    run.temperature.conservativeResize(ns, k + 1);
+    for (Eigen::Index i = 0; i < ns; ++i)
+      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + 273.15;  // degC -> K
+    run.sensors.push_back({"AIR", std::nullopt});
+    run.ambient_sensor = "AIR";
   }
   if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
     const int tcp = point_node(m, truth.mechanical.tcp_point);

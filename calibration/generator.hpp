@@ -63,6 +63,9 @@ core::CaseSpec truth_case(const core::CaseSpec& gen_case, const InjectedEffect& 
 struct Instrumentation {
   std::vector<std::string> sensor_points;  /// ids of named points
   bool tcp_probes = true;
+  /// An air sensor `AIR` (no position; meta.json `ambient_sensor`) reading the truth's air: the
+  /// sink of its first convection entry that is not mechanically fixed, with the sensors' noise.
+  bool ambient_sensor = false;
 };
 
 /// Simulates `truth` on `mesh` (re-meshed when `truth` has other boundary groups, as a heat input

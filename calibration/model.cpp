@@ -103,7 +103,8 @@ Readout located(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
   const Eigen::Index n = m.nodes.rows();
   std::vector<Eigen::Triplet<double>> trip;
   for (size_t s = 0; s < run.sensors.size(); ++s) {
-    if (!run.sensors[s].position) continue;
+    // The ambient sensor reads the air, not the machine: it gives the air (ambient_reading).
+    if (!run.sensors[s].position || run.sensors[s].id == run.ambient_sensor) continue;
     for (const auto& [node, w] : point_weights(m, *run.sensors[s].position))
       trip.emplace_back(r.sensors, node, w);
     r.ids.push_back(run.sensors[s].id);
@@ -219,6 +220,15 @@ core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRu
   spec.thermal.output_interval = spec.thermal.step;
   spec.outputs.fields = false;
   return spec;
+}
+
+Eigen::VectorXd ambient_reading(const io::MeasuredRun& run) {
+  if (!run.ambient_sensor) return {};
+  for (size_t s = 0; s < run.sensors.size(); ++s)
+    if (run.sensors[s].id == *run.ambient_sensor)
+      return run.temperature.col(static_cast<Eigen::Index>(s));
+  throw core::DataError("run '" + run.run + "': ambient_sensor '" + *run.ambient_sensor +
+                        "' is not one of its sensors");
 }
 
 Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r) {

@@ -63,6 +63,10 @@ Eigen::MatrixXd displacement_with_expansions(const Readout& like, const core::Ca
 /// it gives one, and its end at the last sample. Throws DataError without a speed column.
 core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRun& run);
 
+/// The air temperature `run`'s ambient sensor reads: #samples [K], NaN missing; empty when the run
+/// names no ambient sensor.
+Eigen::VectorXd ambient_reading(const io::MeasuredRun& run);
+
 /// Measured channels of `run` in the readout's order: #samples x #channels [K | m], NaN missing.
 Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r);
 

@@ -30,9 +30,15 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
               res.before.displacement_rms_um, res.after.displacement_rms_um,
               res.selection.null_score);
   for (size_t k = 0; k < std::min<size_t>(3, res.selection.ranking.size()); ++k)
-    std::printf("[calibration]   rank %zu: %s score %.1f floor %.1f explained %.3f\n", k,
-                res.selection.ranking[k].name.c_str(), res.selection.ranking[k].score,
-                res.selection.ranking[k].floor, res.selection.ranking[k].explained_fraction);
+    std::printf(
+        "[calibration]   rank %zu: %s score %.1f floor %.1f explained %.3f p0 %.4g %s\n", k,
+        res.selection.ranking[k].name.c_str(), res.selection.ranking[k].score,
+        res.selection.ranking[k].floor, res.selection.ranking[k].explained_fraction,
+        res.selection.ranking[k].parameters.empty() ? 0.0 : res.selection.ranking[k].parameters[0],
+        res.selection.ranking[k].unphysical.c_str());
+  for (const auto& a : res.selection.ambiguous)
+    std::printf("[calibration]   ambiguous: %s / %s (difference %.1f, spread %.1f)\n",
+                a.first.name.c_str(), a.second.name.c_str(), a.difference, a.spread);
   std::string first = res.effects.empty() ? "none" : res.effects[0]["kind"].get<std::string>();
   if (first == "sensor_lag")
     std::printf("[calibration] lag found %.4g s\n",

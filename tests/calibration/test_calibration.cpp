@@ -1,9 +1,11 @@
 // Calibration against generated runs with undeclared effects (CI scale: coarse meshes, 2-hour
 // runs). For each effect kind: the right kind comes first, a heat input is placed within 0.1 m,
 // and the test-run RMS after is at most 30 % of before; on clean runs at most 1 in 10 is given an
-// effect. Plus small unit checks of the pieces.
+// effect; the air is read from a run's ambient sensor, and heat loss following the speed on every
+// film is not claimed as air. Plus small unit checks of the pieces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -143,6 +145,91 @@ TEST(Kinds, SensorOffset) {
 // values) must be found closely enough that the lagged channel falls below the others' error.
 TEST(Kinds, SensorLag) {
   check_kind(study(), EffectKind::sensor_lag, 18);
+}
+
+/// Training and test runs of the generator's truth with every unfixed film growing with speed
+/// (h x 2 at 3000 rpm, exponent 0.8): a mechanism acting on the same sinks as the air, which no
+/// single-film candidate matches.
+std::vector<io::MeasuredRun> speed_on_every_film(const Study& s, const Instrumentation& inst,
+                                                 std::vector<io::MeasuredRun>* clean) {
+  std::mt19937_64 rng = core::generator(21, 1);
+  std::vector<io::MeasuredRun> out;
+  for (int k = 0; k < 3; ++k) {
+    core::CaseSpec t = truth_case(s.gen, InjectedEffect{}, s.duties[k], k);
+    const auto& fixed = t.mechanical.fixed_groups;
+    for (auto& c : t.thermal.convection)
+      if (std::find(fixed.begin(), fixed.end(), c.group) == fixed.end()) {
+        c.h_speed_gain = 2 * c.h;
+        c.speed_ref_rpm = 3000;
+        c.speed_exponent = 0.8;
+      }
+    io::MeasuredRun c = clean_run(s.gen_mesh, t, InjectedEffect{}, inst, s.gopt,
+                                  (k < 2 ? "train " : "test ") + std::to_string(k));
+    out.push_back(with_noise(c, s.gopt, rng));
+    if (clean) clean->push_back(std::move(c));
+  }
+  return out;
+}
+
+// Issue 16: a free per-run air explained away heat loss that follows the speed (6-hour training
+// runs). At this scale the speed mechanism comes first on this set even with the air's rules off
+// (with them, the bounded air on the unfixed sinks scores 73 069 against 75 329); what the rules
+// add here is the report: the air on every sink follows the duty cycle (|r| = 0.76) and says so.
+TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
+  const Study& s = study();
+  std::vector<io::MeasuredRun> clean;
+  const auto runs = speed_on_every_film(s, s.inst, &clean);
+  const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  const CalibrationResult res = calibrate(s.mesh, s.declared, cat, {runs[2]}, s.copt);
+  for (const auto& f : res.selection.ranking)
+    std::printf("[calibration]   %s score %.1f duty correlation %.3f %s\n", f.name.c_str(), f.score,
+                f.duty_correlation, f.unphysical.c_str());
+  const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
+  const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
+  const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
+  std::printf("[calibration] claimed %s; test RMS u %.4g -> %.4g um\n",
+              res.effects.empty() ? "none" : res.effects[0]["name"].get<std::string>().c_str(),
+              b.displacement_rms_um, a.displacement_rms_um);
+  for (const auto& e : res.effects) EXPECT_NE(e["kind"], "ambient_temperature");
+  bool air_reported = false;
+  for (const auto& e : res.runners_up)
+    air_reported |= e["kind"] == "ambient_temperature" && e.contains("unphysical");
+  EXPECT_TRUE(air_reported) << res.runners_up.dump(1);
+  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, {}).dump(1);
+  EXPECT_EQ(res.effects[0]["kind"], "speed_dependent_convection");
+}
+
+// With an ambient sensor the air is read: a changing shop air is claimed from the sensor (no
+// parameters fitted), and the speed mechanism's set keeps its air at the declared 20 degC.
+TEST(Air, ReadFromTheRunsAmbientSensor) {
+  const Study& s = study();
+  Instrumentation inst = s.inst;
+  inst.ambient_sensor = true;
+  std::mt19937_64 rng =
+      core::generator(11, static_cast<std::uint64_t>(EffectKind::ambient_temperature));
+  const InjectedEffect e = random_effect(EffectKind::ambient_temperature, s.declared, s.gen_mesh,
+                                         inst.sensor_points, rng);
+  std::vector<io::MeasuredRun> runs, clean;
+  for (int k = 0; k < 3; ++k) {
+    const core::CaseSpec t = truth_case(s.gen, e, s.duties[k], k);
+    clean.push_back(clean_run(s.gen_mesh, t, e, inst, s.gopt, "run " + std::to_string(k)));
+    runs.push_back(with_noise(clean.back(), s.gopt, rng));
+  }
+  const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  Catalogue with_air = cat;
+  for (size_t k = 0; k < 2; ++k) with_air.runs[k].air = ambient_reading(runs[k]);
+  ASSERT_EQ(with_air.runs[0].air.size(), with_air.runs[0].times.size());
+  const CalibrationResult res = calibrate(s.mesh, s.declared, with_air, {runs[2]}, s.copt);
+  ASSERT_FALSE(res.effects.empty());
+  EXPECT_EQ(res.effects[0]["kind"], "ambient_temperature");
+  for (const auto& run : res.effects[0]["parameters"]["per_training_run"])
+    EXPECT_EQ(run["air"], "ambient sensor");
+  const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
+  const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
+  const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
+  std::printf("[calibration] air read from the sensor: test RMS u %.4g -> %.4g um\n",
+              b.displacement_rms_um, a.displacement_rms_um);
+  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
 }
 
 TEST(Clean, AtMostOneInTenGetsAnEffect) {

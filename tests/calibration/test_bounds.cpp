@@ -1,0 +1,332 @@
+// The choice's physical bounds and its honesty on hand-made catalogues (one temperature channel,
+// responses written down, no mesh): a per-run air stays within its range and rate, is read from
+// the run's ambient sensor when it has one, and is not claimed when it follows the duty cycle; a
+// candidate that needs an unphysical value is reported and not claimed; two mechanisms of
+// different kinds that the runs cannot separate are reported ambiguous and neither is claimed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "calibration/calibrate.hpp"
+#include "core/rng.hpp"
+
+namespace tt::calibration {
+namespace {
+
+constexpr double kAmbientK = 293.15;
+
+/// A run of `hours` sampled every 60 s: speeds 3000, 0, 1500, 0 rpm in turn, in blocks of
+/// `block_s` starting `shift` blocks into the cycle; declared sink 20 degC, base 25 degC.
+RunModel run_model(const std::string& name, double hours, double block_s, int shift) {
+  RunModel rm;
+  rm.name = name;
+  const Eigen::Index n = static_cast<Eigen::Index>(hours * 60) + 1;
+  rm.times = Eigen::VectorXd::LinSpaced(n, 0, hours * 3600);
+  rm.spec.duty_cycle.end = hours * 3600;
+  const double speeds[] = {3000, 0, 1500, 0};
+  int k = shift;
+  for (double t = 0; t < rm.spec.duty_cycle.end; t += block_s)
+    rm.spec.duty_cycle.segments.push_back({t, speeds[k++ % 4]});
+  core::Convection cv;
+  cv.group = 0;
+  cv.h = 8;
+  cv.sink.time = {0};
+  cv.sink.value = {20};
+  rm.spec.thermal.convection = {cv};
+  core::HeatSource src;
+  src.name = "bearing";
+  rm.spec.thermal.sources = {src};
+  rm.base = Eigen::MatrixXd::Constant(n, 1, kAmbientK + 5);
+  rm.measured = rm.base;
+  return rm;
+}
+
+double speed_of(const RunModel& rm, double t) {
+  double s = 0;
+  for (const auto& seg : rm.spec.duty_cycle.segments)
+    if (seg.start <= t) s = seg.speed_rpm;
+  return s;
+}
+
+/// First-order response (time constant tau [s]) of (speed / 3000 rpm)^exponent.
+Eigen::VectorXd speed_response(const RunModel& rm, double tau, double exponent = 1) {
+  Eigen::VectorXd x(rm.times.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    x(i) = std::pow(speed_of(rm, rm.times(i)) / 3000, exponent);
+  return lagged(rm.times, x, tau) - Eigen::VectorXd::Constant(x.size(), x(0));
+}
+
+void add_noise(RunModel& rm, double sigma, std::uint64_t seed) {
+  std::mt19937_64 rng = core::generator(seed, 3);
+  std::normal_distribution<double> noise(0, sigma);
+  for (Eigen::Index i = 0; i < rm.measured.rows(); ++i) rm.measured(i, 0) += noise(rng);
+}
+
+Candidate candidate(EffectKind kind, const std::string& name,
+                    const std::vector<Eigen::VectorXd>& column_per_run) {
+  Candidate c;
+  c.kind = kind;
+  c.name = name;
+  c.location = {{"name", name}};
+  c.parameters = {"p"};
+  c.group = 0;
+  c.source = 0;
+  c.material = 0;
+  c.field = "conductivity";
+  c.area = 0.01;
+  c.ref_speed_rpm = 3000;
+  for (const auto& col : column_per_run) c.columns.emplace_back(col);
+  return c;
+}
+
+/// The air on the one sink at knots every `spacing` [s]: the channel follows it through a
+/// first-order lag of 1200 s, as it follows the films' heat.
+Candidate air_candidate(const std::vector<RunModel>& runs, double spacing) {
+  Candidate c;
+  c.kind = EffectKind::ambient_temperature;
+  c.name = "air";
+  c.per_run = true;
+  c.entries = {0};
+  const double end = runs.front().times(runs.front().times.size() - 1);
+  for (double t = 0; t <= end + 1e-9; t += spacing) c.knots.push_back(t);
+  for (const auto& rm : runs) {
+    Eigen::MatrixXd a(rm.times.size(), static_cast<Eigen::Index>(c.knots.size()));
+    for (Eigen::Index k = 0; k < a.cols(); ++k) {
+      Eigen::VectorXd h(rm.times.size());
+      for (Eigen::Index i = 0; i < h.size(); ++i)
+        h(i) = std::max(0.0, 1 - std::abs(rm.times(i) - c.knots[static_cast<size_t>(k)]) / spacing);
+      a.col(k) = lagged(rm.times, h, 1200) - Eigen::VectorXd::Constant(h.size(), h(0));
+    }
+    c.columns.push_back(a);
+  }
+  for (size_t k = 0; k < c.knots.size(); ++k) c.parameters.push_back("delta_air_K");
+  return c;
+}
+
+Catalogue one_channel(std::vector<RunModel> runs) {
+  Catalogue cat;
+  cat.readout.ids = {"T1"};
+  cat.readout.sensors = 1;
+  cat.runs = std::move(runs);
+  return cat;
+}
+
+TEST(Air, BoundedFitIsFeasibleAndBestOfFeasiblePoints) {
+  CalibrationOptions o;  // 5 K, 3 K/h: 1.5 K between knots 1800 s apart
+  const std::vector<double> knots{0, 1800, 3600, 5400};
+  const Eigen::Vector4d target(0, 7, -2, 1);
+  Eigen::Matrix4d g = Eigen::Matrix4d::Identity();
+  g(1, 2) = g(2, 1) = 0.3;
+  const Eigen::Vector4d b = g * target;
+  const Eigen::VectorXd x = bounded_air(g, b, knots, o);
+  auto objective = [&](const Eigen::VectorXd& v) { return v.dot(g * v) - 2 * b.dot(v); };
+  auto feasible = [&](const Eigen::VectorXd& v) {
+    for (Eigen::Index k = 0; k < 4; ++k)
+      if (std::abs(v(k)) > o.air_range_K + 1e-6) return false;
+    for (Eigen::Index k = 0; k < 3; ++k)
+      if (std::abs(v(k + 1) - v(k)) > 1.5 + 1e-6) return false;
+    return true;
+  };
+  ASSERT_TRUE(feasible(x)) << x.transpose();
+  std::mt19937_64 rng = core::generator(3, 1);
+  std::uniform_real_distribution<double> u(-5, 5);
+  double best = 1e300;
+  for (int trial = 0; trial < 200000; ++trial) {
+    Eigen::Vector4d v(u(rng), u(rng), u(rng), u(rng));
+    if (feasible(v)) best = std::min(best, objective(v));
+  }
+  EXPECT_LE(objective(x), best + 1e-6);
+  // A feasible optimum is returned as it is.
+  const Eigen::Vector4d inside(0.5, 1, 0.2, -0.5);
+  EXPECT_LT((bounded_air(Eigen::Matrix4d::Identity(), inside, knots, o) - inside).norm(), 1e-5);
+}
+
+/// Convection growing with speed with exponent 0.8, seen on a channel through a lag of 1200 s.
+/// The calibrator's speed candidate has exponent 1 (its model is not the truth's), so a free
+/// per-run air on 600 s knots explains more of it than the right mechanism.
+struct SpeedSet {
+  Catalogue cat;
+  CalibrationOptions options;
+};
+
+SpeedSet speed_dependent_set(bool ambient_sensor) {
+  std::vector<RunModel> runs{run_model("a", 4, 2400, 0), run_model("b", 4, 1800, 1)};
+  for (size_t r = 0; r < runs.size(); ++r) {
+    runs[r].measured.col(0) += -0.8 * speed_response(runs[r], 1200, 0.8);
+    add_noise(runs[r], 0.01, r);
+    if (ambient_sensor) {  // the shop's air stayed at the declared 20 degC
+      runs[r].air = Eigen::VectorXd::Constant(runs[r].times.size(), kAmbientK);
+      std::mt19937_64 rng = core::generator(11, r);
+      std::normal_distribution<double> noise(0, 0.03);
+      for (Eigen::Index i = 0; i < runs[r].air.size(); ++i) runs[r].air(i) += noise(rng);
+    }
+  }
+  SpeedSet s;
+  s.cat = one_channel(runs);
+  s.cat.candidates.push_back(air_candidate(s.cat.runs, 600));
+  std::vector<Eigen::VectorXd> cols;
+  for (const auto& rm : s.cat.runs) cols.push_back(-0.1 * speed_response(rm, 1200));
+  s.cat.candidates.push_back(
+      candidate(EffectKind::speed_dependent_convection, "convection growing with speed", cols));
+  // Only the duty-cycle rule at work here: the rate bound would stop the air's steps on its own.
+  s.options.air_rate_K_per_h = 100;
+  return s;
+}
+
+const EffectFit* ranked(const Selection& sel, EffectKind kind) {
+  for (const auto& f : sel.ranking)
+    if (f.kind == kind) return &f;
+  return nullptr;
+}
+
+// The free air wins this set on score; it follows the duty cycle, so it is reported and the speed
+// mechanism is claimed.
+TEST(Air, FollowingTheDutyCycleIsNotClaimed) {
+  const SpeedSet s = speed_dependent_set(false);
+  const Selection sel = select_effects(s.cat, s.options);
+  const EffectFit* air = ranked(sel, EffectKind::ambient_temperature);
+  const EffectFit* speed = ranked(sel, EffectKind::speed_dependent_convection);
+  ASSERT_NE(air, nullptr);
+  ASSERT_NE(speed, nullptr);
+  std::printf("[bounds] air score %.1f (duty correlation %.3f), speed score %.1f\n", air->score,
+              air->duty_correlation, speed->score);
+  EXPECT_GT(air->score, speed->score);  // what made the air win before
+  EXPECT_GE(std::abs(air->duty_correlation), CalibrationOptions{}.air_duty_correlation);
+  EXPECT_NE(air->unphysical.find("duty cycle"), std::string::npos);
+  ASSERT_FALSE(sel.claimed.empty());
+  EXPECT_EQ(sel.claimed[0].kind, EffectKind::speed_dependent_convection);
+  EXPECT_TRUE(sel.ambiguous.empty());
+}
+
+// With an ambient sensor the air is read: it stayed at 20 degC, so the air explains nothing.
+TEST(Air, ReadFromTheAmbientSensor) {
+  const SpeedSet s = speed_dependent_set(true);
+  const Selection sel = select_effects(s.cat, s.options);
+  const EffectFit* air = ranked(sel, EffectKind::ambient_temperature);
+  ASSERT_NE(air, nullptr);
+  for (const auto& run : air->run_parameters)
+    for (double v : run) EXPECT_LT(std::abs(v), 0.05);
+  ASSERT_FALSE(sel.claimed.empty());
+  EXPECT_EQ(sel.claimed[0].kind, EffectKind::speed_dependent_convection);
+  // A real change of the air, read by the sensor, is taken as it is read (not as fitted).
+  Catalogue cat = s.cat;
+  for (size_t r = 0; r < cat.runs.size(); ++r) {
+    auto& rm = cat.runs[r];
+    rm.measured = rm.base;
+    for (Eigen::Index i = 0; i < rm.times.size(); ++i) {
+      const double air = 1.5 * std::sin(rm.times(i) / 4000.0 + static_cast<double>(r));
+      rm.air(i) = kAmbientK + air;
+    }
+    rm.measured.col(0) += lagged(rm.times, rm.air.array() - kAmbientK, 1200);
+    add_noise(rm, 0.01, 20 + r);
+  }
+  const Selection read = select_effects(cat, s.options);
+  ASSERT_FALSE(read.claimed.empty());
+  EXPECT_EQ(read.claimed[0].kind, EffectKind::ambient_temperature);
+  const Candidate& c = cat.candidates[static_cast<size_t>(read.claimed[0].candidate)];
+  const std::vector<double> p =
+      fit_run_parameters(c, 1, cat.runs[1], cat.readout, read.sigma, s.options);
+  for (size_t k = 0; k < c.knots.size(); ++k)
+    EXPECT_NEAR(p[k], 1.5 * std::sin(c.knots[k] / 4000.0 + 1), 0.05) << "knot " << k;
+}
+
+// The residual is a conductivity of the housing lowered by 60 %; conductivity, a heat input and a
+// speed gain of convection with the same response would need -60 %, a negative heat and a
+// negative gain. A smaller response of a conductance (a film that stays positive) is claimed.
+TEST(Physics, UnphysicalCandidatesAreReportedNotClaimed) {
+  std::vector<RunModel> runs{run_model("a", 3, 1800, 0), run_model("b", 3, 2400, 1)};
+  std::vector<Eigen::VectorXd> shape, other;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const Eigen::VectorXd x =
+        speed_response(runs[r], 900) + 0.5 * (runs[r].times.array() / 10800).matrix();
+    shape.push_back(x);
+    other.push_back(0.1 * (x + 0.05 * speed_response(runs[r], 300)));
+    runs[r].measured.col(0) += -0.6 * x;
+    add_noise(runs[r], 0.01, 30 + r);
+  }
+  Catalogue cat = one_channel(runs);
+  cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity", shape));
+  cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", shape));
+  cat.candidates.push_back(candidate(EffectKind::speed_dependent_convection, "speed gain", shape));
+  cat.candidates.push_back(candidate(EffectKind::boundary_conductance, "conductance", other));
+  const Selection sel = select_effects(cat, CalibrationOptions{});
+  for (const auto& f : sel.ranking)
+    std::printf("[bounds] %s: score %.1f p %.3g unphysical '%s'\n", f.name.c_str(), f.score,
+                f.parameters.at(0), f.unphysical.c_str());
+  for (EffectKind k : {EffectKind::material_parameter, EffectKind::heat_input,
+                       EffectKind::speed_dependent_convection}) {
+    const EffectFit* f = ranked(sel, k);
+    ASSERT_NE(f, nullptr);
+    EXPECT_FALSE(f->unphysical.empty()) << kind_name(k);
+    EXPECT_GT(f->score, ranked(sel, EffectKind::boundary_conductance)->score);
+  }
+  ASSERT_FALSE(sel.claimed.empty());
+  EXPECT_EQ(sel.claimed[0].kind, EffectKind::boundary_conductance);
+  EXPECT_GT(sel.claimed[0].parameters.at(0), -8);  // h = 8 W/m2K stays positive
+  // calibration.json's descriptions: the unphysical ones with their reasons.
+  int unphysical = 0;
+  for (const auto& f : sel.ranking) unphysical += effect_json(cat, f, false).contains("unphysical");
+  EXPECT_EQ(unphysical, 3);
+  EXPECT_FALSE(effect_json(cat, sel.claimed[0], true).contains("unphysical"));
+}
+
+// The same response under two kinds, each fitting one run a little better: ambiguous, neither
+// claimed, and the two are named with a channel.
+TEST(Ambiguity, KindsTheRunsCannotSeparate) {
+  std::vector<RunModel> runs{run_model("a", 3, 1800, 0), run_model("b", 3, 2400, 1)};
+  std::vector<Eigen::VectorXd> x, w;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    x.push_back(speed_response(runs[r], 900));
+    w.push_back(0.1 * speed_response(runs[r], 200));
+    runs[r].measured.col(0) += 0.5 * (r == 0 ? x[r] : Eigen::VectorXd(x[r] + w[r]));
+    add_noise(runs[r], 0.01, 40 + r);
+  }
+  auto with = [&](double on_a, double on_b) {
+    Catalogue cat = one_channel(runs);
+    cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", x));
+    cat.candidates.back().location = {{"centre_m", {0.1, 0.2, 0.3}}};
+    cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity",
+                                       {2.5 * (x[0] + on_a * w[0]), 2.5 * (x[1] + on_b * w[1])}));
+    return cat;
+  };
+  // The heat input is right on run a, the conductivity on run b.
+  const Catalogue cat = with(1, 1);
+  const Selection sel = select_effects(cat, CalibrationOptions{});
+  EXPECT_TRUE(sel.claimed.empty());
+  ASSERT_EQ(sel.ambiguous.size(), 1u);
+  const Ambiguity& amb = sel.ambiguous[0];
+  std::printf("[bounds] ambiguous: %s vs %s, difference %.1f, spread %.1f\n",
+              amb.first.name.c_str(), amb.second.name.c_str(), amb.difference, amb.spread);
+  EXPECT_NE(amb.first.kind, amb.second.kind);
+  EXPECT_LT(amb.difference, amb.spread);
+  EXPECT_EQ(amb.channel, 0);
+  EXPECT_GT(amb.channel_difference, 0);
+  // calibration.json's `ambiguous`: both candidates, the channel and a hint.
+  const nlohmann::json j = ambiguity_json(cat, sel);
+  ASSERT_EQ(j.size(), 1u);
+  EXPECT_EQ(j[0]["candidates"].size(), 2u);
+  EXPECT_EQ(j[0]["distinguishing_channel"]["channel"], "T1");
+  EXPECT_NE(j[0]["hint"].get<std::string>().find("heat input's place"), std::string::npos)
+      << j[0].dump(1);
+  // The conductivity wrong on both runs: the heat input is claimed.
+  const Selection one = select_effects(with(3, -3), CalibrationOptions{});
+  EXPECT_TRUE(one.ambiguous.empty());
+  ASSERT_FALSE(one.claimed.empty());
+  EXPECT_EQ(one.claimed[0].kind, EffectKind::heat_input);
+}
+
+TEST(Ambiguity, HintNamesTheAmbientSensorAndADutyCycle) {
+  const nlohmann::json air = {{"kind", "ambient_temperature"},
+                              {"location", nlohmann::json::object()},
+                              {"parameters", nlohmann::json::object()}};
+  const nlohmann::json speed = {{"kind", "speed_dependent_convection"},
+                                {"location", {{"group", "air_gap"}}},
+                                {"parameters", nlohmann::json::object()}};
+  const std::string h = telling_apart(air, speed);
+  EXPECT_NE(h.find("ambient_sensor"), std::string::npos) << h;
+  EXPECT_NE(h.find("duty cycle"), std::string::npos) << h;
+}
+
+}  // namespace
+}  // namespace tt::calibration
