@@ -10,6 +10,7 @@
 
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 
@@ -100,7 +101,7 @@ Eigen::VectorXd air_from_sensor(const Candidate& c, const RunModel& run) {
     Eigen::VectorXd h(p);
     for (Eigen::Index k = 0; k < p; ++k) h(k) = hat(run.times(i), c.knots[k], dk);
     g += h * h.transpose();
-    b += h * (run.air(i) - 273.15 - solvers::table_value(sink, run.times(i)));  // K - degC
+    b += h * (run.air(i) - core::kCelsiusOffset - solvers::table_value(sink, run.times(i)));
   }
   // Knots the run does not reach keep no change.
   return solve_ridge(g, b, 1e-9);

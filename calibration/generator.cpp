@@ -327,7 +327,7 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
     const Eigen::Index k = run.temperature.cols();
     run.temperature.conservativeResize(ns, k + 1);
     for (Eigen::Index i = 0; i < ns; ++i)
-      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + 273.15;  // degC -> K
+      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + core::kCelsiusOffset;
     run.sensors.push_back({"AIR", std::nullopt});
     run.ambient_sensor = "AIR";
   }

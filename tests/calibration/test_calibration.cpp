@@ -180,7 +180,7 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   std::vector<io::MeasuredRun> clean;
   const auto runs = speed_on_every_film(s, s.inst, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
-  const CalibrationResult res = calibrate(s.mesh, s.declared, cat, {runs[2]}, s.copt);
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
   for (const auto& f : res.selection.ranking)
     std::printf("[calibration]   %s score %.1f duty correlation %.3f %s\n", f.name.c_str(), f.score,
                 f.duty_correlation, f.unphysical.c_str());
@@ -219,7 +219,7 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
   Catalogue with_air = cat;
   for (size_t k = 0; k < 2; ++k) with_air.runs[k].air = ambient_reading(runs[k]);
   ASSERT_EQ(with_air.runs[0].air.size(), with_air.runs[0].times.size());
-  const CalibrationResult res = calibrate(s.mesh, s.declared, with_air, {runs[2]}, s.copt);
+  const CalibrationResult res = calibrate(*s.model, s.declared, with_air, {runs[2]}, s.copt);
   ASSERT_FALSE(res.effects.empty());
   EXPECT_EQ(res.effects[0]["kind"], "ambient_temperature");
   for (const auto& run : res.effects[0]["parameters"]["per_training_run"])
