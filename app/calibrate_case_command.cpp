@@ -39,42 +39,6 @@ std::string file_name(const std::string& run) {
   return s.empty() ? "run" : s;
 }
 
-/// The figures: residual before/after per test run, and the identified effect's response.
-constexpr const char* kPlotScript = R"PY(
-import csv, sys
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-src, out_res, out_eff = sys.argv[1], sys.argv[2], sys.argv[3]
-rows = list(csv.DictReader(open(src)))
-runs = sorted(set(r["run"] for r in rows))
-chans = sorted(set(r["channel"] for r in rows), key=lambda c: (rows[[r["channel"] for r in rows].index(c)]["unit"], c))
-fig, axes = plt.subplots(2, len(runs), figsize=(6 * len(runs), 7), squeeze=False)
-for j, run in enumerate(runs):
-    for i, unit in enumerate(["K", "um"]):
-        ax = axes[i][j]
-        for c in chans:
-            rr = [r for r in rows if r["run"] == run and r["channel"] == c and r["unit"] == unit]
-            if not rr: continue
-            t = [float(r["time_s"]) / 3600 for r in rr]
-            b = [float(r["before"]) for r in rr]
-            a = [float(r["after"]) for r in rr]
-            l, = ax.plot(t, b, lw=0.8, alpha=0.6)
-            ax.plot(t, a, lw=1.4, color=l.get_color(), ls="--")
-        ax.set_title(f"{run}: residual [{unit}] (solid before, dashed after)")
-        ax.set_xlabel("time [h]")
-fig.tight_layout(); fig.savefig(out_res, dpi=110)
-fig, axes = plt.subplots(1, 2, figsize=(12, 4))
-for i, unit in enumerate(["K", "um"]):
-    for c in chans:
-        rr = [r for r in rows if r["run"] == runs[0] and r["channel"] == c and r["unit"] == unit]
-        if not rr: continue
-        axes[i].plot([float(r["time_s"]) / 3600 for r in rr], [float(r["effect"]) for r in rr], label=c)
-    axes[i].set_title(f"identified effect on {runs[0]} [{unit}]"); axes[i].set_xlabel("time [h]")
-axes[1].legend(fontsize=7)
-fig.tight_layout(); fig.savefig(out_eff, dpi=110)
-)PY";
-
 void write_text(const std::filesystem::path& p, const std::string& s) {
   io::write_file_atomically(p, s);
 }
@@ -188,11 +152,9 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
       }
     }
   write_text(dir / "residuals.csv", csv.str());
-  write_text(dir / "plot_residuals.py", kPlotScript);
-  if (!run_python(dir / "plot_residuals.py",
-                  {(dir / "residuals.csv").string(), (dir / "residual_before_after.png").string(),
-                   (dir / "effect.png").string()}))
-    std::cerr << "thermotwin: note: calibration figures skipped\n";
+  plot({"residuals", (dir / "residuals.csv").string(),
+        (dir / "residual_before_after.png").string(),
+        "--effect-out=" + (dir / "effect.png").string()});
 
   std::ostringstream md;
   md << "# Calibration of " << declared.name << "\n\n";

@@ -12,6 +12,10 @@ Run with /usr/bin/python3 (Debian's, which has matplotlib). Subcommands:
       any columns against any column.
   plot.py bars CSV OUT.png --label id --value mi_bits_dy [--top N] [--sort] [--title T]
       one bar per row, labelled by a (possibly text) column.
+  plot.py residuals CSV OUT.png --effect-out EFFECT.png
+      calibrate's residuals.csv (run, channel, unit, time_s, before, after, effect): per test run
+      the residual before (solid) and after (dashed) per channel, K and um apart; and the
+      identified effect (after - before) on the first test run.
 
 The time column (--time, default time_s) is in seconds. The PNG is written to a temporary name and
 renamed, so a failed run never leaves a partial image. Exit status 0 on success, 2 on bad input.
@@ -187,6 +191,56 @@ def plot_bars(args):
     save_atomically(figure, args.out)
 
 
+def plot_residuals(args):
+    header, rows = read_table(args.csv)
+    if not rows:
+        raise InputError(f"{args.csv}: no data rows")
+    runs_col = text_column(args.csv, header, rows, "run")
+    chans_col = text_column(args.csv, header, rows, "channel")
+    units_col = text_column(args.csv, header, rows, "unit")
+    hours = [t / 3600.0 for t in numeric_column(args.csv, header, rows, "time_s")]
+    values = {k: numeric_column(args.csv, header, rows, k) for k in ("before", "after", "effect")}
+    runs = sorted(set(runs_col))
+    channels = sorted(set(zip(units_col, chans_col)))
+
+    def series(run, channel, unit, key):
+        picked = [
+            (hours[i], values[key][i])
+            for i in range(len(rows))
+            if runs_col[i] == run and chans_col[i] == channel and units_col[i] == unit
+        ]
+        return [t for t, _ in picked], [v for _, v in picked]
+
+    figure, axes = plt.subplots(2, len(runs), figsize=(6 * len(runs), 7), squeeze=False)
+    for j, run in enumerate(runs):
+        for i, unit in enumerate(["K", "um"]):
+            ax = axes[i][j]
+            for u, channel in channels:
+                if u != unit:
+                    continue
+                t, before = series(run, channel, unit, "before")
+                if not t:
+                    continue
+                (line,) = ax.plot(t, before, lw=0.8, alpha=0.6)
+                ax.plot(t, series(run, channel, unit, "after")[1], lw=1.4, ls="--",
+                        color=line.get_color())
+            ax.set_title(f"{run}: residual [{unit}] (solid before, dashed after)")
+            ax.set_xlabel("Time [h]")
+    save_atomically(figure, args.out)
+    figure, axes = plt.subplots(1, 2, figsize=(12, 4))
+    for i, unit in enumerate(["K", "um"]):
+        for u, channel in channels:
+            if u != unit:
+                continue
+            t, effect = series(runs[0], channel, unit, "effect")
+            if t:
+                axes[i].plot(t, effect, label=channel)
+        axes[i].set_title(f"identified effect on {runs[0]} [{unit}]")
+        axes[i].set_xlabel("Time [h]")
+    axes[1].legend(fontsize=7)
+    save_atomically(figure, args.effect_out)
+
+
 def parser():
     root = argparse.ArgumentParser(description="Plot thermotwin CSV outputs as PNG.")
     commands = root.add_subparsers(dest="command", required=True)
@@ -222,6 +276,9 @@ def parser():
     bars.add_argument("--ylabel", default="")
     bars.add_argument("--sort", action="store_true", help="largest first")
     bars.add_argument("--top", type=int, default=None, help="keep only the first N bars")
+
+    residuals = command("residuals", "calibrate's residuals before and after", plot_residuals)
+    residuals.add_argument("--effect-out", required=True, help="PNG of the identified effect")
     return root
 
 
