@@ -40,6 +40,7 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
     return out;
   }
   std::optional<solvers::Twin> built;
+  std::optional<solvers::FullThermalSystem> full_system;  // assembled once: twin and indicator
   io::ReducedModelFile file;
   const solvers::Twin* twin = nullptr;
   if (!choice.rom.empty()) {
@@ -52,7 +53,8 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
   } else {
     say("model: building the reduced model (--full for the full order)");
     const auto t0 = std::chrono::steady_clock::now();
-    built = solvers::case_twin(mesh, spec);
+    full_system = solvers::thermal_system(mesh, spec);
+    built = solvers::case_twin(mesh, spec, *full_system);
     twin = &*built;
     out.model = {
         {"kind", "reduced"},
@@ -67,8 +69,8 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
   // Trust: the full-order residual at a few output steps of the first run (each distinct step
   // size and horizon costs a full factor, so few samples).
   if (spec.thermal.scheme == core::TimeScheme::backward_euler && !runs.empty()) {
-    const auto ind = solvers::twin_indicator(solvers::thermal_system(mesh, spec), twin->model,
-                                             runs.front().spec, 3);
+    if (!full_system) full_system = solvers::thermal_system(mesh, spec);
+    const auto ind = solvers::twin_indicator(*full_system, twin->model, runs.front().spec, 3);
     out.model["indicator"] = indicator_report(ind, runs.front().name);
   }
   return out;

@@ -103,7 +103,11 @@ Twin build_twin(const FullThermalSystem& full, const core::CaseSpec& spec,
 
 Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                const ReductionOptions& options) {
-  const FullThermalSystem full = thermal_system(mesh, spec);
+  return case_twin(mesh, spec, thermal_system(mesh, spec), options);
+}
+
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+               const FullThermalSystem& full, const ReductionOptions& options) {
   TwinOutputs outputs;
   if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) {
     const ElasticModel elastic(mesh, spec);

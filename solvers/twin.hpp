@@ -58,6 +58,9 @@ Twin build_twin(const FullThermalSystem& full, const core::CaseSpec& spec,
 /// TCP's influence rows (when the case has a TCP), the reduced model and the projected outputs.
 Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                const ReductionOptions& options = {});
+/// The same on the case's full system already assembled (thermal_system(mesh, spec)).
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+               const FullThermalSystem& full, const ReductionOptions& options = {});
 
 /// A run of the twin: the case's duty cycle stepped on the reduced states by the one stepper.
 struct TwinRun {
