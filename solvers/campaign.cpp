@@ -140,9 +140,10 @@ std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const c
   const ElasticModel elastic(mesh, base);
   const auto nodes = error_nodes(mesh, base);
   // 9 influence vectors: (tcp, z1, z2) x (x, y, z).
-  Eigen::MatrixXd influence(9, mesh.nodes.rows());
+  std::vector<std::pair<int, int>> dofs;
   for (int p = 0; p < 3; ++p)
-    for (int d = 0; d < 3; ++d) influence.row(3 * p + d) = elastic.influence(nodes[p], d).transpose();
+    for (int d = 0; d < 3; ++d) dofs.emplace_back(nodes[p], d);
+  const Eigen::MatrixXd influence = elastic.influence_rows(dofs);
   const double distance = (mesh.nodes.row(nodes[2]) - mesh.nodes.row(nodes[1])).norm();
 
   std::vector<CampaignResult> results;

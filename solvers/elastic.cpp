@@ -253,13 +253,22 @@ std::vector<Eigen::MatrixXd> rows_by_material(const mesh::TetMesh& m, const core
 }  // namespace
 
 Eigen::VectorXd ElasticModel::influence(int node, int direction) const {
-  if (node < 0 || node >= impl_->coupling.cols() || direction < 0 || direction > 2)
-    throw core::SolverError("influence at node " + std::to_string(node) + ", direction " +
-                            std::to_string(direction) + ": expected 0 <= node < " +
-                            std::to_string(impl_->coupling.cols()) + " and direction 0, 1 or 2");
-  Eigen::SparseMatrix<double> f(1, impl_->coupling.rows());
-  f.insert(0, 3 * node + direction) = 1.0;
-  return influence_rows(f).row(0).transpose();
+  return influence_rows({{node, direction}}).row(0).transpose();
+}
+
+Eigen::MatrixXd ElasticModel::influence_rows(
+    const std::vector<std::pair<int, int>>& node_directions) const {
+  std::vector<Eigen::Triplet<double>> unit;
+  for (const auto& [node, direction] : node_directions) {
+    if (node < 0 || node >= impl_->coupling.cols() || direction < 0 || direction > 2)
+      throw core::SolverError("influence at node " + std::to_string(node) + ", direction " +
+                              std::to_string(direction) + ": expected 0 <= node < " +
+                              std::to_string(impl_->coupling.cols()) + " and direction 0, 1 or 2");
+    unit.emplace_back(static_cast<int>(unit.size()), 3 * node + direction, 1.0);
+  }
+  Eigen::SparseMatrix<double> f(static_cast<Eigen::Index>(unit.size()), impl_->coupling.rows());
+  f.setFromTriplets(unit.begin(), unit.end());
+  return influence_rows(f);
 }
 
 Eigen::MatrixXd ElasticModel::adjoint_solutions(

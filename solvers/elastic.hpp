@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/case_spec.hpp"
@@ -42,6 +43,8 @@ class ElasticModel {
   /// Influence rows of displacement functionals: row i is a_i with f_i . u = a_i . (T - T_ref),
   /// f = `functionals` (#rows x 3 #nodes, node-major x, y, z) [m/K]; one block solve.
   Eigen::MatrixXd influence_rows(const Eigen::SparseMatrix<double>& functionals) const;
+  /// influence(node, direction) of each (node, direction) pair, as rows, in one block solve.
+  Eigen::MatrixXd influence_rows(const std::vector<std::pair<int, int>>& node_directions) const;
   /// The same rows split by material: entry m is the part of influence_rows that the thermal
   /// strain of material m's elements makes, so that a change of material m's expansion
   /// coefficient by a factor (1 + x) adds x times it (the stiffness does not depend on the

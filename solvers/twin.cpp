@@ -46,22 +46,22 @@ TwinOutputs full_outputs(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
     const auto nodes = error_nodes(mesh, spec);
     out.probe_distance = (mesh.nodes.row(nodes[2]) - mesh.nodes.row(nodes[1])).norm();
     // Every displacement output is one dof: the influence rows of all of them in one block solve.
-    std::vector<Eigen::Triplet<double>> dofs;
-    const auto add = [&](const std::string& name, int node, int d) {
-      dofs.emplace_back(static_cast<int>(dofs.size()), 3 * node + d, 1.0);
-      out.names.push_back(name);
-    };
+    std::vector<std::pair<int, int>> dofs;
     for (int p = 0; p < 3; ++p)
-      for (int d = 0; d < 3; ++d) add(kTcpNames[3 * p + d], nodes[p], d);
+      for (int d = 0; d < 3; ++d) {
+        out.names.push_back(kTcpNames[3 * p + d]);
+        dofs.emplace_back(nodes[p], d);
+      }
     for (const auto& id : spec.mechanical.axis_points) {
       const int node = mesh::named_node(mesh, id);
       if (node < 0)
         throw core::SolverError("axis point '" + id + "' is not a named point of the mesh");
-      for (int d = 0; d < 3; ++d) add(id + "_d" + kAxes[d], node, d);
+      for (int d = 0; d < 3; ++d) {
+        out.names.push_back(id + "_d" + kAxes[d]);
+        dofs.emplace_back(node, d);
+      }
     }
-    Eigen::SparseMatrix<double> f(static_cast<Eigen::Index>(dofs.size()), 3 * n);
-    f.setFromTriplets(dofs.begin(), dofs.end());
-    const Eigen::MatrixXd influence = elastic->influence_rows(f);
+    const Eigen::MatrixXd influence = elastic->influence_rows(dofs);
     for (Eigen::Index i = 0; i < influence.rows(); ++i)
       rows.push_back(influence.row(i).transpose());
   }
