@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/parallel.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/loads.hpp"
 
@@ -225,30 +227,51 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   rhs.leftCols(b.cols()) = b;
   rhs.rightCols(options.output_columns.cols()) = options.output_columns;
   st.film_states = film_states(spec, options);
+  // The shifts of each film state, in the order their Krylov vectors join the basis.
+  std::vector<Sparse> stiffness;  // K(h) per film state
+  std::vector<std::pair<std::size_t, double>> shifted;  // (film state, shift)
   for (const auto& h : st.film_states) {
     const bool steady = removes_heat(full, h);
     std::vector<double> shifts =
         options.shifts_per_s.empty() ? default_shifts(spec, steady) : options.shifts_per_s;
-    const Sparse k = film_stiffness(full, h);
+    stiffness.push_back(film_stiffness(full, h));
     for (double s : shifts) {
       if (s == 0 && !steady) continue;  // K alone is singular: no film removes heat
       if (std::find(st.shifts_per_s.begin(), st.shifts_per_s.end(), s) == st.shifts_per_s.end())
         st.shifts_per_s.push_back(s);
-      Sparse a = k + s * full.capacity;
+      shifted.emplace_back(stiffness.size() - 1, s);
+    }
+  }
+  // Two factors at a time, side by side (each solve needs only its own); the columns join the
+  // basis in the fixed order above, so the basis does not depend on the thread count.
+  // The shifted operators share one pattern: one analysis (ordering, symbolic factor) for all.
+  constexpr std::size_t kWave = 2;
+  std::optional<cholmod::Analysis> analysis;
+  if (!shifted.empty()) {
+    Sparse a = stiffness[shifted[0].first] + shifted[0].second * full.capacity;
+    a.makeCompressed();
+    analysis.emplace(a, "reduction: the pattern of K(h) + s C");
+  }
+  for (std::size_t first = 0; first < shifted.size(); first += kWave) {
+    const std::size_t count = std::min(kWave, shifted.size() - first);
+    std::vector<std::vector<Eigen::MatrixXd>> moments(count);
+    core::parallel_for(static_cast<std::ptrdiff_t>(count), [&](std::ptrdiff_t i) {
+      const auto [state, s] = shifted[first + static_cast<std::size_t>(i)];
+      Sparse a = stiffness[state] + s * full.capacity;
       a.makeCompressed();
       std::ostringstream what;
       what << "reduction: K(h) + s C at s = " << s << " 1/s";
-      const cholmod::Factor factor(a, what.str());
-      ++st.factorizations;
-      Eigen::MatrixXd x = factor.solve(rhs);
-      st.candidate_columns += static_cast<int>(x.cols());
-      st.deflated_columns += v.append(x);
-      if (options.second_moment) {
-        x = factor.solve(full.capacity * x);
+      const cholmod::Factor factor(*analysis, a, what.str());
+      auto& out = moments[static_cast<std::size_t>(i)];
+      out.push_back(factor.solve(rhs));
+      if (options.second_moment) out.push_back(factor.solve(full.capacity * out.back()));
+    });
+    for (auto& block : moments)
+      for (auto& x : block) {
         st.candidate_columns += static_cast<int>(x.cols());
         st.deflated_columns += v.append(x);
       }
-    }
+    st.factorizations += static_cast<int>(count);
   }
   st.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (stats) *stats = st;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/parallel.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
@@ -108,14 +109,22 @@ Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
 
 Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                const FullThermalSystem& full, const ReductionOptions& options) {
+  // The displacement outputs (the stiffness factor and its block adjoint solve) and the thermal
+  // basis (a factor per film state and shift) are independent: they are built side by side.
   TwinOutputs outputs;
-  if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) {
-    const ElasticModel elastic(mesh, spec);
-    outputs = full_outputs(mesh, spec, &elastic);
-  } else {
-    outputs = full_outputs(mesh, spec, nullptr);
-  }
-  return build_twin(full, spec, outputs, options);
+  Twin twin;
+  core::parallel_invoke(
+      [&] {
+        if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) {
+          const ElasticModel elastic(mesh, spec);
+          outputs = full_outputs(mesh, spec, &elastic);
+        } else {
+          outputs = full_outputs(mesh, spec, nullptr);
+        }
+      },
+      [&] { twin.model = reduced_model(full, spec, options); });
+  twin.outputs = projected_outputs(outputs, twin.model.basis);
+  return twin;
 }
 
 TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& progress) {

@@ -2,7 +2,9 @@
 
 #include <cholmod.h>
 
+#include <algorithm>
 #include <cstring>
+#include <vector>
 
 #include "core/errors.hpp"
 
@@ -72,18 +74,82 @@ cholmod_dense dense_view(double* data, int rows, int cols) {
 
 }  // namespace
 
+namespace {
+
+void check_square(const Eigen::SparseMatrix<double>& a, const std::string& what) {
+  if (a.rows() != a.cols() || !a.isCompressed())
+    throw core::SolverError(what + ": matrix must be square and compressed");
+}
+
+cholmod_factor* analysed(const Eigen::SparseMatrix<double>& a, cholmod_common& c,
+                         const std::string& what) {
+  cholmod_sparse s = view_of(a);
+  c.supernodal = CHOLMOD_SUPERNODAL;
+  cholmod_factor* f = cholmod_analyze(&s, &c);
+  if (!f || c.status < CHOLMOD_OK)
+    throw core::SolverError(what + ": CHOLMOD analysis failed (status " +
+                            std::to_string(c.status) + ")");
+  return f;
+}
+
+}  // namespace
+
+struct Analysis::Impl {
+  cholmod_common common;
+  cholmod_factor* symbolic = nullptr;
+  std::vector<int> outer, inner;  // the analysed pattern, to refuse another
+  Impl() { cholmod_start(&common); }
+  ~Impl() {
+    if (symbolic) cholmod_free_factor(&symbolic, &common);
+    cholmod_finish(&common);
+  }
+};
+
+Analysis::Analysis(const Eigen::SparseMatrix<double>& a, std::string what)
+    : impl_(std::make_unique<Impl>()) {
+  check_square(a, what);
+  impl_->outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1);
+  impl_->inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+  impl_->symbolic = analysed(a, impl_->common, what);
+}
+
+Analysis::~Analysis() = default;
+
 Factor::Factor(const Eigen::SparseMatrix<double>& a, std::string what) : impl_(std::make_unique<Impl>()) {
   impl_->what = std::move(what);
-  if (a.rows() != a.cols() || !a.isCompressed())
-    throw core::SolverError(impl_->what + ": matrix must be square and compressed");
+  check_square(a, impl_->what);
   impl_->n = static_cast<int>(a.rows());
+  impl_->factor = analysed(a, impl_->common, impl_->what);
+  factorize(a);
+}
+
+Factor::Factor(const Analysis& analysis, const Eigen::SparseMatrix<double>& a, std::string what)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->what = std::move(what);
+  check_square(a, impl_->what);
+  const auto& p = *analysis.impl_;
+  const bool same = a.outerSize() + 1 == static_cast<Eigen::Index>(p.outer.size()) &&
+                    a.nonZeros() == static_cast<Eigen::Index>(p.inner.size()) &&
+                    std::equal(p.outer.begin(), p.outer.end(), a.outerIndexPtr()) &&
+                    std::equal(p.inner.begin(), p.inner.end(), a.innerIndexPtr());
+  if (!same)
+    throw core::SolverError(impl_->what + ": its pattern (" + std::to_string(a.rows()) +
+                            " rows, " + std::to_string(a.nonZeros()) +
+                            " entries) is not the analysed one (" +
+                            std::to_string(p.outer.size() - 1) + " rows, " +
+                            std::to_string(p.inner.size()) + " entries)");
+  impl_->n = static_cast<int>(a.rows());
+  impl_->common.supernodal = CHOLMOD_SUPERNODAL;
+  impl_->factor = cholmod_copy_factor(analysis.impl_->symbolic, &impl_->common);
+  if (!impl_->factor)
+    throw core::SolverError(impl_->what + ": CHOLMOD could not copy the analysis (status " +
+                            std::to_string(impl_->common.status) + ")");
+  factorize(a);
+}
+
+void Factor::factorize(const Eigen::SparseMatrix<double>& a) {
   cholmod_sparse s = view_of(a);
   cholmod_common& c = impl_->common;
-  c.supernodal = CHOLMOD_SUPERNODAL;
-  impl_->factor = cholmod_analyze(&s, &c);
-  if (!impl_->factor || c.status < CHOLMOD_OK)
-    throw core::SolverError(impl_->what + ": CHOLMOD analysis failed (status " +
-                            std::to_string(c.status) + ")");
   cholmod_factorize(&s, impl_->factor, &c);
   if (c.status == CHOLMOD_NOT_POSDEF || impl_->factor->minor < impl_->factor->n)
     throw core::SolverError(

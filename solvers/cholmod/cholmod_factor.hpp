@@ -14,11 +14,31 @@ namespace tt::solvers::cholmod {
 /// back-substitutions of this size, faster than two.
 void set_blas_threads(int threads);
 
+/// The fill-reducing ordering and symbolic factor of a sparsity pattern, computed once and shared
+/// (read only, so from several threads) by the factors of matrices with that pattern, such as the
+/// shifted operators K(h) + s C of a reduced basis.
+class Analysis {
+ public:
+  /// Analyses A's pattern (column-major, compressed; upper triangle). `what` names it in errors.
+  Analysis(const Eigen::SparseMatrix<double>& a, std::string what);
+  ~Analysis();
+  Analysis(const Analysis&) = delete;
+  Analysis& operator=(const Analysis&) = delete;
+
+ private:
+  friend class Factor;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 class Factor {
  public:
   /// Factors A (column-major, compressed; only its upper triangle is read). `what` names the
   /// matrix in error messages.
   Factor(const Eigen::SparseMatrix<double>& a, std::string what);
+  /// Factors A, whose pattern is the analysed one, without analysing it again. Throws
+  /// SolverError when A has another size or number of entries.
+  Factor(const Analysis& analysis, const Eigen::SparseMatrix<double>& a, std::string what);
   ~Factor();
   Factor(const Factor&) = delete;
   Factor& operator=(const Factor&) = delete;
@@ -35,6 +55,7 @@ class Factor {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  void factorize(const Eigen::SparseMatrix<double>& a);
 };
 
 }  // namespace tt::solvers::cholmod

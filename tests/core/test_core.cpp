@@ -2,6 +2,10 @@
 
 #include <omp.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
@@ -25,6 +29,26 @@ TEST(Parallel, ChunksAreInOrderWhateverTheThreadCount) {
     ASSERT_EQ(chunks.size(), 11u);
     EXPECT_EQ(chunks[0], 4950);
     EXPECT_EQ(chunks[10], 1000);
+  }
+}
+
+TEST(Parallel, AThrowingBodyRethrowsTheLowestIndexAfterTheLoop) {
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    std::vector<int> done(8, 0);
+    try {
+      parallel_for(8, [&](std::ptrdiff_t i) {
+        if (i == 3 || i == 6) throw SolverError("failed at " + std::to_string(i));
+        done[static_cast<std::size_t>(i)] = 1;
+      });
+      ADD_FAILURE() << "no exception";
+    } catch (const SolverError& e) {
+      EXPECT_STREQ(e.what(), "failed at 3");
+    }
+    EXPECT_EQ(std::count(done.begin(), done.end(), 1), 6);  // the others ran to the end
+    int first = 0, second = 0;
+    parallel_invoke([&] { first = 1; }, [&] { second = 2; });
+    EXPECT_EQ(first + second, 3);
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <omp.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
+#include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/feed_axis.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/reduction.hpp"
@@ -185,6 +187,42 @@ TEST(ReductionBasis, IsCapacityOrthonormalAndHoldsTheUniformField) {
   // A film state that removes heat: 0 is among the shifts, and 2 states were sampled.
   EXPECT_EQ(b.model.stats.film_states.size(), 2u);
   EXPECT_EQ(b.model.stats.shifts_per_s.front(), 0.0);
+}
+
+TEST(ReductionBasis, DoesNotDependOnTheThreadCount) {
+  // The shifts are factored two at a time, side by side; the columns join in a fixed order.
+  const Block& b = block();
+  solvers::ReductionOptions o;
+  o.speeds_rpm = {0.0, 6000.0};
+  omp_set_num_threads(1);
+  const Eigen::MatrixXd one = solvers::reduction_basis(b.full, b.spec, o);
+  omp_set_num_threads(2);
+  const Eigen::MatrixXd two = solvers::reduction_basis(b.full, b.spec, o);
+  ASSERT_EQ(one.cols(), b.model.basis.cols());
+  ASSERT_EQ(two.cols(), one.cols());
+  EXPECT_EQ((one - two).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Factor, SharesOneAnalysisAndRefusesAnotherPattern) {
+  const Block& b = block();
+  Eigen::SparseMatrix<double> a = b.full.conduction + 1e-3 * b.full.capacity;
+  a.makeCompressed();
+  const solvers::cholmod::Analysis analysis(a, "pattern");
+  Eigen::SparseMatrix<double> a2 = b.full.conduction + 2e-3 * b.full.capacity;
+  a2.makeCompressed();
+  const Eigen::VectorXd rhs = b.full.capacity * Eigen::VectorXd::LinSpaced(a.rows(), 0, 1);
+  const Eigen::MatrixXd shared = solvers::cholmod::Factor(analysis, a2, "shared").solve(rhs);
+  const Eigen::MatrixXd own = solvers::cholmod::Factor(a2, "own").solve(rhs);
+  EXPECT_LT((shared - own).cwiseAbs().maxCoeff(), 1e-12 * own.cwiseAbs().maxCoeff());
+  Eigen::SparseMatrix<double> diag(a.rows(), a.cols());
+  diag.setIdentity();
+  diag.makeCompressed();
+  try {
+    solvers::cholmod::Factor(analysis, diag, "diagonal");
+    ADD_FAILURE() << "another pattern was accepted";
+  } catch (const tt::core::SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not the analysed one"), std::string::npos) << e.what();
+  }
 }
 
 TEST(ReductionBasis, ReducedStepsAreStableForAnyFilm) {
