@@ -21,6 +21,8 @@
 #include <iostream>
 #include <string>
 
+#include <unistd.h>
+
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
 #include "app/version.hpp"
@@ -219,6 +221,13 @@ int main(int argc, char** argv) {
                        "terminal)");
 
   CLI11_PARSE(cli, argc, argv);
+  // OpenBLAS chose kernels slower than this CPU allows (cholmod_factor.hpp, better_blas_core):
+  // start again with OPENBLAS_CORETYPE set; a value the user set is kept. If exec fails, go on.
+  if (!std::getenv("OPENBLAS_CORETYPE")) {
+    const std::string core = tt::solvers::cholmod::better_blas_core();
+    if (!core.empty() && setenv("OPENBLAS_CORETYPE", core.c_str(), 1) == 0)
+      execv("/proc/self/exe", argv);
+  }
   // Ctrl-C or a kill (SIGINT, SIGTERM, SIGHUP) while a command works removes its DIR.partial and
   // DIR.lock; DIR keeps the previous result and DIR.checkpoint stays for --resume.
   tt::io::clean_up_outputs_on_signals();

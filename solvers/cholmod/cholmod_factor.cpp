@@ -9,11 +9,22 @@
 #include "core/errors.hpp"
 
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+extern "C" char* openblas_get_corename() __attribute__((weak));
 
 namespace tt::solvers::cholmod {
 
 void set_blas_threads(int threads) {
   if (openblas_set_num_threads) openblas_set_num_threads(threads);
+}
+
+std::string better_blas_core() {
+  if (!openblas_get_corename) return {};  // another BLAS
+  const std::string chosen = openblas_get_corename();
+  if (chosen != "Prescott" && chosen != "prescott") return {};
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return "SkylakeX";
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
+  return {};
 }
 
 struct Factor::Impl {

@@ -17,6 +17,14 @@ void set_blas_threads(int threads);
 /// The fill-reducing ordering and symbolic factor of a sparsity pattern, computed once and shared
 /// (read only, so from several threads) by the factors of matrices with that pattern, such as the
 /// shifted operators K(h) + s C of a reduced basis.
+/// The OpenBLAS core type that matches this CPU when the loaded OpenBLAS chose a slower one, else
+/// empty. Debian's OpenBLAS picks its kernels from the CPU model when it is loaded; a CPU it does
+/// not know (a virtual machine that reports a generic model) gets Prescott's SSE3 kernels even
+/// when it has AVX-512 or AVX2, and the sparse factors' dense blocks run slower. OpenBLAS takes
+/// the choice from OPENBLAS_CORETYPE only when it is loaded, so the caller must start again with
+/// it set (app/main.cpp does).
+std::string better_blas_core();
+
 class Analysis {
  public:
   /// Analyses A's pattern (column-major, compressed; upper triangle). `what` names it in errors.
