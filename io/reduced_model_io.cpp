@@ -290,6 +290,7 @@ ReducedModelFile read_reduced_model(const fs::path& dir) {
                             " names nodes outside the model's " + std::to_string(f.key.nodes));
     s.moving_pieces.push_back(std::move(p));
   }
+  s = solvers::with_moving_prefix(std::move(s));
   const auto& b = j.value("basis", nlohmann::json::object());
   model.stats.shifts_per_s = b.value("shifts_per_s", std::vector<double>{});
   model.stats.film_states = b.value("film_states_W_m2K", std::vector<std::vector<double>>{});

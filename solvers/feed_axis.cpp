@@ -76,20 +76,19 @@ Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, E
   return load;
 }
 
-Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
-                                       double t0, double t1) {
+std::vector<WindowShare> moving_windows(const core::CaseSpec& spec, const MovingSourceShape& shape,
+                                        double t0, double t1) {
   const auto& src = spec.thermal.sources[shape.source];
   const auto n = shape.centre.size();
   const double* begin = shape.centre.data();
   const double* end = begin + n;
-  // Enough sub-instants that the window moves at most an eighth of its length between two.
   const double travel = feed_speed_at(spec.feed_axis, 0.5 * (t0 + t1)) * (t1 - t0);
   const int k = std::clamp(static_cast<int>(std::ceil(8 * travel / src.window)), 1, 4096);
-  // Prefix volumes, and a difference array of the per-piece fractions.
-  Eigen::VectorXd prefix(n + 1);
+  Eigen::VectorXd prefix(n + 1);  // prefix volumes
   prefix(0) = 0;
   for (Eigen::Index i = 0; i < n; ++i) prefix(i + 1) = prefix(i) + shape.volume(i);
-  Eigen::VectorXd diff = Eigen::VectorXd::Zero(n + 1);
+  std::vector<WindowShare> windows;
+  windows.reserve(static_cast<std::size_t>(k));
   for (int j = 0; j < k; ++j) {
     const double t = t0 + (j + 0.5) * (t1 - t0) / k;
     const double c = axis_position_at(spec.feed_axis, t) + src.window_offset;
@@ -100,9 +99,18 @@ Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingS
       lo = at >= n || (at > 0 && c - shape.centre(at - 1) <= shape.centre(at) - c) ? at - 1 : at;
       hi = lo + 1;
     }
-    const double share = 1.0 / (k * (prefix(hi) - prefix(lo)));
-    diff(lo) += share;
-    diff(hi) -= share;
+    windows.push_back({lo, hi, 1.0 / (k * (prefix(hi) - prefix(lo)))});
+  }
+  return windows;
+}
+
+Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
+                                       double t0, double t1) {
+  const auto n = shape.centre.size();
+  Eigen::VectorXd diff = Eigen::VectorXd::Zero(n + 1);  // a difference array of the shares
+  for (const WindowShare& w : moving_windows(spec, shape, t0, t1)) {
+    diff(w.lo) += w.per_volume;
+    diff(w.hi) -= w.per_volume;
   }
   Eigen::VectorXd fraction(n);
   double density = 0;  // fraction per unit volume
@@ -111,6 +119,17 @@ Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingS
     fraction(i) = density * shape.volume(i);
   }
   return fraction;
+}
+
+Eigen::MatrixXd moving_prefix(const Eigen::MatrixXd& load, const MovingSourceShape& shape) {
+  if (load.cols() != shape.volume.size())
+    throw core::SolverError("moving load: " + std::to_string(load.cols()) + " columns for " +
+                            std::to_string(shape.volume.size()) + " pieces");
+  Eigen::MatrixXd prefix(load.rows(), load.cols() + 1);
+  prefix.col(0).setZero();
+  for (Eigen::Index i = 0; i < load.cols(); ++i)
+    prefix.col(i + 1) = prefix.col(i) + shape.volume(i) * load.col(i);
+  return prefix;
 }
 
 }  // namespace tt::solvers

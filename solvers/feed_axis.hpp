@@ -32,10 +32,29 @@ std::vector<MovingSourceShape> moving_source_shapes(const mesh::TetMesh& mesh,
 /// unit power over its nodes by int N dV / V_piece (each column sums to 1) [-].
 Eigen::SparseMatrix<double> moving_load_matrix(const MovingSourceShape& shape, Eigen::Index nodes);
 
+/// The window at one of a step's sub-instants: pieces [lo, hi) share the power by volume, each
+/// piece p receiving volume_p * per_volume of it (per_volume = 1 / (sub-instants x their volume)).
+struct WindowShare {
+  Eigen::Index lo = 0, hi = 0;
+  double per_volume = 0;  /// [1/m^3]
+};
+
+/// The windows of the step [t0, t1]: enough sub-instants that the window moves at most an eighth
+/// of its length between two; the piece nearest the window's centre takes it all when the window
+/// holds no centroid.
+std::vector<WindowShare> moving_windows(const core::CaseSpec& spec, const MovingSourceShape& shape,
+                                        double t0, double t1);
+
 /// Per piece, the fraction of the source's power it receives averaged over [t0, t1] [-] (sums to
-/// 1): at each of a set of sub-instants the pieces in the window share the power by volume (the
-/// piece nearest the window's centre takes it all when the window holds no centroid).
+/// 1): the windows' shares summed per piece.
 Eigen::VectorXd moving_piece_fractions(const core::CaseSpec& spec, const MovingSourceShape& shape,
                                        double t0, double t1);
+
+/// Prefix sums along the pieces of the volume-weighted load columns, #space x (#pieces + 1):
+/// column i = sum over p < i of volume_p load.col(p). A window's load per watt is then
+/// per_volume (prefix.col(hi) - prefix.col(lo)): one column difference per sub-instant instead of
+/// one column per piece (a reduced system's load matrix is dense). Throws SolverError when load
+/// has not one column per piece.
+Eigen::MatrixXd moving_prefix(const Eigen::MatrixXd& load, const MovingSourceShape& shape);
 
 }  // namespace tt::solvers

@@ -302,7 +302,7 @@ ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen
   // was built on, not for another capacity projected on it (a calibrated case).
   r.uniform = r.capacity.ldlt().solve(basis.transpose() *
                                       (full.capacity * Eigen::VectorXd::Ones(full.states())));
-  return r;
+  return with_moving_prefix(std::move(r));
 }
 
 ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& spec,
@@ -421,25 +421,31 @@ ErrorIndicator error_indicator(const FullThermalSystem& full, const ReducedModel
   out.tolerance_k = tolerance_k;
   out.samples_k.assign(steps.size(), 0.0);
   for (const auto& s : steps) check_step(full, model.basis, s);
-  // Samples grouped by (film state, rounded horizon): one factor and one block solve per group.
-  std::vector<bool> done(steps.size(), false);
+  // Samples grouped by (film state, rounded horizon): one factor and one block solve per group,
+  // the groups side by side (each writes its own samples only).
+  std::vector<bool> grouped(steps.size(), false);
+  std::vector<std::vector<size_t>> groups;
   for (size_t i = 0; i < steps.size(); ++i) {
-    if (done[i]) continue;
+    if (grouped[i]) continue;
     const double tau = rounded_horizon(steps[i]);
-    std::vector<size_t> group;
+    groups.emplace_back();
     for (size_t j = i; j < steps.size(); ++j)
-      if (!done[j] && steps[j].film == steps[i].film && rounded_horizon(steps[j]) == tau)
-        group.push_back(j);
-    const Sparse k = film_stiffness(full, steps[i].film);
+      if (!grouped[j] && steps[j].film == steps[i].film && rounded_horizon(steps[j]) == tau) {
+        groups.back().push_back(j);
+        grouped[j] = true;
+      }
+  }
+  core::parallel_for(static_cast<std::ptrdiff_t>(groups.size()), [&](std::ptrdiff_t gi) {
+    const auto& group = groups[static_cast<size_t>(gi)];
+    const ReducedStep& first = steps[group.front()];
+    const Sparse k = film_stiffness(full, first.film);
     Eigen::MatrixXd r(full.states(), static_cast<Eigen::Index>(group.size()));
     for (size_t g = 0; g < group.size(); ++g)
       r.col(static_cast<Eigen::Index>(g)) = step_residual(full, model.basis, k, steps[group[g]]);
-    const Eigen::VectorXd e = estimates(full, k, tau, r);
-    for (size_t g = 0; g < group.size(); ++g) {
+    const Eigen::VectorXd e = estimates(full, k, rounded_horizon(first), r);
+    for (size_t g = 0; g < group.size(); ++g)
       out.samples_k[group[g]] = e(static_cast<Eigen::Index>(g));
-      done[group[g]] = true;
-    }
-  }
+  });
   for (double e : out.samples_k) out.max_k = std::max(out.max_k, e);
   return out;
 }

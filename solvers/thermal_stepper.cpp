@@ -293,12 +293,29 @@ Eigen::VectorXd moving_heat_load(const core::CaseSpec& spec, const LinearThermal
   for (size_t k = 0; k < sys.moving.size(); ++k) {
     const double power = source_power(spec.thermal.sources[sys.moving_source[k]], speed, feed);
     if (power == 0) continue;
-    // Only the pieces under the window take heat: a reduced system's moving matrix is dense.
-    const Eigen::VectorXd share = moving_piece_fractions(spec, sys.moving_pieces[k], t0, t1);
-    for (Eigen::Index p = 0; p < share.size(); ++p)
-      if (share(p) != 0) f += (share(p) * power) * sys.moving[k].col(p);
+    if constexpr (std::is_same_v<Matrix, Dense>) {
+      // A reduced system's moving matrix is dense: one prefix difference per sub-instant.
+      if (sys.moving_prefix.size() != sys.moving.size())
+        throw core::SolverError(
+            "reduced system without the prefix sums of its moving loads (with_moving_prefix)");
+      const Dense& prefix = sys.moving_prefix[k];
+      for (const WindowShare& w : moving_windows(spec, sys.moving_pieces[k], t0, t1))
+        f += (w.per_volume * power) * (prefix.col(w.hi) - prefix.col(w.lo));
+    } else {
+      // Only the pieces under the window take heat.
+      const Eigen::VectorXd share = moving_piece_fractions(spec, sys.moving_pieces[k], t0, t1);
+      for (Eigen::Index p = 0; p < share.size(); ++p)
+        if (share(p) != 0) f += (share(p) * power) * sys.moving[k].col(p);
+    }
   }
   return f;
+}
+
+ReducedThermalSystem with_moving_prefix(ReducedThermalSystem reduced) {
+  reduced.moving_prefix.clear();
+  for (std::size_t k = 0; k < reduced.moving.size(); ++k)
+    reduced.moving_prefix.push_back(moving_prefix(reduced.moving[k], reduced.moving_pieces[k]));
+  return reduced;
 }
 
 template <class Matrix>

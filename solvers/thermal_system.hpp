@@ -34,11 +34,18 @@ struct LinearThermalSystem {
   /// weights), from which solvers/feed_axis computes each piece's share of the power over a step.
   /// Independent of the space: a reduced system keeps the full one's.
   std::vector<MovingSourceShape> moving_pieces;
+  /// A reduced system only: per moving entry, moving_prefix(moving[k], moving_pieces[k]), from
+  /// which the stepper forms a step's moving load in one column difference per sub-instant
+  /// (projected_system and the reduced-model reader fill it; with_moving_prefix adds it).
+  std::vector<Eigen::MatrixXd> moving_prefix;
 
   Eigen::Index states() const { return capacity.rows(); }
 };
 using FullThermalSystem = LinearThermalSystem<Eigen::SparseMatrix<double>>;
 using ReducedThermalSystem = LinearThermalSystem<Eigen::MatrixXd>;
+
+/// `reduced` with its moving_prefix filled.
+LinearThermalSystem<Eigen::MatrixXd> with_moving_prefix(LinearThermalSystem<Eigen::MatrixXd> reduced);
 
 /// The full system of `spec` on `mesh` (element loops in parallel, deterministic order). Throws
 /// SolverError for inverted elements and sources on empty bodies.

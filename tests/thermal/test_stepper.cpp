@@ -29,7 +29,7 @@ ReducedThermalSystem densified(const FullThermalSystem& s) {
   d.moving_source = s.moving_source;
   d.moving_pieces = s.moving_pieces;
   d.uniform = s.uniform;
-  return d;
+  return with_moving_prefix(std::move(d));
 }
 
 /// Largest |a - b| / |b| over the entries.
