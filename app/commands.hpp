@@ -94,6 +94,7 @@ struct ObserveArgs {
   double sensor_sigma_k = 0.05;      /// white noise per reading [K]
   double heat_walk_w = 4.0;          /// random walk of each unknown heat input [W/sqrt(h)]
   double air_walk_k = 0.5;           /// random walk of the air offset [K/sqrt(h)]
+  double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
   bool quiet = false;
 };

@@ -246,6 +246,10 @@ int main(int argc, char** argv) {
   observe->add_option("--air-walk-k", observe_args.air_walk_k,
                       "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
       ->check(CLI::NonNegativeNumber);
+  observe->add_option("--drift-relative-sigma", observe_args.drift_relative_sigma,
+                      "error of the drift rows (elastic model) relative to the drift (default "
+                      "0.04)")
+      ->check(CLI::NonNegativeNumber);
   observe->add_option("--window-s", observe_args.window_s,
                       "consistency test: window of the summed NIS [s] (default 1800)")
       ->check(positive_number());

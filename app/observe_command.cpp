@@ -79,6 +79,7 @@ int observe_command(const ObserveArgs& args) {
       Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), args.sensor_sigma_k);
   noise.heat_walk_w = args.heat_walk_w;
   noise.air_walk_k = args.air_walk_k;
+  noise.drift_relative_sigma = args.drift_relative_sigma;
   solvers::ObserverSetup setup = solvers::twin_observer_setup(rom.twin, spec, sensors, noise);
   setup.consistency.window_s = args.window_s;
   setup.consistency.sustain_s = args.sustain_s;
@@ -122,7 +123,8 @@ int observe_command(const ObserveArgs& args) {
       {"noise",
        {{"sensor_sigma_K", args.sensor_sigma_k},
         {"heat_walk_W_per_sqrt_h", args.heat_walk_w},
-        {"air_walk_K_per_sqrt_h", args.air_walk_k}}},
+        {"air_walk_K_per_sqrt_h", args.air_walk_k},
+        {"drift_relative_sigma", args.drift_relative_sigma}}},
       {"consistency",
        {{"window_s", args.window_s},
         {"sustain_s", args.sustain_s},

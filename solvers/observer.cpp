@@ -132,7 +132,8 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
          std::to_string(setup_.sensor_rows.rows()) +
          " sensors; expected one finite sigma > 0 K each");
   const ObserverNoise& n = setup_.noise;
-  for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k})
+  for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
+                   n.drift_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
   const auto& conv = spec.thermal.convection;
@@ -268,10 +269,14 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   }
   const Eigen::MatrixXd& l = setup_.target_rows;
   e.drift = l * (x_.head(r_) - z0_);
-  e.drift_sigma = (l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
-                      .diagonal()
-                      .cwiseMax(0.0)
-                      .cwiseSqrt();
+  const double rel = setup_.noise.drift_relative_sigma;
+  e.drift_sigma = ((l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
+                       .diagonal()
+                       .cwiseMax(0.0)
+                       .array() +
+                   (rel * e.drift.array()).square())
+                      .sqrt()
+                      .matrix();
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
   e.recalibrate_since_s = monitor_.since_s();
   return e;

@@ -38,6 +38,9 @@ struct ObserverNoise {
   /// White process noise on every reduced state [K per sqrt(h)] in the capacity norm: model-form
   /// error that no input explains (0: none).
   double state_walk_k = 0;
+  /// Error of the drift rows themselves (the elastic model's discretisation, its material
+  /// values), relative to the predicted drift [-]: added to the drift's variance as (e d)^2.
+  double drift_relative_sigma = 0;
 };
 
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
