@@ -91,7 +91,8 @@ struct CompensateArgs {
 struct ObserveArgs {
   std::filesystem::path case_file, rom, data, out;
   std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
-  double sensor_sigma_k = 0.05;      /// white noise per reading [K]
+  /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
+  std::vector<double> sensor_sigma_k{0.05};
   double heat_walk_w = 4.0;          /// random walk of each unknown heat input [W/sqrt(h)]
   double air_walk_k = 0.5;           /// random walk of the air offset [K/sqrt(h)]
   double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]

@@ -237,8 +237,11 @@ int main(int argc, char** argv) {
   observe->add_option("--sensors", observe_args.sensors,
                       "sensor ids to read (default: every sensor of the run the model names)")
       ->delimiter(',');
-  observe->add_option("--sensor-sigma-k", observe_args.sensor_sigma_k,
-                      "white noise of a reading [K] (default 0.05)")
+  observe
+      ->add_option("--sensor-sigma-k", observe_args.sensor_sigma_k,
+                   "white noise of a reading [K]: one value for all sensors or one per sensor, "
+                   "comma-separated (default 0.05)")
+      ->delimiter(',')
       ->check(positive_number());
   observe->add_option("--heat-walk-w", observe_args.heat_walk_w,
                       "random walk of each unknown heat input [W per sqrt(h)] (default 4)")

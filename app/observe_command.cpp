@@ -57,6 +57,19 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
   return y;
 }
 
+/// One sigma per sensor from --sensor-sigma-k: one value for all, or one each [K].
+Eigen::VectorXd sensor_sigmas(const std::vector<double>& values,
+                              const std::vector<std::string>& sensors) {
+  const auto n = static_cast<Eigen::Index>(sensors.size());
+  if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
+  if (values.size() == sensors.size()) return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
+  std::string ids;
+  for (const auto& s : sensors) ids += (ids.empty() ? "" : ",") + s;
+  throw core::DataError("--sensor-sigma-k: " + std::to_string(values.size()) + " values for " +
+                        std::to_string(sensors.size()) + " sensors (" + ids +
+                        "); expected one value for all or one per sensor in that order");
+}
+
 }  // namespace
 
 int observe_command(const ObserveArgs& args) {
@@ -75,8 +88,7 @@ int observe_command(const ObserveArgs& args) {
   // 3. The set-up.
   const std::vector<std::string> sensors = observed_sensors(args, run, rom.twin.outputs);
   solvers::ObserverNoise noise;
-  noise.sensor_sigma_k =
-      Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), args.sensor_sigma_k);
+  noise.sensor_sigma_k = sensor_sigmas(args.sensor_sigma_k, sensors);
   noise.heat_walk_w = args.heat_walk_w;
   noise.air_walk_k = args.air_walk_k;
   noise.drift_relative_sigma = args.drift_relative_sigma;
@@ -121,7 +133,9 @@ int observe_command(const ObserveArgs& args) {
        {{"kind", "reduced"}, {"order", rom.twin.model.states()}, {"rom", args.rom.string()}}},
       {"sensors", sensors},
       {"noise",
-       {{"sensor_sigma_K", args.sensor_sigma_k},
+       {{"sensor_sigma_K",
+         std::vector<double>(noise.sensor_sigma_k.data(),
+                             noise.sensor_sigma_k.data() + noise.sensor_sigma_k.size())},
         {"heat_walk_W_per_sqrt_h", args.heat_walk_w},
         {"air_walk_K_per_sqrt_h", args.air_walk_k},
         {"drift_relative_sigma", args.drift_relative_sigma}}},

@@ -102,12 +102,27 @@ bool InnovationMonitor::add(double t, double nis, int dof) {
     if (std::isnan(exceed_start_)) exceed_start_ = t;
     if (!alarm_ && t - exceed_start_ >= o_.sustain_s) {
       alarm_ = true;
-      alarm_start_ = exceed_start_;
+      alarm_start_ = change_start();
     }
   } else {
     exceed_start_ = std::numeric_limits<double>::quiet_NaN();
   }
   return alarm_;
+}
+
+double InnovationMonitor::change_start() const {
+  // The change point of a shift in the NIS's mean: where the cumulative excess over its
+  // expectation, sum (NIS - dof), is lowest; the change starts at the next sample.
+  double sum = 0, lowest = 0;
+  std::size_t after = 0;
+  for (std::size_t k = 0; k < t_.size(); ++k) {
+    sum += nis_[k] - dof_[k];
+    if (sum <= lowest) {  // the latest of equal lows: a flat stretch is before the change
+      lowest = sum;
+      after = k + 1;
+    }
+  }
+  return t_[std::min(after, t_.size() - 1)];
 }
 
 KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,

@@ -46,8 +46,8 @@ struct ObserverNoise {
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
 /// chi-square with #readings degrees of freedom when the model holds) summed over a sliding
 /// window is compared with the chi-square quantile `probability` of the window's degrees of
-/// freedom; an exceedance held for `sustain_s` raises `recalibrate`, dated from the start of the
-/// exceedance.
+/// freedom; an exceedance held for `sustain_s` raises `recalibrate`, dated from the change point
+/// of the NIS's mean before it (InnovationMonitor::since_s).
 struct ConsistencyOptions {
   double window_s = 1800;
   double probability = 0.999;
@@ -91,9 +91,12 @@ class InnovationMonitor {
   double window_bound() const { return bound_; }  /// its chi-square bound
   bool exceeded() const { return sum_ > bound_; }
   bool recalibrate() const { return alarm_; }
-  double since_s() const { return alarm_start_; }  /// start of the exceedance that raised it [s]
+  /// When the inconsistency started [s]: the change point of the NIS's mean before the alarm,
+  /// the sample after the lowest point of the cumulative sum of NIS - dof (a CUSUM).
+  double since_s() const { return alarm_start_; }
 
  private:
+  double change_start() const;
   ConsistencyOptions o_;
   std::vector<double> t_, nis_;
   std::vector<int> dof_;
@@ -167,7 +170,7 @@ struct ObserverRun {
   Eigen::MatrixXd unknown_inputs, unknown_inputs_sigma;  /// #samples x #biases
   std::vector<std::string> unknown_input_names;
   bool recalibrate = false;
-  double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// exceedance start
+  double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// change point
   double recalibrate_at_s = std::numeric_limits<double>::quiet_NaN();     /// when it was raised
 };
 

@@ -63,7 +63,7 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   const auto j = nlohmann::json::parse(std::ifstream(out / "observer.json"));
   EXPECT_EQ(j["status"], "recalibrate");
   EXPECT_EQ(j["sensors"].size(), 9u);
-  EXPECT_LE(j["recalibrate_since_s"].get<double>(), j["recalibrate_raised_s"].get<double>());
+  EXPECT_LE(j["recalibrate_since_s"].get<double>(), 900.0);  // the offset is there from t = 0
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
   // 3. A sensor the model does not name: refused, naming it; nothing written.
@@ -73,6 +73,16 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
                     {}, bad_log),
             0);
   EXPECT_NE(rt::read_text(bad_log).find("NOPE"), std::string::npos) << rt::read_text(bad_log);
+  EXPECT_FALSE(fs::exists(bad));
+  // Sigmas: one for all or one per sensor; two for nine sensors is refused.
+  EXPECT_NE(
+      rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data", data.string(),
+               "--out", bad.string(), "--sensor-sigma-k", "0.04,0.05", "--quiet"},
+              {}, bad_log),
+      0);
+  EXPECT_NE(rt::read_text(bad_log).find("--sensor-sigma-k: 2 values for 9 sensors"),
+            std::string::npos)
+      << rt::read_text(bad_log);
   EXPECT_FALSE(fs::exists(bad));
 }
 
