@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "calibration/generator.hpp"
@@ -170,6 +171,29 @@ TEST_F(Observer, RecalibrateOnAnUndeclaredHeatInputNotOnACleanRun) {
   EXPECT_LE(heat.recalibrate_at_s, 2 * 3600.0);
   // The heat is there from t = 0: the change point is dated near the start, not at the alarm.
   EXPECT_LE(heat.recalibrate_since_s, 900.0);
+}
+
+TEST_F(Observer, MissingReadingsAreLeftOutOfTheUpdate) {
+  // One sensor silent for the second half, every sensor missing at one sample: the update uses
+  // what is there (the readings' count says so) and the drift stays within its 2 sigma.
+  const core::CaseSpec c = run_spec();
+  Eigen::MatrixXd y = s_->clean.temperature;
+  const Eigen::Index n = y.rows(), half = n / 2;
+  y.col(2).tail(n - half).setConstant(std::numeric_limits<double>::quiet_NaN());
+  y.row(10).setConstant(std::numeric_limits<double>::quiet_NaN());
+  const solvers::ObserverRun run =
+      solvers::observe(s_->twin.model.system, c, setup(default_noise()), s_->clean.time, y);
+  const int m = static_cast<int>(kSensors.size());
+  EXPECT_EQ(run.dof(0), m);
+  EXPECT_EQ(run.dof(10), 0);
+  EXPECT_EQ(run.nis(10), 0.0);
+  EXPECT_EQ(run.dof(n - 1), m - 1);
+  EXPECT_TRUE(std::isnan(run.innovation(n - 1, 2)));
+  EXPECT_TRUE(run.drift.allFinite());
+  const Eigen::Vector3d cov = coverage(run, s_->clean_truth);
+  EXPECT_GE(cov(1), 0.85);
+  EXPECT_GE(cov(2), 0.85);
+  EXPECT_FALSE(run.recalibrate);
 }
 
 TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
