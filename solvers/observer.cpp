@@ -26,6 +26,28 @@ std::string number(double v) {
   return std::to_string(v);
 }
 
+/// Columns of the unknown heat inputs, r x #inputs [state per W]: one per fixed source (on its
+/// shape) and one per film (1 W spread over its surface by area); their names go to `names`.
+Eigen::MatrixXd unknown_heat_columns(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                                     std::vector<std::string>& names) {
+  std::vector<Eigen::VectorXd> heat;
+  for (std::size_t i = 0; i < system.source_shape.size(); ++i) {
+    if (spec.thermal.sources[i].window > 0) continue;  // moving: its pieces, not a shape
+    heat.push_back(system.source_shape[i]);
+    names.push_back("heat:" + spec.thermal.sources[i].name);
+  }
+  const auto& conv = spec.thermal.convection;
+  for (std::size_t c = 0; c < system.film_area.size(); ++c) {
+    const double area = system.film_area[c].dot(system.uniform);
+    if (!(area > 0)) continue;
+    heat.push_back(system.film_area[c] / area);
+    names.push_back("heat:" + spec.groups[conv[c].group].name);
+  }
+  Eigen::MatrixXd columns(system.states(), static_cast<Eigen::Index>(heat.size()));
+  for (std::size_t k = 0; k < heat.size(); ++k) columns.col(static_cast<Eigen::Index>(k)) = heat[k];
+  return columns;
+}
+
 }  // namespace
 
 std::vector<int> air_entries(const core::CaseSpec& spec) {
@@ -158,22 +180,7 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       fail("air entry " + std::to_string(c) + " is not a convection entry (the case has " +
            std::to_string(conv.size()) + ")");
 
-  // Unknown heat: one per fixed source (on its shape) and one per film (spread by area) [W].
-  std::vector<Eigen::VectorXd> heat;
-  for (std::size_t i = 0; i < system.source_shape.size(); ++i) {
-    if (spec.thermal.sources[i].window > 0) continue;  // moving: its pieces, not a shape
-    heat.push_back(system.source_shape[i]);
-    bias_names_.push_back("heat:" + spec.thermal.sources[i].name);
-  }
-  for (std::size_t c = 0; c < system.film_area.size(); ++c) {
-    const double area = system.film_area[c].dot(system.uniform);
-    if (!(area > 0)) continue;
-    heat.push_back(system.film_area[c] / area);
-    bias_names_.push_back("heat:" + spec.groups[conv[c].group].name);
-  }
-  heat_columns_.resize(r_, static_cast<Eigen::Index>(heat.size()));
-  for (std::size_t k = 0; k < heat.size(); ++k)
-    heat_columns_.col(static_cast<Eigen::Index>(k)) = heat[k];
+  heat_columns_ = unknown_heat_columns(system, spec, bias_names_);
   const bool air = !setup_.air_entries.empty();
   if (air) bias_names_.push_back("air");
   nb_ = static_cast<Eigen::Index>(bias_names_.size());
