@@ -86,7 +86,22 @@ struct CompensateArgs {
   bool flush = false;         /// flush after every line (always on a terminal)
 };
 
+/// observe CASE --rom DIR --data RUN --out DIR: the physics observer on a measured run
+/// (app/observe_command.cpp, docs/observer.md).
+struct ObserveArgs {
+  std::filesystem::path case_file, rom, data, out;
+  std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
+  /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
+  std::vector<double> sensor_sigma_k{0.05};
+  double heat_walk_w = 4.0;          /// random walk of each unknown heat input [W/sqrt(h)]
+  double air_walk_k = 0.5;           /// random walk of the air offset [K/sqrt(h)]
+  double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]
+  double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
+  bool quiet = false;
+};
+
 int mesh_command(const MeshArgs& args);
+int observe_command(const ObserveArgs& args);
 int compensate_command(const CompensateArgs& args);
 int reduce_command(const ReduceArgs& args);
 int fit_data_command(const FitDataArgs& args);

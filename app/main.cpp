@@ -12,6 +12,8 @@
 //                                  without --case, from the data alone
 //   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
 //   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file)
+//   observe CASE --rom DIR --data RUN --out DIR
+//                                  the physics observer: drift with its sigma, recalibrate status
 //   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
@@ -220,6 +222,51 @@ int main(int argc, char** argv) {
                        "flush after every line (default: when the input pauses; always on a "
                        "terminal)");
 
+  ObserveArgs observe_args;
+  auto* observe = cli.add_subcommand(
+      "observe",
+      "Physics observer on a measured run: a Kalman filter on the reduced model (docs/observer.md)");
+  observe->add_option("case", observe_args.case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  observe->add_option("--rom", observe_args.rom, "the reduced model (thermotwin reduce CASE --out DIR)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  observe->add_option("--data", observe_args.data, "measured run folder (meta.json, data.csv)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  observe->add_option("--out", observe_args.out, "output directory")->required();
+  observe->add_option("--sensors", observe_args.sensors,
+                      "sensor ids to read (default: every sensor of the run the model names)")
+      ->delimiter(',');
+  observe
+      ->add_option("--sensor-sigma-k", observe_args.sensor_sigma_k,
+                   "white noise of a reading [K]: one value for all sensors or one per sensor, "
+                   "comma-separated (default 0.05)")
+      ->delimiter(',')
+      ->check(positive_number());
+  observe->add_option("--heat-walk-w", observe_args.heat_walk_w,
+                      "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
+      ->check(CLI::NonNegativeNumber);
+  observe->add_option("--air-walk-k", observe_args.air_walk_k,
+                      "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
+      ->check(CLI::NonNegativeNumber);
+  observe->add_option("--drift-relative-sigma", observe_args.drift_relative_sigma,
+                      "error of the drift rows (elastic model) relative to the drift (default "
+                      "0.04)")
+      ->check(CLI::NonNegativeNumber);
+  observe->add_option("--window-s", observe_args.window_s,
+                      "consistency test: window of the summed NIS [s] (default 1800)")
+      ->check(positive_number());
+  observe->add_option("--sustain-s", observe_args.sustain_s,
+                      "consistency test: how long an exceedance lasts before recalibrate [s] "
+                      "(default 900)")
+      ->check(CLI::NonNegativeNumber);
+  observe->add_option("--probability", observe_args.probability,
+                      "consistency test: chi-square quantile of the bound (default 0.999)")
+      ->check(CLI::Range(0.5, 0.999999));
+  observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
+
   CLI11_PARSE(cli, argc, argv);
   // OpenBLAS chose kernels slower than this CPU allows (cholmod_factor.hpp, better_blas_core):
   // start again with OPENBLAS_CORETYPE set; a value the user set is kept. If exec fails, go on.
@@ -264,6 +311,7 @@ int main(int argc, char** argv) {
                                               : calibrate_command_with_case(calibrate_args);
     }
     if (*compensate) return compensate_command(compensate_args);
+    if (*observe) return observe_command(observe_args);
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())
         throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");

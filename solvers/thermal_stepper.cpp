@@ -59,6 +59,7 @@ class StepFactor<Dense> {
   void solve_in_place(Eigen::VectorXd& x) const { x = inverse_ * x; }
   Dense solve(const Dense& b) const { return inverse_ * b; }
   double entries() const { return static_cast<double>(inverse_.size()); }
+  const Dense& inverse() const { return inverse_; }
 
  private:
   Dense inverse_;
@@ -107,6 +108,38 @@ Eigen::VectorXd load_vector(const core::CaseSpec& spec, const LinearThermalSyste
     f += fl.flux * flux_scale(fl, s.speed) * sys.flux_area[i];
   }
   return f;
+}
+
+/// What one step [t_prev, t] loads, as the loop forms it: the loads at the step's end, the scheme
+/// weight (Crank–Nicolson restarts with one backward-Euler step after every load discontinuity:
+/// when the speed differs from `prev_speed`, NaN before the first step), the heat moving with the
+/// feed axis (averaged over the step, the same for both ends of CN) and the step's load times dt,
+/// so that (C + theta dt A) x1 = (C - (1 - theta) dt A) x0 + load.
+struct StepPlan {
+  LoadState s_new, s_old;  /// s_old: the loads at t_prev (Crank–Nicolson only)
+  double theta = 1;
+  Eigen::VectorXd f_moving, load;
+};
+
+template <class Matrix>
+StepPlan step_plan(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>& sys,
+                   double t_prev, double t, double prev_speed, const Eigen::VectorXd& temp,
+                   double t0_k) {
+  const double dt = t - t_prev, mid = 0.5 * (t_prev + t);
+  StepPlan p;
+  p.s_new = load_state(spec, sys, mid, t, temp, t0_k);
+  const bool cn =
+      spec.thermal.scheme == core::TimeScheme::crank_nicolson && p.s_new.speed == prev_speed;
+  p.theta = cn ? 0.5 : 1.0;
+  p.f_moving = moving_heat_load(spec, sys, t_prev, t);
+  const Eigen::VectorXd f_new = load_vector(spec, sys, p.s_new) + p.f_moving;
+  if (cn) {
+    p.s_old = load_state(spec, sys, mid, t_prev, temp, t0_k);
+    p.load = (0.5 * dt) * (load_vector(spec, sys, p.s_old) + p.f_moving + f_new);
+  } else {
+    p.load = dt * f_new;
+  }
+  return p;
 }
 
 /// Heat rate leaving through every film [W]: h (int T dA - T_sink int dA).
@@ -330,8 +363,6 @@ template <class Matrix>
 SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec,
                             const StepperRequest& q, const Progress& progress,
                             const Checkpointing& checkpointing) {
-  using Scheme = core::TimeScheme;
-  const Scheme scheme = spec.thermal.scheme;
   const Eigen::Index n = sys.states();
   const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const double end = spec.duty_cycle.end;
@@ -387,26 +418,21 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     hist.timings.steps = c->steps;
   }
   auto t_saved = Clock::now();
-  Eigen::VectorXd rhs(n), f_prev, f_new, read_new;
+  Eigen::VectorXd rhs(n), read_new;
   Dense block_new;
   for (size_t i = first_step; i < grid.size(); ++i) {
-    const double t = grid[i], dt = t - t_prev, mid = 0.5 * (t_prev + t);
-    const LoadState s_new = load_state(spec, sys, mid, t, temp, t0_k);
-    // Crank–Nicolson restarts with one backward-Euler step after every load discontinuity.
-    const bool restart = i == 0 || s_new.speed != prev_speed;
-    const bool cn = scheme == Scheme::crank_nicolson && !restart;
-    const double theta = cn ? 0.5 : 1.0;
+    const double t = grid[i], dt = t - t_prev;
+    const StepPlan p =
+        step_plan(spec, sys, t_prev, t, i == 0 ? std::nan("") : prev_speed, temp, t0_k);
+    const LoadState& s_new = p.s_new;
+    const bool cn = p.theta != 1;
+    const double theta = p.theta;
     const Matrix& kk = ops.stiffness(s_new);
-    // Heat moving with the feed axis: averaged over the step, the same for both ends of CN.
-    const Eigen::VectorXd f_moving = moving_heat_load(spec, sys, t_prev, t);
-    f_new = load_vector(spec, sys, s_new) + f_moving;
+    const Eigen::VectorXd& f_moving = p.f_moving;
+    rhs = sys.capacity * temp + p.load;
     if (cn) {
-      const LoadState s_old = load_state(spec, sys, mid, t_prev, temp, t0_k);
-      f_prev = load_vector(spec, sys, s_old) + f_moving;
-      rhs = sys.capacity * temp - (0.5 * dt) * (kk * temp) + (0.5 * dt) * (f_prev + f_new);
-      lost_rate_prev = convected_rate(sys, film_total, temp, s_old);
-    } else {
-      rhs = sys.capacity * temp + dt * f_new;
+      rhs -= (0.5 * dt) * (kk * temp);
+      lost_rate_prev = convected_rate(sys, film_total, temp, p.s_old);
     }
     const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
     Eigen::VectorXd next = rhs;
@@ -467,6 +493,54 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
   hist.timings.solve_s = seconds_since(t_solve) - hist.timings.factor_s;
   hist.final_state = std::move(temp);
   return hist;
+}
+
+struct ReducedStepper::Impl {
+  const ReducedThermalSystem& sys;
+  const core::CaseSpec& spec;
+  ThermalTimings timings;
+  StepOperators<Dense> ops;
+  std::vector<double> grid;
+  std::map<std::tuple<double, double, double>, Dense> transitions;
+  Impl(const ReducedThermalSystem& s, const core::CaseSpec& c)
+      : sys(s), spec(c), ops(s, timings), grid(time_grid(c, c.thermal.step)) {}
+};
+
+ReducedStepper::ReducedStepper(const ReducedThermalSystem& system, const core::CaseSpec& spec)
+    : impl_(std::make_unique<Impl>(system, spec)) {}
+ReducedStepper::~ReducedStepper() = default;
+
+const std::vector<double>& ReducedStepper::grid() const {
+  return impl_->grid;
+}
+
+AffineStep ReducedStepper::step(double t0, double t1, double prev_speed,
+                                const Eigen::VectorXd& state) {
+  Impl& m = *impl_;
+  if (!(t1 > t0))
+    throw core::SolverError("reduced step from t = " + std::to_string(t0) + " s to " +
+                            std::to_string(t1) + " s: the end must be after the start");
+  const double dt = t1 - t0;
+  const double t0_k = m.spec.thermal.initial_temperature_c + core::kCelsiusOffset;
+  const StepPlan p = step_plan(m.spec, m.sys, t0, t1, prev_speed, state, t0_k);
+  const StepFactor<Dense>& factor = m.ops.factor(dt, p.theta, p.s_new);
+  const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, p.s_new.speed, p.theta);
+  auto it = m.transitions.find(key);
+  if (it == m.transitions.end()) {
+    Dense right = m.sys.capacity;
+    if (p.theta != 1) right -= ((1 - p.theta) * dt) * m.ops.stiffness(p.s_new);
+    it = m.transitions.emplace(key, factor.inverse() * right).first;
+  }
+  AffineStep a;
+  a.t0 = t0;
+  a.t1 = t1;
+  a.speed = p.s_new.speed;
+  a.theta = p.theta;
+  a.film = p.s_new.h;
+  a.step_inverse = &factor.inverse();
+  a.transition = &it->second;
+  a.input = factor.inverse() * p.load;
+  return a;
 }
 
 template SteppedHistory step_thermal<Sparse>(const FullThermalSystem&, const core::CaseSpec&,

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/case_spec.hpp"
@@ -100,5 +101,41 @@ struct StepLoad {
 template <class Matrix>
 StepLoad step_load(const LinearThermalSystem<Matrix>& system, const core::CaseSpec& spec, double t0,
                    double t1, const Eigen::VectorXd& state0);
+
+
+/// One step of a reduced (dense) system as an affine map of its state, formed as step_thermal
+/// forms the step: x1 = transition x0 + input, with (C + theta dt A) transition = C - (1 - theta)
+/// dt A and (C + theta dt A) input = dt times the step's weighted load (the load's temperature-
+/// dependent part from x0). For a filter that propagates a covariance with the runs' own
+/// discretisation.
+struct AffineStep {
+  double t0 = 0, t1 = 0;      /// [s]
+  double speed = 0;           /// spindle speed over the step [rpm]
+  double theta = 1;           /// 1: backward Euler; 0.5: Crank–Nicolson
+  std::vector<double> film;   /// h per convection entry over the step [W/(m^2 K)]
+  const Eigen::MatrixXd* step_inverse = nullptr;  /// (C + theta dt A)^{-1}, r x r
+  const Eigen::MatrixXd* transition = nullptr;    /// r x r
+  Eigen::VectorXd input;                          /// r [state]
+};
+
+/// Steps a reduced system one step at a time under `spec`'s loads, with step_thermal's loads,
+/// restarts and factors (one per step size, speed and scheme weight, kept for the next steps).
+class ReducedStepper {
+ public:
+  ReducedStepper(const ReducedThermalSystem& system, const core::CaseSpec& spec);
+  ~ReducedStepper();
+  ReducedStepper(const ReducedStepper&) = delete;
+  ReducedStepper& operator=(const ReducedStepper&) = delete;
+  /// The step [t0, t1] from `state`; `prev_speed` is the speed of the step before (NaN for the
+  /// first, which restarts Crank–Nicolson as a speed change does). The pointers stay valid as
+  /// long as the stepper. Throws SolverError when t1 <= t0 or the factorisation fails.
+  AffineStep step(double t0, double t1, double prev_speed, const Eigen::VectorXd& state);
+  /// The case's step ends, as step_thermal walks them [s].
+  const std::vector<double>& grid() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace tt::solvers

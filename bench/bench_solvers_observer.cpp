@@ -1,0 +1,384 @@
+// The physics observer (solvers/observer) against the fitted regression on the same sensors:
+// held-out RMS of the TCP drift, coverage of the true drift by the reported ±2σ, and the
+// innovation test's alarms (false alarms per hour on clean runs, delay on runs with an
+// undeclared effect).
+// Usage: bench_solvers_observer [CASE=cases/sb1_coarse.toml] [HOURS=5] [GEN_HOURS=4]
+//                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
+//                               [DRIFT_RELATIVE_SIGMA=0]
+//   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
+// 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
+// 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
+//    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
+//    validation: staircase_down, ambient_drift; test: irregular_b, run_then_cool, mixed_speeds).
+// 3. The sensors: the four best by the standard's correlation (7.1) for dy and for dz on the
+//    fitting groups, together. The regression: model type and settings chosen on validation among
+//    fitting::default_model_candidates (as `fit` does), refitted; its sigma is the RMS residual
+//    on the groups it was fitted on.
+// 4. The observer on each test run (the run's declared inputs), and the regression, against the
+//    true (noiseless) drift.
+// 5. The calibration generator's runs (its own finer mesh and step, its sensor noise): CLEAN_RUNS
+//    with no effect and one per effect kind, random duty cycles of GEN_HOURS; the observer is
+//    given the declared case and the run's duty cycle only.
+// Prints one line per run and the totals.
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <random>
+#include <set>
+
+#include "calibration/generator.hpp"
+#include "calibration/model.hpp"
+#include "core/rng.hpp"
+#include "core/units.hpp"
+#include "fitting/models.hpp"
+#include "fitting/noise.hpp"
+#include "fitting/selection.hpp"
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/campaign.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/thermal_error.hpp"
+#include "solvers/twin.hpp"
+
+namespace {
+
+using namespace tt;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Per target (dy, dz): sum of squared errors, samples, samples inside ±2σ.
+struct Score {
+  Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero();
+  double n = 0;
+  void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
+           const Eigen::MatrixXd& truth) {
+    for (Eigen::Index i = 1; i < truth.rows(); ++i) {  // t = 0 is the reference, not a prediction
+      for (int d = 0; d < 2; ++d) {
+        const double e = predicted(i, d) - truth(i, d);
+        ss(d) += e * e;
+        inside(d) += std::abs(e) <= 2 * sigma(i, d);
+      }
+      n += 1;
+    }
+  }
+  Eigen::Vector2d rms_um() const { return (ss / n).cwiseSqrt() * 1e6; }
+  Eigen::Vector2d coverage() const { return inside / n; }
+};
+
+/// Alarms over a set of runs.
+struct Alarms {
+  double hours = 0;
+  int raised = 0;
+  std::vector<double> delays_s;
+};
+
+struct Method {
+  Score observer, regression;
+};
+
+/// The candidate sensors' names (named points but the TCP, probes and axis points).
+std::vector<std::string> candidates(const core::CaseSpec& spec, const mesh::TetMesh& mesh) {
+  std::vector<std::string> out;
+  const auto& m = spec.mechanical;
+  for (const auto& p : mesh.points) {
+    if (p.id == m.tcp_point ||
+        std::find(m.probe_points.begin(), m.probe_points.end(), p.id) != m.probe_points.end() ||
+        std::find(m.axis_points.begin(), m.axis_points.end(), p.id) != m.axis_points.end())
+      continue;
+    out.push_back(p.id);
+  }
+  return out;
+}
+
+int point_column(const mesh::TetMesh& mesh, const std::string& id) {
+  for (std::size_t k = 0; k < mesh.points.size(); ++k)
+    if (mesh.points[k].id == id) return static_cast<int>(k);
+  throw std::runtime_error("no named point " + id);
+}
+
+/// A campaign run as a fitting group on `sensors` (dy, dz targets).
+fitting::Group group_of(const mesh::TetMesh& mesh, const solvers::CampaignResult& r,
+                        const std::vector<std::string>& sensors) {
+  fitting::Group g;
+  g.name = r.name;
+  g.time =
+      Eigen::Map<const Eigen::VectorXd>(r.times.data(), static_cast<Eigen::Index>(r.times.size()));
+  g.temperature.resize(g.time.size(), static_cast<Eigen::Index>(sensors.size()));
+  for (std::size_t k = 0; k < sensors.size(); ++k)
+    g.temperature.col(static_cast<Eigen::Index>(k)) =
+        r.point_temperature.col(point_column(mesh, sensors[k]));
+  g.error.resize(g.time.size(), 2);
+  g.error.col(0) = r.error.col(solvers::kDy);
+  g.error.col(1) = r.error.col(solvers::kDz);
+  g.sensor_names = sensors;
+  g.target_names = {"dy", "dz"};
+  return g;
+}
+
+fitting::Group columns(const fitting::Group& g, const std::vector<int>& cols,
+                       const std::vector<std::string>& names) {
+  fitting::Group out = g;
+  out.temperature.resize(g.time.size(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    out.temperature.col(static_cast<Eigen::Index>(k)) = g.temperature.col(cols[k]);
+  out.sensor_names = names;
+  return out;
+}
+
+/// The regression's chosen model per target and its sigma [m].
+struct Regression {
+  std::vector<tt::fitting::FittedModel> models;
+  Eigen::Vector2d sigma;
+};
+
+/// #samples x 2 predictions and sigmas of the regression on a group.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> regression_on(const Regression& reg,
+                                                          const fitting::Group& g) {
+  Eigen::MatrixXd p(g.time.size(), 2), s(g.time.size(), 2);
+  for (int d = 0; d < 2; ++d) {
+    p.col(d) = fitting::predicted_error(reg.models[static_cast<std::size_t>(d)], g);
+    s.col(d).setConstant(reg.sigma(d));
+  }
+  return {p, s};
+}
+
+/// Observer's (dy, dz) drift and sigma.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> dy_dz(const solvers::ObserverRun& run) {
+  return {run.drift.middleCols(1, 2), run.drift_sigma.middleCols(1, 2)};
+}
+
+void add_alarm(Alarms& a, const solvers::ObserverRun& run, double hours) {
+  a.hours += hours;
+  if (run.recalibrate) {
+    a.raised += 1;
+    a.delays_s.push_back(run.recalibrate_at_s);
+  }
+}
+
+std::string fmt(double v, int digits = 3) {
+  std::ostringstream o;
+  o << std::setprecision(digits) << v;
+  return o.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const std::string case_file =
+        argc > 1 ? argv[1] : std::string(TT_SOURCE_DIR) + "/cases/sb1_coarse.toml";
+    const double hours = argc > 2 ? std::stod(argv[2]) : 5;
+    const double gen_hours = argc > 3 ? std::stod(argv[3]) : 4;
+    const int clean_runs = argc > 4 ? std::stoi(argv[4]) : 3;
+    const std::uint64_t seed = argc > 5 ? std::stoull(argv[5]) : 1;
+    solvers::ObserverNoise campaign_noise;
+    if (argc > 6) campaign_noise.heat_walk_w = std::stod(argv[6]);
+    if (argc > 7) campaign_noise.air_walk_k = std::stod(argv[7]);
+    if (argc > 8) campaign_noise.drift_relative_sigma = std::stod(argv[8]);
+    const auto t_all = Clock::now();
+
+    // 1. Case, mesh, twin.
+    const core::CaseSpec spec = io::read_case(case_file);
+    const mesh::TetMesh mesh = mesh::mesh_case(spec);
+    const solvers::FullThermalSystem full = solvers::thermal_system(mesh, spec);
+    const solvers::Twin twin = solvers::case_twin(mesh, spec, full);
+    std::cout << "case " << case_file << ": " << mesh.nodes.rows() << " nodes, twin order "
+              << twin.model.states() << " (" << fmt(seconds_since(t_all))
+              << " s); observer walks: heat " << campaign_noise.heat_walk_w << " W/sqrt(h), air "
+              << campaign_noise.air_walk_k << " K/sqrt(h), drift relative sigma "
+              << campaign_noise.drift_relative_sigma << "\n";
+
+    // 2. The campaign in full order, noisy readings.
+    const auto t_camp = Clock::now();
+    const auto runs = solvers::campaign_runs(spec, hours, spec.seed);
+    const auto results = solvers::simulate_campaign(mesh, spec, runs);
+    const std::vector<std::string> cand = candidates(spec, mesh);
+    std::vector<fitting::Group> clean, noisy;
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      clean.push_back(group_of(mesh, results[i], cand));
+      noisy.push_back(fitting::noisy_group(clean.back(), fitting::SensorNoise{}, spec.seed, i));
+    }
+    const auto index = [&](const std::vector<std::string>& names) {
+      std::vector<int> out;
+      for (const auto& n : names)
+        for (std::size_t i = 0; i < clean.size(); ++i)
+          if (clean[i].name == n) out.push_back(static_cast<int>(i));
+      return out;
+    };
+    const fitting::Split split{index({"p1_extended", "staircase_up", "irregular_a", "warm_start"}),
+                               index({"staircase_down", "ambient_drift"}),
+                               index({"irregular_b", "run_then_cool", "mixed_speeds"})};
+    std::cout << "campaign: " << runs.size() << " runs of " << hours << " h in full order ("
+              << fmt(seconds_since(t_camp)) << " s)\n";
+
+    // 3. Sensors and regression.
+    std::vector<int> chosen;
+    for (int d = 0; d < 2; ++d)
+      for (int c :
+           fitting::sensors_by_correlation(fitting::group_subset(noisy, split.fitting), d, 4))
+        if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
+    std::vector<std::string> sensors;
+    for (int c : chosen) sensors.push_back(cand[static_cast<std::size_t>(c)]);
+    std::cout << "sensors:";
+    for (const auto& s : sensors) std::cout << " " << s;
+    std::cout << "\n";
+    std::vector<fitting::Group> noisy_s;
+    for (const auto& g : noisy) noisy_s.push_back(columns(g, chosen, sensors));
+    std::vector<int> all(sensors.size());
+    for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+    const std::vector<fitting::SensorSet> sets{{"correlation_union", all}};
+    Regression reg;
+    std::vector<int> fitted = split.fitting;
+    fitted.insert(fitted.end(), split.validation.begin(), split.validation.end());
+    for (int d = 0; d < 2; ++d) {
+      const fitting::Evaluation e =
+          fitting::evaluation(noisy_s, split, d, sets, fitting::default_model_candidates());
+      reg.models.push_back(e.model);
+      double ss = 0, n = 0;
+      for (int i : fitted) {
+        const Eigen::VectorXd r =
+            fitting::predicted_error(e.model, noisy_s[static_cast<std::size_t>(i)]) -
+            noisy_s[static_cast<std::size_t>(i)].error.col(d);
+        ss += r.squaredNorm();
+        n += static_cast<double>(r.size());
+      }
+      reg.sigma(d) = std::sqrt(ss / n);
+      std::cout << "regression " << (d ? "dz" : "dy") << ": " << fitting::model_label(e.model.spec)
+                << ", sigma " << fmt(reg.sigma(d) * 1e6) << " um (RMS residual on fitting + "
+                << "validation, with the probes' 0.3 um noise)\n";
+    }
+
+    // 4. Observer and regression on the held-out runs.
+    campaign_noise.sensor_sigma_k = Eigen::VectorXd::Constant(
+        static_cast<Eigen::Index>(sensors.size()), fitting::SensorNoise{}.temperature_sigma);
+    Method held;
+    Alarms clean_alarms, effect_alarms;
+    double observer_s = 0, observed_h = 0;
+    std::cout
+        << "\nrun | kind | observer RMS dy, dz [um] | regression RMS dy, dz [um] | "
+           "observer 2σ coverage dy, dz | regression coverage dy, dz | alarm at [s] (since)\n";
+    const auto line = [&](const std::string& name, const std::string& kind, const Score& o,
+                          const Score& r, const solvers::ObserverRun& run) {
+      std::cout << name << " | " << kind << " | " << fmt(o.rms_um()(0)) << ", "
+                << fmt(o.rms_um()(1)) << " | " << fmt(r.rms_um()(0)) << ", " << fmt(r.rms_um()(1))
+                << " | " << fmt(100 * o.coverage()(0)) << " %, " << fmt(100 * o.coverage()(1))
+                << " % | " << fmt(100 * r.coverage()(0)) << " %, " << fmt(100 * r.coverage()(1))
+                << " % | "
+                << (run.recalibrate ? fmt(run.recalibrate_at_s, 5) + " (" +
+                                          fmt(run.recalibrate_since_s, 5) + ")"
+                                    : std::string("none"))
+                << "\n";
+    };
+    for (int i : split.test) {
+      const auto& r = runs[static_cast<std::size_t>(i)];
+      const auto& g = noisy_s[static_cast<std::size_t>(i)];
+      const Eigen::MatrixXd truth = clean[static_cast<std::size_t>(i)].error;
+      const solvers::ObserverSetup setup =
+          solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise);
+      const auto t_obs = Clock::now();
+      const solvers::ObserverRun run =
+          solvers::observe(twin.model.system, r.spec, setup, g.time, g.temperature);
+      observer_s += seconds_since(t_obs);
+      observed_h += r.spec.duty_cycle.end / 3600;
+      Score o, rr;
+      const auto [po, so] = dy_dz(run);
+      o.add(po, so, truth);
+      const auto [pr, sr] = regression_on(reg, g);
+      rr.add(pr, sr, truth);
+      held.observer.add(po, so, truth);
+      held.regression.add(pr, sr, truth);
+      add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
+      line(r.name, "campaign, held out", o, rr, run);
+    }
+
+    // 5. The generator's runs.
+    const auto t_gen = Clock::now();
+    calibration::GeneratorOptions gopt;
+    const core::CaseSpec gen = calibration::generator_case(spec, gopt);
+    const mesh::TetMesh gmesh = mesh::mesh_case(gen);
+    calibration::Instrumentation inst;
+    inst.sensor_points = sensors;
+    std::mt19937_64 rng = core::generator(seed, 0);
+    solvers::ObserverNoise gen_noise = campaign_noise;
+    // The generator's sensors: 0.03 K white, 0.01 K drifting (600 s), 0.01 K steps.
+    gen_noise.sensor_sigma_k.setConstant(std::sqrt(0.03 * 0.03 + 0.01 * 0.01 + 0.01 * 0.01 / 12));
+    Method gclean, geffect;
+    std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
+    for (int k = 0; k < clean_runs; ++k) plan.emplace_back("none", calibration::InjectedEffect{});
+    for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
+      const auto kind = static_cast<calibration::EffectKind>(k);
+      plan.emplace_back(calibration::kind_name(kind),
+                        calibration::random_effect(kind, spec, gmesh, sensors, rng));
+    }
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+      const auto& [kind, effect] = plan[k];
+      const core::DutyCycle duty = calibration::random_duty_cycle(gen_hours, rng);
+      const core::CaseSpec truth_spec =
+          calibration::truth_case(gen, effect, duty, static_cast<int>(k));
+      const std::string name = "gen_" + std::to_string(k);
+      const io::MeasuredRun truth =
+          calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
+      const io::MeasuredRun measured = calibration::with_noise(truth, gopt, rng);
+      const core::CaseSpec declared = calibration::case_for_run(spec, measured);
+      const solvers::ObserverSetup setup =
+          solvers::twin_observer_setup(twin, declared, sensors, gen_noise);
+      const auto t_obs = Clock::now();
+      const solvers::ObserverRun run =
+          solvers::observe(twin.model.system, declared, setup, measured.time, measured.temperature);
+      observer_s += seconds_since(t_obs);
+      observed_h += duty.end / 3600;
+      const Eigen::MatrixXd true_drift = truth.displacement.middleCols(1, 2);
+      fitting::Group g;
+      g.name = name;
+      g.time = measured.time;
+      g.temperature = measured.temperature;
+      g.error = true_drift;
+      g.sensor_names = sensors;
+      g.target_names = {"dy", "dz"};
+      Score o, rr;
+      const auto [po, so] = dy_dz(run);
+      o.add(po, so, true_drift);
+      const auto [pr, sr] = regression_on(reg, g);
+      rr.add(pr, sr, true_drift);
+      Method& m = effect.present ? geffect : gclean;
+      m.observer.add(po, so, true_drift);
+      m.regression.add(pr, sr, true_drift);
+      add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
+      std::string what = kind;
+      if (effect.present)
+        what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
+      line(name, "generator, " + what, o, rr, run);
+    }
+    std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
+              << fmt(seconds_since(t_gen)) << " s)\n\n";
+
+    const auto total = [&](const std::string& what, const Method& m) {
+      std::cout << what << ": observer RMS dy " << fmt(m.observer.rms_um()(0)) << " um, dz "
+                << fmt(m.observer.rms_um()(1)) << " um, coverage "
+                << fmt(100 * m.observer.coverage()(0)) << " %, "
+                << fmt(100 * m.observer.coverage()(1)) << " %; regression RMS dy "
+                << fmt(m.regression.rms_um()(0)) << " um, dz " << fmt(m.regression.rms_um()(1))
+                << " um, coverage " << fmt(100 * m.regression.coverage()(0)) << " %, "
+                << fmt(100 * m.regression.coverage()(1)) << " %\n";
+    };
+    total("campaign held-out runs", held);
+    total("generator clean runs", gclean);
+    total("generator effect runs", geffect);
+    std::cout << "alarms on clean runs: " << clean_alarms.raised << " in " << clean_alarms.hours
+              << " h (" << fmt(clean_alarms.raised / clean_alarms.hours) << " per hour)\n";
+    std::cout << "alarms on effect runs: " << effect_alarms.raised << " of "
+              << plan.size() - clean_runs << "; delays [s]:";
+    for (double d : effect_alarms.delays_s) std::cout << " " << d;
+    std::cout << "\nobserver: " << fmt(observer_s) << " s for " << fmt(observed_h) << " h of runs ("
+              << fmt(observer_s / observed_h * 1e3) << " ms per hour of run); total "
+              << fmt(seconds_since(t_all)) << " s\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_solvers_observer: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,352 @@
+#include "solvers/observer.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/errors.hpp"
+#include "core/units.hpp"
+
+namespace tt::solvers {
+
+namespace {
+
+/// Quantile p of the standard normal distribution (bisection on erfc: called once per window).
+double normal_quantile(double p) {
+  double lo = -10, hi = 10;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::string number(double v) {
+  return std::to_string(v);
+}
+
+/// Columns of the unknown heat inputs, r x #inputs [state per W]: one per fixed source (on its
+/// shape) and one per film (1 W spread over its surface by area); their names go to `names`.
+Eigen::MatrixXd unknown_heat_columns(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                                     std::vector<std::string>& names) {
+  std::vector<Eigen::VectorXd> heat;
+  for (std::size_t i = 0; i < system.source_shape.size(); ++i) {
+    if (spec.thermal.sources[i].window > 0) continue;  // moving: its pieces, not a shape
+    heat.push_back(system.source_shape[i]);
+    names.push_back("heat:" + spec.thermal.sources[i].name);
+  }
+  const auto& conv = spec.thermal.convection;
+  for (std::size_t c = 0; c < system.film_area.size(); ++c) {
+    const double area = system.film_area[c].dot(system.uniform);
+    if (!(area > 0)) continue;
+    heat.push_back(system.film_area[c] / area);
+    names.push_back("heat:" + spec.groups[conv[c].group].name);
+  }
+  Eigen::MatrixXd columns(system.states(), static_cast<Eigen::Index>(heat.size()));
+  for (std::size_t k = 0; k < heat.size(); ++k) columns.col(static_cast<Eigen::Index>(k)) = heat[k];
+  return columns;
+}
+
+}  // namespace
+
+std::vector<int> air_entries(const core::CaseSpec& spec) {
+  std::vector<int> out;
+  const auto& fixed = spec.mechanical.fixed_groups;
+  for (std::size_t c = 0; c < spec.thermal.convection.size(); ++c)
+    if (std::find(fixed.begin(), fixed.end(), spec.thermal.convection[c].group) == fixed.end())
+      out.push_back(static_cast<int>(c));
+  return out;
+}
+
+ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
+                                  const std::vector<std::string>& sensors,
+                                  const ObserverNoise& noise) {
+  const TwinOutputs& out = twin.outputs;
+  if (!out.tcp)
+    throw core::SolverError(
+        "observer: the reduced model has no TCP rows (mechanical.enabled and mechanical.tcp in "
+        "the case it was built from): there is no drift to predict");
+  ObserverSetup s;
+  s.sensor_rows.resize(static_cast<Eigen::Index>(sensors.size()), out.rows.cols());
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    const auto first = out.names.begin(), last = first + out.temperatures;
+    const auto it = std::find(first, last, sensors[k]);
+    if (it == last) {
+      std::string known;
+      for (auto n = first; n != last; ++n) known += (known.empty() ? "" : ", ") + *n;
+      throw core::SolverError("observer: sensor '" + sensors[k] +
+                              "' is not a named point of the reduced model; expected one of " +
+                              known);
+    }
+    s.sensor_rows.row(static_cast<Eigen::Index>(k)) = out.rows.row(it - first);
+  }
+  const Eigen::Index first = out.temperatures;
+  const Eigen::Index axis = static_cast<Eigen::Index>(out.names.size()) - first - 9;
+  s.target_rows.resize(3 + axis, out.rows.cols());
+  s.target_rows.topRows(3) = out.rows.middleRows(first, 3);
+  s.target_names = {"dx", "dy", "dz"};
+  if (axis > 0) {
+    s.target_rows.bottomRows(axis) = out.rows.bottomRows(axis);
+    for (Eigen::Index k = 0; k < axis; ++k)
+      s.target_names.push_back(out.names[static_cast<std::size_t>(first + 9 + k)]);
+  }
+  s.air_entries = air_entries(spec);
+  s.noise = noise;
+  return s;
+}
+
+double chi_square_quantile(double p, double k) {
+  if (!(k > 0) || !(p > 0 && p < 1))
+    throw core::SolverError("chi-square quantile p = " + number(p) + ", k = " + number(k) +
+                            ": expected 0 < p < 1 and k > 0");
+  const double z = normal_quantile(p), a = 2.0 / (9.0 * k);
+  const double c = 1 - a + z * std::sqrt(a);
+  return k * std::max(0.0, c * c * c);
+}
+
+bool InnovationMonitor::add(double t, double nis, int dof) {
+  if (dof <= 0) return alarm_;  // nothing read: the window is unchanged
+  t_.push_back(t);
+  nis_.push_back(nis);
+  dof_.push_back(dof);
+  sum_ += nis;
+  dof_sum_ += dof;
+  while (first_ < t_.size() && t_[first_] <= t - o_.window_s) {
+    sum_ -= nis_[first_];
+    dof_sum_ -= dof_[first_];
+    ++first_;
+  }
+  // A window is judged once it is full: a few samples of a fresh start say little.
+  const bool full = t - t_.front() >= o_.window_s;
+  bound_ = chi_square_quantile(o_.probability, dof_sum_);
+  if (full && sum_ > bound_) {
+    if (std::isnan(exceed_start_)) exceed_start_ = t;
+    if (!alarm_ && t - exceed_start_ >= o_.sustain_s) {
+      alarm_ = true;
+      alarm_start_ = change_start();
+    }
+  } else {
+    exceed_start_ = std::numeric_limits<double>::quiet_NaN();
+  }
+  return alarm_;
+}
+
+double InnovationMonitor::change_start() const {
+  // The change point of a shift in the NIS's mean: where the cumulative excess over its
+  // expectation, sum (NIS - dof), is lowest; the change starts at the next sample.
+  double sum = 0, lowest = 0;
+  std::size_t after = 0;
+  for (std::size_t k = 0; k < t_.size(); ++k) {
+    sum += nis_[k] - dof_[k];
+    if (sum <= lowest) {  // the latest of equal lows: a flat stretch is before the change
+      lowest = sum;
+      after = k + 1;
+    }
+  }
+  return t_[std::min(after, t_.size() - 1)];
+}
+
+KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                               const ObserverSetup& setup)
+    : sys_(system),
+      spec_(spec),
+      setup_(setup),
+      stepper_(system, spec),
+      monitor_(setup.consistency) {
+  r_ = system.states();
+  const auto fail = [](const std::string& what) { throw core::SolverError("observer: " + what); };
+  if (setup_.sensor_rows.cols() != r_ || setup_.target_rows.cols() != r_)
+    fail("the sensor and target rows have " + std::to_string(setup_.sensor_rows.cols()) + " and " +
+         std::to_string(setup_.target_rows.cols()) + " columns, the reduced model " +
+         std::to_string(r_) + " states: rows of another model");
+  if (static_cast<std::size_t>(setup_.target_rows.rows()) != setup_.target_names.size())
+    fail(std::to_string(setup_.target_rows.rows()) + " target rows for " +
+         std::to_string(setup_.target_names.size()) + " names");
+  const auto& sigma = setup_.noise.sensor_sigma_k;
+  if (sigma.size() != setup_.sensor_rows.rows() || !(sigma.array() > 0).all() || !sigma.allFinite())
+    fail("sensor noise: " + std::to_string(sigma.size()) + " values for " +
+         std::to_string(setup_.sensor_rows.rows()) +
+         " sensors; expected one finite sigma > 0 K each");
+  const ObserverNoise& n = setup_.noise;
+  for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
+                   n.drift_relative_sigma})
+    if (!(v >= 0) || !std::isfinite(v))
+      fail("process noise " + number(v) + ": expected a finite value >= 0");
+  const auto& conv = spec.thermal.convection;
+  for (int c : setup_.air_entries)
+    if (c < 0 || c >= static_cast<int>(conv.size()) ||
+        static_cast<std::size_t>(c) >= system.film_area.size())
+      fail("air entry " + std::to_string(c) + " is not a convection entry (the case has " +
+           std::to_string(conv.size()) + ")");
+
+  heat_columns_ = unknown_heat_columns(system, spec, bias_names_);
+  const bool air = !setup_.air_entries.empty();
+  if (air) bias_names_.push_back("air");
+  nb_ = static_cast<Eigen::Index>(bias_names_.size());
+  bias_walk_.resize(nb_);
+  const Eigen::Index nh = heat_columns_.cols();
+  bias_walk_.head(nh).setConstant(n.heat_walk_w * n.heat_walk_w / 3600.0);
+  if (air) bias_walk_(nh) = n.air_walk_k * n.air_walk_k / 3600.0;
+
+  const double t0_k = std::isnan(setup_.initial_temperature_k)
+                          ? spec.thermal.initial_temperature_c + core::kCelsiusOffset
+                          : setup_.initial_temperature_k;
+  z0_ = t0_k * system.uniform;
+  x_ = Eigen::VectorXd::Zero(r_ + nb_);
+  x_.head(r_) = z0_;
+  p_ = Eigen::MatrixXd::Zero(r_ + nb_, r_ + nb_);
+  for (Eigen::Index k = 0; k < nh; ++k) p_(r_ + k, r_ + k) = n.heat_initial_w * n.heat_initial_w;
+  if (air) p_(r_ + nh, r_ + nh) = n.air_initial_k * n.air_initial_k;
+}
+
+void KalmanObserver::step(double t1) {
+  const AffineStep a = stepper_.step(t_, t1, prev_speed_, x_.head(r_));
+  const double dt = t1 - t_;
+  // Unknown inputs' columns over this step: the air's follows the step's film coefficients.
+  Eigen::MatrixXd b(r_, nb_);
+  const Eigen::Index nh = heat_columns_.cols();
+  b.leftCols(nh) = heat_columns_;
+  if (nb_ > nh) {
+    Eigen::VectorXd air = Eigen::VectorXd::Zero(r_);
+    for (int c : setup_.air_entries) air += a.film[static_cast<std::size_t>(c)] * sys_.film_area[c];
+    b.col(nh) = air;
+  }
+  const Eigen::MatrixXd gamma = (*a.step_inverse).lazyProduct(dt * b);
+  const Eigen::MatrixXd& phi = *a.transition;
+  // x1 = F x0 + [u; 0], F = [[Phi, Gamma], [0, I]]; P1 = F P0 F^T + Q, by blocks.
+  Eigen::VectorXd z = phi * x_.head(r_) + a.input + gamma * x_.tail(nb_);
+  const Eigen::MatrixXd pzz = p_.topLeftCorner(r_, r_), pzb = p_.topRightCorner(r_, nb_),
+                        pbb = p_.bottomRightCorner(nb_, nb_);
+  // Coefficient-wise products: matrices of ~100 rows do not pay for Eigen's OpenMP-parallel GEMM,
+  // whose threads wait on each other every step when the cores are shared (as in the stepper).
+  const Eigen::MatrixXd left = phi.lazyProduct(pzz) + gamma.lazyProduct(pzb.transpose());  // r x r
+  const Eigen::MatrixXd cross = phi.lazyProduct(pzb) + gamma.lazyProduct(pbb);             // r x nb
+  Eigen::MatrixXd zz = left.lazyProduct(phi.transpose()) + cross.lazyProduct(gamma.transpose());
+  const double walk = setup_.noise.state_walk_k;
+  if (walk > 0) zz.diagonal().array() += walk * walk / 3600.0 * dt;
+  p_.topLeftCorner(r_, r_) = 0.5 * (zz + zz.transpose());
+  p_.topRightCorner(r_, nb_) = cross;
+  p_.bottomLeftCorner(nb_, r_) = cross.transpose();
+  p_.bottomRightCorner(nb_, nb_).diagonal() += bias_walk_ * dt;
+  x_.head(r_) = std::move(z);
+  t_ = t1;
+  prev_speed_ = a.speed;
+}
+
+void KalmanObserver::advance_to(double t) {
+  const auto& grid = stepper_.grid();
+  const double end = spec_.duty_cycle.end, eps = 1e-9 * std::max(1.0, end);
+  if (t < t_ - eps)
+    throw core::SolverError("observer: a reading at t = " + number(t) +
+                            " s comes after one at t = " + number(t_) +
+                            " s; expected increasing times");
+  if (t > end + eps)
+    throw core::SolverError("observer: a reading at t = " + number(t) +
+                            " s is beyond the duty cycle's end (" + number(end) +
+                            " s): the inputs are not known there");
+  while (t_ < t - eps) {
+    while (next_grid_ < grid.size() && grid[next_grid_] <= t_ + eps) ++next_grid_;
+    const double g = next_grid_ < grid.size() ? grid[next_grid_] : end;
+    step(std::min(g, t));
+  }
+}
+
+ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& readings) {
+  const Eigen::Index m = setup_.sensor_rows.rows();
+  if (readings.size() != m)
+    throw core::SolverError("observer: " + std::to_string(readings.size()) + " readings for " +
+                            std::to_string(m) + " sensors");
+  advance_to(t);
+  ObserverEstimate e;
+  e.time = t;
+  e.innovation = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::quiet_NaN());
+  std::vector<Eigen::Index> used;
+  for (Eigen::Index k = 0; k < m; ++k)
+    if (std::isfinite(readings(k))) used.push_back(k);
+  const auto nu = static_cast<Eigen::Index>(used.size());
+  if (nu > 0) {
+    Eigen::MatrixXd h(nu, r_);
+    Eigen::VectorXd y(nu), r2(nu);
+    for (Eigen::Index i = 0; i < nu; ++i) {
+      h.row(i) = setup_.sensor_rows.row(used[i]);
+      y(i) = readings(used[i]);
+      r2(i) = setup_.noise.sensor_sigma_k(used[i]) * setup_.noise.sensor_sigma_k(used[i]);
+    }
+    const Eigen::VectorXd innovation = y - h * x_.head(r_);
+    const Eigen::MatrixXd pht = p_.leftCols(r_).lazyProduct(h.transpose());  // (r + nb) x nu
+    Eigen::MatrixXd s = h.lazyProduct(pht.topRows(r_));
+    s.diagonal() += r2;
+    const Eigen::LLT<Eigen::MatrixXd> llt(s);
+    if (llt.info() != Eigen::Success)
+      throw core::SolverError("observer: the innovation covariance at t = " + number(t) +
+                              " s is not positive definite");
+    const Eigen::MatrixXd gain = llt.solve(pht.transpose()).transpose();  // (r + nb) x nu
+    x_ += gain * innovation;
+    p_ -= gain.lazyProduct(pht.transpose());
+    p_ = 0.5 * (p_ + p_.transpose()).eval();
+    e.nis = innovation.dot(llt.solve(innovation));
+    e.dof = static_cast<int>(nu);
+    for (Eigen::Index i = 0; i < nu; ++i) e.innovation(used[i]) = innovation(i);
+  }
+  const Eigen::MatrixXd& l = setup_.target_rows;
+  e.drift = l * (x_.head(r_) - z0_);
+  const double rel = setup_.noise.drift_relative_sigma;
+  e.drift_sigma = ((l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
+                       .diagonal()
+                       .cwiseMax(0.0)
+                       .array() +
+                   (rel * e.drift.array()).square())
+                      .sqrt()
+                      .matrix();
+  e.recalibrate = monitor_.add(t, e.nis, e.dof);
+  e.recalibrate_since_s = monitor_.since_s();
+  return e;
+}
+
+ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                    const ObserverSetup& setup, const Eigen::VectorXd& times,
+                    const Eigen::MatrixXd& readings) {
+  if (readings.rows() != times.size())
+    throw core::SolverError("observer: " + std::to_string(readings.rows()) +
+                            " rows of readings for " + std::to_string(times.size()) + " times");
+  KalmanObserver kf(system, spec, setup);
+  const Eigen::Index n = times.size(), nt = setup.target_rows.rows();
+  const Eigen::Index nb = static_cast<Eigen::Index>(kf.unknown_inputs().size());
+  ObserverRun run;
+  run.times = times;
+  run.drift.resize(n, nt);
+  run.drift_sigma.resize(n, nt);
+  run.innovation.resize(n, readings.cols());
+  run.nis.resize(n);
+  run.window_nis.resize(n);
+  run.window_bound.resize(n);
+  run.dof.resize(n);
+  run.states.resize(kf.states(), n);
+  run.unknown_inputs.resize(n, nb);
+  run.unknown_inputs_sigma.resize(n, nb);
+  run.unknown_input_names = kf.unknown_inputs();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const ObserverEstimate e = kf.assimilate(times(i), readings.row(i).transpose());
+    run.drift.row(i) = e.drift.transpose();
+    run.drift_sigma.row(i) = e.drift_sigma.transpose();
+    run.innovation.row(i) = e.innovation.transpose();
+    run.nis(i) = e.nis;
+    run.dof(i) = e.dof;
+    run.window_nis(i) = kf.monitor().window_nis();
+    run.window_bound(i) = kf.monitor().window_bound();
+    const Eigen::Index r = kf.states();
+    run.states.col(i) = kf.state().head(r);
+    run.unknown_inputs.row(i) = kf.state().tail(nb).transpose();
+    run.unknown_inputs_sigma.row(i) =
+        kf.covariance().bottomRightCorner(nb, nb).diagonal().cwiseMax(0.0).cwiseSqrt().transpose();
+    if (e.recalibrate && !run.recalibrate) {
+      run.recalibrate = true;
+      run.recalibrate_since_s = e.recalibrate_since_s;
+      run.recalibrate_at_s = e.time;
+    }
+  }
+  return run;
+}
+
+}  // namespace tt::solvers

@@ -1,0 +1,182 @@
+// A physics observer beside the machine: a Kalman filter on the reduced-order twin's states that
+// takes the duty cycle's inputs (the case's loads, stepped by the twin's own stepper) and the
+// placed sensors' readings together, and predicts the thermal drift at the tool (and the axis
+// points) with its standard deviation. Its innovations (readings minus predicted readings) are
+// tested for consistency with the noise model: a sustained inconsistency says the machine is no
+// longer the model (recalibrate). docs/observer.md gives the model, its noise and the figures.
+//
+// State: x = [z; b], z the reduced thermal state (T = V z), b unknown inputs the case does not
+// declare, each a random walk: one heat input per fixed heat source (power added to its shape)
+// and per convection entry (spread over its surface, by area), and one air-temperature offset of
+// the sinks of the chosen convection entries. One step of the case's grid:
+//   z1 = Phi z0 + u + Gamma b0,  b1 = b0 + w,  w ~ N(0, diag(q) dt),
+// Phi and u the stepper's affine map (ReducedStepper), Gamma = (C + theta dt A)^{-1} dt B(h) with
+// B the unknown inputs' columns (the air's column is sum_c h_c(speed) a_c: it follows the film).
+// Readings y = H z + v, H the sensors' rows on the reduced state, v ~ N(0, diag(sigma^2)).
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "solvers/thermal_stepper.hpp"
+#include "solvers/thermal_system.hpp"
+#include "solvers/twin.hpp"
+
+namespace tt::solvers {
+
+/// What the observer does not know, and how sure it is of the rest.
+struct ObserverNoise {
+  /// Per sensor: standard deviation of a reading's white noise [K] (#sensors).
+  Eigen::VectorXd sensor_sigma_k;
+  /// Random walk of each unknown heat input [W per sqrt(h)], and its spread at t = 0 [W].
+  double heat_walk_w = 4.0, heat_initial_w = 2.0;
+  /// Random walk of the air-temperature offset [K per sqrt(h)], and its spread at t = 0 [K].
+  double air_walk_k = 0.5, air_initial_k = 0.3;
+  /// White process noise on every reduced state [K per sqrt(h)] in the capacity norm: model-form
+  /// error that no input explains (0: none).
+  double state_walk_k = 0;
+  /// Error of the drift rows themselves (the elastic model's discretisation, its material
+  /// values), relative to the predicted drift [-]: added to the drift's variance as (e d)^2.
+  double drift_relative_sigma = 0;
+};
+
+/// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
+/// chi-square with #readings degrees of freedom when the model holds) summed over a sliding
+/// window is compared with the chi-square quantile `probability` of the window's degrees of
+/// freedom; an exceedance held for `sustain_s` raises `recalibrate`, dated from the change point
+/// of the NIS's mean before it (InnovationMonitor::since_s).
+struct ConsistencyOptions {
+  double window_s = 1800;
+  double probability = 0.999;
+  double sustain_s = 900;
+};
+
+/// The observer's set-up on a reduced system.
+struct ObserverSetup {
+  Eigen::MatrixXd sensor_rows;            /// #sensors x r: reading [K] = row z
+  Eigen::MatrixXd target_rows;            /// #targets x r: drift [m] = row (z - z(0))
+  std::vector<std::string> target_names;  /// e.g. "dx", "dy", "dz", "<axis point>_dx"
+  std::vector<int> air_entries;           /// convection entries whose sink the air offset moves
+  double initial_temperature_k = std::numeric_limits<double>::quiet_NaN();  /// NaN: the case's
+  ObserverNoise noise;
+  ConsistencyOptions consistency;
+};
+
+/// The set-up on a twin: the named points `sensors` (ids) read with `noise`, the TCP's drift
+/// (dx, dy, dz) and every axis point's as targets, the air offset on air_entries(spec). Throws
+/// SolverError naming an id that is not a named point of the twin, or a twin without TCP rows.
+ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
+                                  const std::vector<std::string>& sensors,
+                                  const ObserverNoise& noise);
+
+/// Convection entries of `spec` that are not on a mechanically fixed group (the shop's air; the
+/// bed contact's sink is the foundation): the calibration generator's air acts on these.
+std::vector<int> air_entries(const core::CaseSpec& spec);
+
+/// Quantile p of the chi-square distribution with k > 0 degrees of freedom (Wilson–Hilferty;
+/// relative error below 1 % for k >= 3 at p <= 0.999).
+double chi_square_quantile(double p, double k);
+
+/// The sliding-window test of ConsistencyOptions, fed one assimilation at a time.
+class InnovationMonitor {
+ public:
+  explicit InnovationMonitor(const ConsistencyOptions& options) : o_(options) {}
+  /// Adds the NIS of an assimilation at time t with `dof` readings; returns whether the status is
+  /// now (and stays) `recalibrate`.
+  bool add(double t, double nis, int dof);
+  double window_nis() const { return sum_; }      /// NIS summed over the window
+  double window_bound() const { return bound_; }  /// its chi-square bound
+  bool exceeded() const { return sum_ > bound_; }
+  bool recalibrate() const { return alarm_; }
+  /// When the inconsistency started [s]: the change point of the NIS's mean before the alarm,
+  /// the sample after the lowest point of the cumulative sum of NIS - dof (a CUSUM).
+  double since_s() const { return alarm_start_; }
+
+ private:
+  double change_start() const;
+  ConsistencyOptions o_;
+  std::vector<double> t_, nis_;
+  std::vector<int> dof_;
+  std::size_t first_ = 0;
+  double sum_ = 0, bound_ = std::numeric_limits<double>::infinity();
+  int dof_sum_ = 0;
+  double exceed_start_ = std::numeric_limits<double>::quiet_NaN();
+  double alarm_start_ = std::numeric_limits<double>::quiet_NaN();
+  bool alarm_ = false;
+};
+
+/// What the observer says after one assimilation.
+struct ObserverEstimate {
+  double time = 0;              /// [s]
+  Eigen::VectorXd drift;        /// #targets [m], relative to t = 0
+  Eigen::VectorXd drift_sigma;  /// #targets standard deviation [m]
+  Eigen::VectorXd innovation;   /// #sensors reading minus prediction [K], NaN where missing
+  double nis = 0;               /// normalised innovation squared
+  int dof = 0;                  /// readings used
+  bool recalibrate = false;
+  double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The filter. Steps the case's grid (the case's duty cycle, feed axis, sinks and fluxes are its
+/// inputs) and assimilates readings as they come.
+class KalmanObserver {
+ public:
+  /// `system` and `spec` must outlive the observer. Throws SolverError when the rows do not have r
+  /// columns, the sensors' sigmas are not one positive value per sensor, or an air entry is not a
+  /// convection entry of `spec`.
+  KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                 const ObserverSetup& setup);
+  /// Steps to time t (a time not on the grid cuts a step there) and assimilates `readings`
+  /// (#sensors [K], NaN: missing). Throws SolverError for t before the last assimilation or
+  /// beyond the duty cycle's end, or readings of another size.
+  ObserverEstimate assimilate(double t, const Eigen::VectorXd& readings);
+
+  const Eigen::VectorXd& state() const { return x_; }  /// [z; b]
+  const Eigen::MatrixXd& covariance() const { return p_; }
+  const std::vector<std::string>& unknown_inputs() const { return bias_names_; }
+  Eigen::Index states() const { return r_; }
+  const InnovationMonitor& monitor() const { return monitor_; }
+
+ private:
+  void advance_to(double t);
+  void step(double t1);
+
+  const ReducedThermalSystem& sys_;
+  const core::CaseSpec& spec_;
+  ObserverSetup setup_;
+  ReducedStepper stepper_;
+  Eigen::Index r_ = 0, nb_ = 0;
+  Eigen::MatrixXd heat_columns_;         /// r x #heat biases [state per W]
+  std::vector<std::string> bias_names_;  /// heat:<source>, heat:<group>, air
+  Eigen::VectorXd bias_walk_;            /// per bias: variance per second
+  Eigen::VectorXd x_, z0_;
+  Eigen::MatrixXd p_;
+  double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
+  std::size_t next_grid_ = 0;
+  InnovationMonitor monitor_;
+};
+
+/// A whole run through the observer: one assimilation per sample.
+struct ObserverRun {
+  Eigen::VectorXd times;                          /// #samples [s]
+  Eigen::MatrixXd drift, drift_sigma;             /// #samples x #targets [m]
+  Eigen::MatrixXd innovation;                     /// #samples x #sensors [K]
+  Eigen::VectorXd nis, window_nis, window_bound;  /// #samples
+  Eigen::VectorXi dof;                            /// #samples
+  Eigen::MatrixXd states;                         /// r x #samples: the estimated reduced states
+  Eigen::MatrixXd unknown_inputs, unknown_inputs_sigma;  /// #samples x #biases
+  std::vector<std::string> unknown_input_names;
+  bool recalibrate = false;
+  double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// change point
+  double recalibrate_at_s = std::numeric_limits<double>::quiet_NaN();     /// when it was raised
+};
+
+/// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle).
+ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                    const ObserverSetup& setup, const Eigen::VectorXd& times,
+                    const Eigen::MatrixXd& readings);
+
+}  // namespace tt::solvers

@@ -1,0 +1,90 @@
+// `thermotwin observe` on the coarse SB-1: a reduced model from `reduce`, a 3-hour run from the
+// calibration generator (the case's own mesh and step) with an offset of 0.6 K on one sensor,
+// written in the measured-data format. The observer writes its CSV and JSON, raises
+// `recalibrate` with its start, and refuses a sensor the model does not name, writing nothing.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "calibration/generator.hpp"
+#include "core/rng.hpp"
+#include "io/case_reader.hpp"
+#include "io/measured_data.hpp"
+#include "mesh/mesher.hpp"
+#include "tests/reliability/process.hpp"
+
+namespace tt::observe_cli_test {
+namespace {
+
+namespace fs = std::filesystem;
+namespace rt = reliability_test;
+
+TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
+  const fs::path dir = rt::scratch("observe");
+  const fs::path rom = dir / "rom", data = dir / "run", out = dir / "out";
+  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
+                     "--quick-validation", "--quiet"},
+                    {}, dir / "reduce.log"),
+            0)
+      << rt::read_text(dir / "reduce.log");
+  // 1. A generated run with a sensor offset.
+  const core::CaseSpec spec = io::read_case(rt::kCoarseCase);
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  calibration::GeneratorOptions g;
+  g.mesh_scale = 1;
+  g.step_s = spec.thermal.step;
+  calibration::Instrumentation inst;
+  inst.sensor_points = {"T02", "T08", "T11", "T14", "T17", "T25", "T33", "T44", "T52"};
+  std::mt19937_64 rng = core::generator(5, 0);
+  calibration::InjectedEffect e;
+  e.present = true;
+  e.kind = calibration::EffectKind::sensor_offset;
+  e.target = "T11";
+  e.magnitude = 0.6;
+  const core::DutyCycle duty = calibration::random_duty_cycle(3, rng);
+  const auto gen = calibration::generator_case(spec, g);
+  io::write_measured_run(
+      data, calibration::synthetic_run(mesh, calibration::truth_case(gen, e, duty, 0), e, inst, g,
+                                       "offset", rng));
+  // 2. The observer.
+  const fs::path log = dir / "observe.log";
+  ASSERT_EQ(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
+                     data.string(), "--out", out.string(), "--sensor-sigma-k", "0.04", "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const std::string csv = rt::read_text(out / "observer.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "time_s,dx_predicted_um,dx_sigma_um,dy_predicted_um,dy_sigma_um,dz_predicted_um,"
+            "dz_sigma_um,nis,readings,window_nis,window_bound,status");
+  EXPECT_NE(csv.find(",recalibrate\n"), std::string::npos);
+  const auto j = nlohmann::json::parse(std::ifstream(out / "observer.json"));
+  EXPECT_EQ(j["status"], "recalibrate");
+  EXPECT_EQ(j["sensors"].size(), 9u);
+  EXPECT_LE(j["recalibrate_since_s"].get<double>(), 900.0);  // the offset is there from t = 0
+  EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
+  EXPECT_TRUE(j["unknown_inputs"].contains("air"));
+  // 3. A sensor the model does not name: refused, naming it; nothing written.
+  const fs::path bad = dir / "bad", bad_log = dir / "bad.log";
+  EXPECT_NE(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
+                     data.string(), "--out", bad.string(), "--sensors", "T02,NOPE", "--quiet"},
+                    {}, bad_log),
+            0);
+  EXPECT_NE(rt::read_text(bad_log).find("NOPE"), std::string::npos) << rt::read_text(bad_log);
+  EXPECT_FALSE(fs::exists(bad));
+  // Sigmas: one for all or one per sensor; two for nine sensors is refused.
+  EXPECT_NE(
+      rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data", data.string(),
+               "--out", bad.string(), "--sensor-sigma-k", "0.04,0.05", "--quiet"},
+              {}, bad_log),
+      0);
+  EXPECT_NE(rt::read_text(bad_log).find("--sensor-sigma-k: 2 values for 9 sensors"),
+            std::string::npos)
+      << rt::read_text(bad_log);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+}  // namespace
+}  // namespace tt::observe_cli_test

@@ -1,0 +1,219 @@
+// The physics observer on the coarse SB-1 twin (cases/sb1_coarse.toml), against runs made by the
+// calibration generator on the case's own mesh and step (so that a clean run is the declared
+// model up to the reduction's 1e-4 K): the filter without noise reproduces the reduced model; on
+// a clean noisy run the true TCP drift lies within ±2σ near 95 % of the time; the innovation test
+// raises `recalibrate` on a run with an undeclared heat input and stays quiet on a clean run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "calibration/generator.hpp"
+#include "core/rng.hpp"
+#include "core/units.hpp"
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/loads.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/twin.hpp"
+
+namespace tt::observer_test {
+namespace {
+
+const std::vector<std::string> kSensors{"T02", "T08", "T11", "T14", "T17",
+                                        "T25", "T33", "T44", "T52"};
+
+struct Study {
+  core::CaseSpec spec;
+  mesh::TetMesh mesh;
+  solvers::Twin twin;
+  core::DutyCycle duty;
+  io::MeasuredRun clean_truth;  /// a generated run without effect, without noise
+  io::MeasuredRun clean, heat;  /// noisy generated runs: no effect, an undeclared heat input
+};
+
+/// A 4-hour duty cycle of the generator's kind (segments at 0 .. 4000 rpm).
+core::DutyCycle duty_cycle(std::uint64_t seed) {
+  std::mt19937_64 rng = core::generator(seed, 0);
+  return calibration::random_duty_cycle(4.0, rng);
+}
+
+class Observer : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    s_ = new Study;
+    s_->spec = io::read_case(std::string(TT_SOURCE_DIR) + "/cases/sb1_coarse.toml");
+    s_->mesh = mesh::mesh_case(s_->spec);
+    s_->twin = solvers::case_twin(s_->mesh, s_->spec);
+    s_->duty = duty_cycle(7);
+    calibration::GeneratorOptions g;
+    g.mesh_scale = 1;  // the case's own mesh and step: a clean run is the declared model
+    g.step_s = s_->spec.thermal.step;
+    const core::CaseSpec gen = calibration::generator_case(s_->spec, g);
+    calibration::Instrumentation inst;
+    inst.sensor_points = kSensors;
+    std::mt19937_64 rng = core::generator(11, 0);
+    const calibration::InjectedEffect none;
+    s_->clean_truth = calibration::clean_run(
+        s_->mesh, calibration::truth_case(gen, none, s_->duty, 0), none, inst, g, "clean");
+    s_->clean = calibration::with_noise(s_->clean_truth, g, rng);
+    calibration::InjectedEffect heat = calibration::random_effect(
+        calibration::EffectKind::heat_input, s_->spec, s_->mesh, kSensors, rng);
+    heat.magnitude = 15;  // W, constant from t = 0: within the generator's range (4 .. 25 W)
+    heat.follows_speed = false;
+    s_->heat = calibration::synthetic_run(s_->mesh, calibration::truth_case(gen, heat, s_->duty, 1),
+                                          heat, inst, g, "heat", rng);
+  }
+  static void TearDownTestSuite() { delete s_; }
+
+  static core::CaseSpec run_spec() {
+    core::CaseSpec c = s_->spec;
+    c.duty_cycle = s_->duty;
+    return c;
+  }
+  static solvers::ObserverSetup setup(const solvers::ObserverNoise& noise) {
+    return solvers::twin_observer_setup(s_->twin, s_->spec, kSensors, noise);
+  }
+  static solvers::ObserverNoise default_noise() {
+    solvers::ObserverNoise n;
+    // The generator's sensors: 0.03 K white, 0.01 K drifting, 0.01 K steps.
+    n.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(kSensors.size()), 0.04);
+    return n;
+  }
+  static Study* s_;
+};
+Study* Observer::s_ = nullptr;
+
+TEST_F(Observer, WithoutNoiseItIsTheReducedModel) {
+  // No process noise and a sure start: the gain is zero and the filter is the twin's run, under
+  // either scheme (Crank–Nicolson's transition (C + dt/2 A)^-1 (C - dt/2 A) and its restarts).
+  solvers::ObserverNoise n = default_noise();
+  n.heat_walk_w = n.heat_initial_w = n.air_walk_k = n.air_initial_k = 0;
+  for (const auto scheme : {core::TimeScheme::backward_euler, core::TimeScheme::crank_nicolson}) {
+    core::CaseSpec c = run_spec();
+    c.thermal.scheme = scheme;
+    const solvers::TwinRun twin = solvers::twin_run(s_->twin, c);
+    const auto nt = static_cast<Eigen::Index>(twin.times.size());
+    Eigen::VectorXd times(nt - 1);
+    for (Eigen::Index k = 1; k < nt; ++k) times(k - 1) = twin.times[static_cast<std::size_t>(k)];
+    // Readings far from the model: ignored by a zero gain.
+    const Eigen::MatrixXd readings =
+        Eigen::MatrixXd::Constant(nt - 1, static_cast<Eigen::Index>(kSensors.size()), 400.0);
+    const solvers::ObserverRun run =
+        solvers::observe(s_->twin.model.system, c, setup(n), times, readings);
+    const double scale = twin.states.cwiseAbs().maxCoeff();
+    EXPECT_LE((run.states - twin.states.rightCols(nt - 1)).cwiseAbs().maxCoeff(), 1e-11 * scale)
+        << "scheme " << static_cast<int>(scheme);
+    const Eigen::Index first = s_->twin.outputs.temperatures;
+    const Eigen::MatrixXd tcp = twin.outputs.middleCols(first, 3).bottomRows(nt - 1).rowwise() -
+                                twin.outputs.middleCols(first, 3).row(0);
+    EXPECT_LE((run.drift.leftCols(3) - tcp).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_GT(tcp.col(1).cwiseAbs().maxCoeff(), 1e-6);  // a drift of microns was compared
+    EXPECT_EQ(run.drift_sigma.maxCoeff(), 0.0);
+    if (scheme != core::TimeScheme::backward_euler) continue;
+    // Readings between the grid's steps cut a step there and land on the same trajectory.
+    Eigen::VectorXd off = times.array() - 5.0;
+    const solvers::ObserverRun cut =
+        solvers::observe(s_->twin.model.system, c, setup(n), off, readings);
+    EXPECT_LE((cut.drift - run.drift).cwiseAbs().maxCoeff(), 0.05 * tcp.cwiseAbs().maxCoeff());
+  }
+}
+
+/// Share of the samples (after the first) whose |estimate - truth| <= 2 sigma, per TCP direction.
+Eigen::Vector3d coverage(const solvers::ObserverRun& run, const io::MeasuredRun& truth) {
+  Eigen::Vector3d in = Eigen::Vector3d::Zero();
+  const Eigen::Index n = truth.time.size();
+  for (Eigen::Index i = 1; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      in(d) += std::abs(run.drift(i, d) - truth.displacement(i, d)) <= 2 * run.drift_sigma(i, d);
+  return in / static_cast<double>(n - 1);
+}
+
+TEST_F(Observer, TwoSigmaCoversTheTrueDriftOnACleanRun) {
+  const core::CaseSpec c = run_spec();
+  const solvers::ObserverRun run = solvers::observe(
+      s_->twin.model.system, c, setup(default_noise()), s_->clean.time, s_->clean.temperature);
+  const io::MeasuredRun& truth = s_->clean_truth;  // full order, no noise
+  const Eigen::Vector3d cov = coverage(run, truth);
+  std::cerr << "coverage dx " << cov(0) << " dy " << cov(1) << " dz " << cov(2) << "\n";
+  for (int d = 1; d < 3; ++d) {
+    EXPECT_GE(cov(d), 0.85) << "direction " << d;
+    EXPECT_LE(cov(d), 1.0) << "direction " << d;
+  }
+  // Sharp, not only wide: sigma is a few per cent of the drift's range, and the errors are of
+  // the size sigma says (an RMS error to mean sigma ratio near 1, not 0.1).
+  for (int d = 1; d < 3; ++d) {
+    const double range = truth.displacement.col(d).cwiseAbs().maxCoeff();
+    const double mean_sigma = run.drift_sigma.col(d).mean();
+    const double rms =
+        std::sqrt((run.drift.col(d) - truth.displacement.col(d)).squaredNorm() / run.drift.rows());
+    std::cerr << "d" << d << ": range " << range << " mean sigma " << mean_sigma << " rms " << rms
+              << "\n";
+    EXPECT_LE(mean_sigma, 0.1 * range) << "direction " << d;
+    EXPECT_GE(rms / mean_sigma, 0.2) << "direction " << d;
+  }
+  EXPECT_FALSE(run.recalibrate) << "clean run: alarm raised at " << run.recalibrate_at_s << " s";
+}
+
+TEST_F(Observer, RecalibrateOnAnUndeclaredHeatInputNotOnACleanRun) {
+  const core::CaseSpec c = run_spec();
+  const solvers::ObserverRun clean = solvers::observe(
+      s_->twin.model.system, c, setup(default_noise()), s_->clean.time, s_->clean.temperature);
+  const solvers::ObserverRun heat = solvers::observe(
+      s_->twin.model.system, c, setup(default_noise()), s_->heat.time, s_->heat.temperature);
+  std::cerr << "clean: max window NIS / bound "
+            << (clean.window_nis.array() / clean.window_bound.array()).maxCoeff()
+            << "; heat: alarm at " << heat.recalibrate_at_s << " s since "
+            << heat.recalibrate_since_s << " s\n";
+  EXPECT_FALSE(clean.recalibrate);
+  ASSERT_TRUE(heat.recalibrate);
+  EXPECT_LE(heat.recalibrate_at_s, 2 * 3600.0);
+  // The heat is there from t = 0: the change point is dated near the start, not at the alarm.
+  EXPECT_LE(heat.recalibrate_since_s, 900.0);
+}
+
+TEST_F(Observer, MissingReadingsAreLeftOutOfTheUpdate) {
+  // One sensor silent for the second half, every sensor missing at one sample: the update uses
+  // what is there (the readings' count says so) and the drift stays within its 2 sigma.
+  const core::CaseSpec c = run_spec();
+  Eigen::MatrixXd y = s_->clean.temperature;
+  const Eigen::Index n = y.rows(), half = n / 2;
+  y.col(2).tail(n - half).setConstant(std::numeric_limits<double>::quiet_NaN());
+  y.row(10).setConstant(std::numeric_limits<double>::quiet_NaN());
+  const solvers::ObserverRun run =
+      solvers::observe(s_->twin.model.system, c, setup(default_noise()), s_->clean.time, y);
+  const int m = static_cast<int>(kSensors.size());
+  EXPECT_EQ(run.dof(0), m);
+  EXPECT_EQ(run.dof(10), 0);
+  EXPECT_EQ(run.nis(10), 0.0);
+  EXPECT_EQ(run.dof(n - 1), m - 1);
+  EXPECT_TRUE(std::isnan(run.innovation(n - 1, 2)));
+  EXPECT_TRUE(run.drift.allFinite());
+  const Eigen::Vector3d cov = coverage(run, s_->clean_truth);
+  EXPECT_GE(cov(1), 0.85);
+  EXPECT_GE(cov(2), 0.85);
+  EXPECT_FALSE(run.recalibrate);
+}
+
+TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
+  // Tabulated quantiles: chi2(0.999; 10) = 29.59, chi2(0.999; 100) = 149.45, chi2(0.95; 30)
+  // = 43.77.
+  EXPECT_NEAR(solvers::chi_square_quantile(0.999, 10), 29.59, 0.3);
+  EXPECT_NEAR(solvers::chi_square_quantile(0.999, 100), 149.45, 0.5);
+  EXPECT_NEAR(solvers::chi_square_quantile(0.95, 30), 43.77, 0.2);
+  // NIS at its expectation never alarms; four times it, held past window and sustain, does.
+  solvers::ConsistencyOptions o;
+  o.window_s = 600;
+  o.sustain_s = 300;
+  solvers::InnovationMonitor quiet(o), loud(o);
+  for (int k = 0; k <= 120; ++k) {
+    EXPECT_FALSE(quiet.add(60.0 * k, 5.0, 5));
+    loud.add(60.0 * k, k < 30 ? 5.0 : 20.0, 5);
+  }
+  EXPECT_TRUE(loud.recalibrate());
+  EXPECT_NEAR(loud.since_s(), 1800.0, 60.0);  // the change point, not the window's end
+}
+
+}  // namespace
+}  // namespace tt::observer_test
