@@ -185,6 +185,7 @@ json model_json(const FittedModel& model) {
     const auto& o = network->options();
     const auto& r = network->report();
     j["inputs"] = fitting::feature_names(model.features);
+    j["output"] = model.output;  // of the network's outputs, the one this target reads
     j["window_steps"] = o.window_steps;
     j["window_stride_samples"] = o.window_stride;
     j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;

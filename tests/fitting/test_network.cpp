@@ -1,6 +1,7 @@
 // The CNN-BiGRU-attention model kind (seed 004) on a short synthetic campaign: it learns a lagged
 // response better than a constant, gives the same weights and predictions twice for one seed,
-// round-trips through its TorchScript file, and is tried only with its own sensor sets.
+// round-trips through its TorchScript file, and is tried only with its own sensor sets; one network
+// trained on two targets at once (the patent's every-output model) serves both.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -117,6 +118,47 @@ TEST_F(Network, TriedOnlyWithItsSensorMethod) {
   EXPECT_NE(s.candidates[1].failure.find("not tried"), std::string::npos);
   ASSERT_TRUE(s.candidates[3].model.has_value()) << s.candidates[3].failure;
   EXPECT_EQ(s.candidates[3].model->features.sensors, (std::vector<int>{0, 1, 3}));
+}
+
+TEST(NetworkOfEveryOutput, OneNetworkPredictsEachTargetAndBeatsAConstant) {
+  // Two targets with different lags: one network with an output per target.
+  auto groups = campaign(6, 91, lagged_truth, 0.1 * um, 4);
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    tt::fitting::test::add_target(
+        groups[i], "x",
+        [](const Group& g) -> Eigen::VectorXd {
+          return -2.0 * um * low_pass(g.time, increment(g, 1), 900.0).array();
+        },
+        0.1 * um, 2000, i);
+  const auto fit = group_subset(groups, {0, 1, 2, 3});
+  const auto models = fitted_network_models(small_network(), fit, {0, 1, 2, 3}, {1, 0});
+  ASSERT_EQ(models.size(), 2u);
+  EXPECT_EQ(models[0].target, 1);
+  EXPECT_EQ(models[0].output, 0);
+  EXPECT_EQ(models[1].target, 0);
+  EXPECT_EQ(models[1].output, 1);
+  const auto& a = std::get<tt::torchnet::Network>(models[0].body);
+  const auto& b = std::get<tt::torchnet::Network>(models[1].body);
+  EXPECT_EQ(a.outputs(), 2);
+  EXPECT_EQ(a.flat_weights(), b.flat_weights());  // one training, shared
+  const Group& g = groups[5];
+  const Eigen::MatrixXd both = a.prediction(feature_matrix(models[0].features, g));
+  EXPECT_EQ(predicted_error(models[0], g), Eigen::VectorXd(both.col(0)));
+  EXPECT_EQ(predicted_error(models[1], g), Eigen::VectorXd(both.col(1)));
+  const auto held_out = group_subset(groups, {4, 5});
+  for (const auto& m : models) {
+    std::vector<double> s;
+    for (const Group& h : held_out) {
+      const Eigen::VectorXd e = h.error.col(m.target);
+      s.push_back(residual_std((e.array() - e.mean()).matrix()));
+    }
+    EXPECT_LT(model_accuracy(m, held_out).sm, 0.5 * accuracy(s).sm) << m.target_name;
+  }
+  // The same seed gives the same network.
+  const auto again = fitted_network_models(small_network(), fit, {0, 1, 2, 3}, {1, 0});
+  EXPECT_EQ(std::get<tt::torchnet::Network>(again[0].body).flat_weights(), a.flat_weights());
+  EXPECT_THROW(fitted_network_models(small_network(), fit, {0, 1}, {0, 0}), tt::core::DataError);
+  EXPECT_THROW(fitted_network_models(ModelSpec{}, fit, {0, 1}, {0, 1}), tt::core::DataError);
 }
 
 TEST(NetworkOptions, BadSettingsNameTheKey) {
