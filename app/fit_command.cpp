@@ -112,14 +112,6 @@ std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p,
   return sets;
 }
 
-/// The specs without the network (the axis points' linear models; the network is trained once
-/// for every output).
-std::vector<fitting::ModelSpec> specs_without_network(std::vector<fitting::ModelSpec> specs) {
-  std::erase_if(specs,
-                [](const auto& s) { return s.kind == fitting::ModelKind::cnn_bigru_attention; });
-  return specs;
-}
-
 /// The sensors of several sets, each once, in the order first met.
 std::vector<int> sensor_union(const std::vector<fitting::SensorSet>& sets) {
   std::vector<int> out;
@@ -157,10 +149,9 @@ int fit_command(const FitArgs& args) {
   const placement::PlacementResult placed =
       placement_on(groups, split.fitting, first.positions, tcp_targets, spec.seed);
   // 4. Per target: choose model, settings and placement method on validation; test; count sensors.
-  std::vector<fitting::ModelSpec> specs =
+  const std::vector<fitting::ModelSpec> specs =
       args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
                  : fitting::default_model_candidates();
-  if (args.network) specs.push_back(driver_network_spec(spec.seed));
   std::map<std::string, NetworkFigures> networks;
   std::vector<fitting::Evaluation> evals;
   std::vector<fitting::SensorCountTable> tables;
@@ -185,6 +176,17 @@ int fit_command(const FitArgs& args) {
       network_inputs.insert(network_inputs.end(), grey.begin(), grey.end());
     }
     evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
+    if (args.network) {
+      // The network on the grey relational sensors and on the chosen linear model's, chosen on
+      // validation beside the linear models.
+      const fitting::Candidate linear_inputs = linear_inputs_network(evals.back().model, spec.seed);
+      at_most_4.push_back(linear_inputs.sensor_set);
+      network_inputs.push_back(linear_inputs.sensor_set);
+      std::vector<fitting::ModelSpec> with_network = specs;
+      with_network.push_back(driver_network_spec(spec.seed));
+      with_network.push_back(linear_inputs.spec);
+      evals.back() = fitting::evaluation(groups, split, target, at_most_4, with_network);
+    }
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
     const auto corr6 = standard_sets(6);
     all.insert(all.end(), corr6.begin(), corr6.end());
@@ -222,8 +224,8 @@ int fit_command(const FitArgs& args) {
   if (!spec.mechanical.axis_points.empty()) {
     std::optional<fitting::ModelSpec> network;
     if (args.network && !network_inputs.empty()) network = driver_network_spec(spec.seed);
-    axis = axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs_without_network(specs),
-                    network, sensor_union(network_inputs));
+    axis = axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs, network,
+                    sensor_union(network_inputs));
   }
   // 6. Outputs, all or nothing.
   const auto& dir = out.path();

@@ -143,8 +143,10 @@ std::string model_label(const ModelSpec& spec) {
     case ModelKind::cnn_bigru_attention:
       out << "(window=" << spec.network.options.window_steps << "x" << spec.network.window_span_s
           << "s,conv=" << spec.network.options.conv_channels
-          << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden
-          << ",seed=" << spec.network.options.seed << ")";
+          << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden;
+      if (spec.network.options.weight_decay > 0.0)
+        out << ",wd=" << spec.network.options.weight_decay;
+      out << ",seed=" << spec.network.options.seed << ")";
       break;
   }
   if (spec.use_inputs && spec.kind != ModelKind::no_compensation) out << "+inputs";

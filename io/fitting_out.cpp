@@ -75,6 +75,7 @@ json settings_json(const fitting::ModelSpec& spec) {
       s["patience"] = o.patience;
       s["batch_size"] = o.batch_size;
       s["learning_rate"] = o.learning_rate;
+      s["weight_decay"] = o.weight_decay;
       s["time_budget_s"] = o.time_budget_s;
       s["seed"] = o.seed;
       s["threads"] = o.threads;

@@ -4,6 +4,7 @@
 // trained on two targets at once (the patent's every-output model) serves both.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "core/errors.hpp"
@@ -161,6 +162,23 @@ TEST(NetworkOfEveryOutput, OneNetworkPredictsEachTargetAndBeatsAConstant) {
   EXPECT_THROW(fitted_network_models(ModelSpec{}, fit, {0, 1}, {0, 1}), tt::core::DataError);
 }
 
+TEST_F(Network, WeightDecayShrinksTheWeightsAndStaysDeterministic) {
+  ModelSpec spec = small_network();
+  spec.network.options.weight_decay = 1.0;
+  const auto fit = group_subset(*groups_, {0, 1, 2, 3});
+  const FittedModel a = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const FittedModel b = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const auto norm = [](const FittedModel& m) {
+    double sum = 0.0;
+    for (float w : std::get<tt::torchnet::Network>(m.body).flat_weights()) sum += double(w) * w;
+    return std::sqrt(sum);
+  };
+  EXPECT_EQ(std::get<tt::torchnet::Network>(a.body).flat_weights(),
+            std::get<tt::torchnet::Network>(b.body).flat_weights());
+  EXPECT_LT(norm(a), norm(*model_));
+  EXPECT_NE(model_label(spec).find("wd=1"), std::string::npos) << model_label(spec);
+}
+
 TEST(NetworkOptions, BadSettingsNameTheKey) {
   const auto groups = campaign(3, 5, lagged_truth, 0.1 * um, 4);
   ModelSpec spec = small_network();
@@ -170,5 +188,13 @@ TEST(NetworkOptions, BadSettingsNameTheKey) {
     FAIL() << "an even kernel was accepted";
   } catch (const tt::core::DataError& e) {
     EXPECT_NE(std::string(e.what()).find("kernel_size = 4"), std::string::npos) << e.what();
+  }
+  spec = small_network();
+  spec.network.options.weight_decay = -0.1;
+  try {
+    fitted_model(spec, groups, {0, 1}, 0);
+    FAIL() << "a negative weight decay was accepted";
+  } catch (const tt::core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("weight_decay"), std::string::npos) << e.what();
   }
 }
