@@ -106,8 +106,8 @@ Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
   return case_twin(mesh, spec, thermal_system(mesh, spec), options);
 }
 
-Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const FullThermalSystem& full,
-               const ReductionOptions& options) {
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+               const FullThermalSystem& full, const ReductionOptions& options) {
   TwinOutputs outputs;
   if (spec.mechanical.enabled && !spec.mechanical.tcp_point.empty()) {
     const ElasticModel elastic(mesh, spec);
