@@ -50,7 +50,8 @@ fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResul
   g.time = h.times;
   g.temperature = h.temperature;
   g.error.resize(h.targets.rows(), h.targets.cols() + r.axis.values.cols());
-  g.error << h.targets, r.axis.values;
+  g.error.leftCols(h.targets.cols()) = h.targets;
+  g.error.rightCols(r.axis.values.cols()) = r.axis.values;
   g.sensor_names = h.names;
   g.target_names = h.target_names;
   for (const auto& name : axis_target_names(spec)) g.target_names.push_back(name);
