@@ -7,6 +7,7 @@
 // predictions (fit.json "axis", axis_fit.md); with --network, the patent's one network for every
 // output, network_all_outputs.pt.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -222,11 +223,14 @@ int fit_command(const FitArgs& args) {
   }
   // 5. The feed axis: models at its points and the polynomial from their predictions.
   std::optional<AxisFit> axis;
+  double axis_seconds = 0.0;
   if (!spec.mechanical.axis_points.empty()) {
+    const auto start = std::chrono::steady_clock::now();
     std::optional<fitting::ModelSpec> network;
     if (args.network && !network_inputs.empty()) network = driver_network_spec(spec.seed);
     axis = axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs, network,
                     sensor_union(network_inputs));
+    axis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   // 6. Outputs, all or nothing.
   const auto& dir = out.path();
@@ -242,6 +246,7 @@ int fit_command(const FitArgs& args) {
                                {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
   if (axis) {
     doc["axis"] = axis_fit_json(*axis);
+    doc["axis"]["seconds"] = axis_seconds;  // the axis points' models, network and polynomials
     if (!axis->network.empty()) doc["axis"]["network"]["file"] = "network_all_outputs.pt";
     io::write_file_atomically(dir / "axis_fit.md", axis_fit_markdown(*axis));
     if (!axis->network.empty())
