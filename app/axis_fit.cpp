@@ -97,7 +97,11 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
     refit.insert(refit.end(), split.validation.begin(), split.validation.end());
     std::vector<int> all(static_cast<std::size_t>(columns));
     for (int t = 0; t < columns; ++t) all[static_cast<std::size_t>(t)] = t;
-    fit.network = fitting::fitted_network_models(*network, fitting::group_subset(groups, refit),
+    // One scale for all outputs: the loss weighs them by size, so the 100 um dx of the far axis
+    // points counts for more than the 1 um dz that is mostly noise.
+    fitting::ModelSpec every_output = *network;
+    every_output.network.options.common_output_scale = true;
+    fit.network = fitting::fitted_network_models(every_output, fitting::group_subset(groups, refit),
                                                  network_sensors, all);
     for (const auto& m : fit.network) fit.network_test.push_back(fitting::model_accuracy(m, test));
   }

@@ -76,6 +76,7 @@ json settings_json(const fitting::ModelSpec& spec) {
       s["batch_size"] = o.batch_size;
       s["learning_rate"] = o.learning_rate;
       s["weight_decay"] = o.weight_decay;
+      s["common_output_scale"] = o.common_output_scale;
       s["time_budget_s"] = o.time_budget_s;
       s["seed"] = o.seed;
       s["threads"] = o.threads;

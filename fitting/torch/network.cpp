@@ -420,6 +420,9 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
   impl->in_scale = column_scale(x_all, impl->in_mean);
   impl->out_mean = y_all.colwise().mean().transpose();
   impl->out_scale = column_scale(y_all, impl->out_mean);
+  if (o.common_output_scale)
+    impl->out_scale.setConstant(
+        std::sqrt(impl->out_scale.squaredNorm() / static_cast<double>(impl->out_scale.size())));
 
   // Windows: every row of the fitting groups; the validation groups', or the last fifth of each
   // fitting group's rows when there are none.

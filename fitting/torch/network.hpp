@@ -41,6 +41,10 @@ struct NetworkOptions {
   /// decoupled weight decay (AdamW) per unit learning rate; 0: plain Adam. Shrinking the weights
   /// keeps the gates off saturation, so the network leaves its training range more gently
   double weight_decay = 0.0;
+  /// one scale for every output (the root mean square of their standard deviations) instead of
+  /// each its own: the loss then weighs outputs by their size, so a network for many outputs
+  /// does not spend itself on those that are mostly noise
+  bool common_output_scale = false;
   /// wall-clock limit of training [s]; reaching it ends training with the best weights so far
   /// (then the result depends on the machine's speed: the report says so)
   double time_budget_s = 300.0;

@@ -158,6 +158,15 @@ TEST(NetworkOfEveryOutput, OneNetworkPredictsEachTargetAndBeatsAConstant) {
   // The same seed gives the same network.
   const auto again = fitted_network_models(small_network(), fit, {0, 1, 2, 3}, {1, 0});
   EXPECT_EQ(std::get<tt::torchnet::Network>(again[0].body).flat_weights(), a.flat_weights());
+  // One scale for both outputs: the standardisation keeps their ratio of sizes.
+  ModelSpec common = small_network();
+  common.network.options.common_output_scale = true;
+  const auto scaled = fitted_network_models(common, fit, {0, 1, 2, 3}, {1, 0});
+  const auto& c = std::get<tt::torchnet::Network>(scaled[0].body);
+  EXPECT_EQ(c.output_scale()(0), c.output_scale()(1));
+  EXPECT_NE(a.output_scale()(0), a.output_scale()(1));
+  EXPECT_NEAR(c.output_scale().squaredNorm(), a.output_scale().squaredNorm(),
+              1e-12 * a.output_scale().squaredNorm());
   EXPECT_THROW(fitted_network_models(small_network(), fit, {0, 1}, {0, 0}), tt::core::DataError);
   EXPECT_THROW(fitted_network_models(ModelSpec{}, fit, {0, 1}, {0, 1}), tt::core::DataError);
 }
