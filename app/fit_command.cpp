@@ -2,13 +2,20 @@
 // cycles it was not fitted on (DB3401/T 326-2024 metrics S, S_M, S_sigma).
 //   thermotwin fit CASE --out DIR [--hours 5] [--required-sm-um 1] [--quick]
 // Writes fit.json, modelling_record.{json,md}, compensation.csv, sensor_count_<target>.csv and
-// sensor_count_<target>.png, campaign.csv (what each group was).
+// sensor_count_<target>.png, campaign.csv (what each group was). A case with feed-axis points
+// (GM-1) also gets models of the error at those points and the axis polynomial fitted from their
+// predictions (fit.json "axis", axis_fit.md); with --network, the patent's one network for every
+// output, network_all_outputs.pt.
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <set>
 
+#include "app/axis_fit.hpp"
 #include "app/commands.hpp"
 #include "app/network_candidate.hpp"
 #include "app/study.hpp"
@@ -36,15 +43,19 @@ const std::vector<std::string> kFitting{"p1_extended", "staircase_up", "irregula
 const std::vector<std::string> kValidation{"staircase_down", "ambient_drift"};
 const std::vector<std::string> kTest{"irregular_b", "run_then_cool", "mixed_speeds"};
 
+/// The case's targets at the TCP, then the error at each feed-axis point (axis_target_names).
 fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResult& r) {
   const Histories h = histories_from_points(spec, r.times, r.point_temperature, r.error);
   fitting::Group g;
   g.name = r.name;
   g.time = h.times;
   g.temperature = h.temperature;
-  g.error = h.targets;
+  g.error.resize(h.targets.rows(), h.targets.cols() + r.axis.values.cols());
+  g.error.leftCols(h.targets.cols()) = h.targets;
+  g.error.rightCols(r.axis.values.cols()) = r.axis.values;
   g.sensor_names = h.names;
   g.target_names = h.target_names;
+  for (const auto& name : axis_target_names(spec)) g.target_names.push_back(name);
   return g;
 }
 
@@ -57,10 +68,12 @@ std::vector<int> indices_of(const std::vector<fitting::Group>& groups,
   return out;
 }
 
-/// Placement on the fitting groups laid end to end (times shifted so they increase).
+/// Placement for the first `targets` targets on the fitting groups laid end to end (times shifted
+/// so they increase).
 placement::PlacementResult placement_on(const std::vector<fitting::Group>& groups,
                                         const std::vector<int>& fit,
-                                        const Eigen::MatrixX3d& positions, std::uint64_t seed) {
+                                        const Eigen::MatrixX3d& positions, Eigen::Index targets,
+                                        std::uint64_t seed) {
   Eigen::Index rows = 0;
   for (int i : fit) rows += groups[i].time.size();
   placement::PlacementInput in;
@@ -70,7 +83,6 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
   in.positions_m = positions;
   in.times_s.resize(rows);
   in.temperatures_K.resize(rows, g0.temperature.cols());
-  const Eigen::Index targets = g0.error.cols();
   Eigen::MatrixXd error(rows, targets);
   Eigen::Index r = 0;
   double offset = 0;
@@ -79,7 +91,7 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
     const Eigen::Index n = g.time.size();
     in.times_s.segment(r, n) = g.time.array() + offset;
     in.temperatures_K.middleRows(r, n) = g.temperature;
-    error.middleRows(r, n) = g.error;
+    error.middleRows(r, n) = g.error.leftCols(targets);
     offset += g.time(n - 1) + 1.0;
     r += n;
   }
@@ -102,15 +114,13 @@ std::vector<fitting::SensorSet> sensor_sets(const placement::PlacementResult& p,
   return sets;
 }
 
-/// Mean over groups of the standard deviation of the uncompensated error [m].
-double uncompensated_std(const std::vector<fitting::Group>& groups, const std::vector<int>& which,
-                         int target) {
-  double sum = 0;
-  for (int i : which) {
-    const Eigen::VectorXd e = groups[i].error.col(target);
-    sum += fitting::residual_std((e.array() - e.mean()).matrix());
-  }
-  return sum / static_cast<double>(which.size());
+/// The sensors of several sets, each once, in the order first met.
+std::vector<int> sensor_union(const std::vector<fitting::SensorSet>& sets) {
+  std::vector<int> out;
+  for (const auto& s : sets)
+    for (int c : s.sensors)
+      if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+  return out;
 }
 
 }  // namespace
@@ -137,18 +147,19 @@ int fit_command(const FitArgs& args) {
   // 3. Placement on the fitting groups only.
   const Histories first =
       histories_from_points(spec, results[0].times, results[0].point_temperature, results[0].error);
+  const auto tcp_targets = static_cast<int>(first.target_names.size());
   const placement::PlacementResult placed =
-      placement_on(groups, split.fitting, first.positions, spec.seed);
+      placement_on(groups, split.fitting, first.positions, tcp_targets, spec.seed);
   // 4. Per target: choose model, settings and placement method on validation; test; count sensors.
-  std::vector<fitting::ModelSpec> specs =
+  const std::vector<fitting::ModelSpec> specs =
       args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
                  : fitting::default_model_candidates();
-  if (args.network) specs.push_back(driver_network_spec(spec.seed));
   std::map<std::string, NetworkFigures> networks;
   std::vector<fitting::Evaluation> evals;
   std::vector<fitting::SensorCountTable> tables;
   nlohmann::json summary = nlohmann::json::object();
-  for (int target = 0; target < static_cast<int>(groups[0].target_names.size()); ++target) {
+  std::vector<fitting::SensorSet> tcp_chosen, network_inputs;
+  for (int target = 0; target < tcp_targets; ++target) {
     // The standard's own choice (7.1: |r| of the increments, pooled over the fitting groups) is
     // named apart from the placement module's correlation ranking (which leaves twins out), so
     // that the two never share a column of sensor_count_<target>.csv.
@@ -164,8 +175,20 @@ int fit_command(const FitArgs& args) {
     if (args.network) {
       const auto grey = network_sensor_sets(placed, target);
       at_most_4.insert(at_most_4.end(), grey.begin(), grey.end());
+      network_inputs.insert(network_inputs.end(), grey.begin(), grey.end());
     }
     evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
+    if (args.network) {
+      // The network on the grey relational sensors and on the chosen linear model's, chosen on
+      // validation beside the linear models.
+      const fitting::Candidate linear_inputs = linear_inputs_network(evals.back().model, spec.seed);
+      at_most_4.push_back(linear_inputs.sensor_set);
+      network_inputs.push_back(linear_inputs.sensor_set);
+      std::vector<fitting::ModelSpec> with_network = specs;
+      with_network.push_back(driver_network_spec(spec.seed));
+      with_network.push_back(linear_inputs.spec);
+      evals.back() = fitting::evaluation(groups, split, target, at_most_4, with_network);
+    }
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);
     const auto corr6 = standard_sets(6);
     all.insert(all.end(), corr6.begin(), corr6.end());
@@ -174,6 +197,7 @@ int fit_command(const FitArgs& args) {
     const auto& e = evals.back();
     const double drift = uncompensated_std(groups, split.test, target);
     const auto& chosen = e.sensor_sets[e.selection.candidates[e.selection.best].sensor_set];
+    tcp_chosen.push_back({"tcp_" + groups[0].target_names[target] + "_chosen", chosen.sensors});
     std::vector<std::string> names;
     for (int c : chosen.sensors) names.push_back(groups[0].sensor_names[c]);
     summary[groups[0].target_names[target]] = {{"method", chosen.method},
@@ -197,7 +221,18 @@ int fit_command(const FitArgs& args) {
       }
     }
   }
-  // 5. Outputs, all or nothing.
+  // 5. The feed axis: models at its points and the polynomial from their predictions.
+  std::optional<AxisFit> axis;
+  double axis_seconds = 0.0;
+  if (!spec.mechanical.axis_points.empty()) {
+    const auto start = std::chrono::steady_clock::now();
+    std::optional<fitting::ModelSpec> network;
+    if (args.network && !network_inputs.empty()) network = driver_network_spec(spec.seed);
+    axis = axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs, network,
+                    sensor_union(network_inputs));
+    axis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  // 6. Outputs, all or nothing.
   const auto& dir = out.path();
   io::write_fit_json(dir / "fit.json", evals, tables);
   nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "fit.json"));
@@ -209,6 +244,15 @@ int fit_command(const FitArgs& args) {
                                {"shape", r.shape},
                                {"hours", r.spec.duty_cycle.end / 3600.0},
                                {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
+  if (axis) {
+    doc["axis"] = axis_fit_json(*axis);
+    doc["axis"]["seconds"] = axis_seconds;  // the axis points' models, network and polynomials
+    if (!axis->network.empty()) doc["axis"]["network"]["file"] = "network_all_outputs.pt";
+    io::write_file_atomically(dir / "axis_fit.md", axis_fit_markdown(*axis));
+    if (!axis->network.empty())
+      std::get<torchnet::Network>(axis->network.front().body)
+          .save_torchscript(dir / "network_all_outputs.pt");
+  }
   io::write_json(dir / "fit.json", doc);
   for (const auto& [name, n] : networks)
     std::get<torchnet::Network>(n.model.body).save_torchscript(dir / ("network_" + name + ".pt"));

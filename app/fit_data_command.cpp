@@ -379,11 +379,16 @@ int fit_data_command(const FitDataArgs& args) {
       window_rows;  /// per channel: time_s, measured_um, predicted_um
   const auto candidates = data_candidates(sensor_count, has_speed, args.quick);
   for (int target = 0; target < static_cast<int>(targets.size()); ++target) {
-    std::vector<fitting::Candidate> target_candidates = candidates;
-    if (placed)
+    evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, candidates));
+    if (placed) {
+      // The network on the grey relational sensors and on the inputs of the linear model just
+      // chosen, chosen beside the linear models under the same rule.
+      std::vector<fitting::Candidate> target_candidates = candidates;
       for (const auto& set : network_sensor_sets(*placed, target))
         target_candidates.push_back({set, driver_network_spec(1)});
-    evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, target_candidates));
+      target_candidates.push_back(linear_inputs_network(evals.back().model, 1));
+      evals.back() = fitting::blocked_evaluation(groups, pool, test, target, target_candidates);
+    }
     const auto& e = evals.back();
     const auto& chosen = e.selection.candidates[static_cast<std::size_t>(e.selection.best)];
     const auto& lowest = e.selection.candidates[static_cast<std::size_t>(e.selection.lowest)];

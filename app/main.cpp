@@ -169,7 +169,9 @@ int main(int argc, char** argv) {
   fit->add_flag("--quick", fit_args.quick,
                 "least squares only (no model search); with --data: a coarser ridge grid");
   fit->add_flag("--network", fit_args.network,
-                "also try the CNN-BiGRU-attention network (seed 004); writes network_<target>.pt");
+                "also try the CNN-BiGRU-attention network (seed 004); writes network_<target>.pt "
+                "(and network_all_outputs.pt, one network for every output, on a case with "
+                "feed-axis points)");
   fit->add_flag("--quiet", fit_args.quiet, "no progress on stderr");
   fit->add_option("--rom", fit_args.rom,
                   "a reduced model (thermotwin reduce CASE --out DIR) to run the campaign on")

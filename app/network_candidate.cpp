@@ -6,7 +6,8 @@
 
 namespace tt::app {
 
-fitting::ModelSpec driver_network_spec(std::uint64_t seed) {
+fitting::ModelSpec driver_network_spec(std::uint64_t seed, const std::string& sensor_method,
+                                       bool use_inputs) {
   torchnet::NetworkOptions o;
   o.window_steps = 16;
   o.conv_channels = 16;
@@ -16,10 +17,18 @@ fitting::ModelSpec driver_network_spec(std::uint64_t seed) {
   o.patience = 20;
   o.batch_size = 64;
   o.learning_rate = 3e-3;
+  o.weight_decay = kNetworkWeightDecay;
   o.time_budget_s = 300.0;
   o.seed = seed;
   o.threads = 1;
-  return fitting::network_spec(o, 3600.0, kNetworkSensorMethod);
+  fitting::ModelSpec spec = fitting::network_spec(o, 3600.0, sensor_method);
+  spec.use_inputs = use_inputs;
+  return spec;
+}
+
+fitting::Candidate linear_inputs_network(const fitting::FittedModel& chosen, std::uint64_t seed) {
+  return {fitting::SensorSet{kLinearInputsNetworkMethod, chosen.features.sensors},
+          driver_network_spec(seed, kLinearInputsNetworkMethod, !chosen.features.inputs.empty())};
 }
 
 std::vector<fitting::SensorSet> network_sensor_sets(const placement::PlacementResult& placed,

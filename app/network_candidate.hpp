@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fitting/models.hpp"
+#include "fitting/segments.hpp"
 #include "fitting/selection.hpp"
 #include "placement/place.hpp"
 
@@ -13,10 +14,25 @@ namespace tt::app {
 
 /// Sensor-set method of the network's inputs: the grey relational grade's best m <= 4 sensors.
 inline constexpr const char* kNetworkSensorMethod = "grey_relational_network";
+/// Sensor-set method of the network's other inputs: those of the linear model chosen on
+/// validation for the same target (its sensors, and the speed when it reads it).
+inline constexpr const char* kLinearInputsNetworkMethod = "linear_inputs_network";
 
 /// The drivers' network: 16-entry windows spanning an hour, 16 convolution channels, a 2 x 16
-/// bidirectional GRU, at most 150 epochs (patience 20) and 300 s per training, seed `seed`.
-fitting::ModelSpec driver_network_spec(std::uint64_t seed);
+/// bidirectional GRU, at most 150 epochs (patience 20) and 300 s per training, weight decay
+/// kNetworkWeightDecay, seed `seed`, tried with `sensor_method`'s sets (and the operating inputs
+/// when `use_inputs`).
+fitting::ModelSpec driver_network_spec(std::uint64_t seed,
+                                       const std::string& sensor_method = kNetworkSensorMethod,
+                                       bool use_inputs = false);
+
+/// AdamW's decoupled weight decay of the drivers' network. A few hundred windows give a few
+/// optimiser steps per epoch, so it is large beside the usual 0.01.
+inline constexpr double kNetworkWeightDecay = 0.3;
+
+/// The network candidate on the inputs of the linear model chosen for a target: its sensors as a
+/// set of method kLinearInputsNetworkMethod and a network spec that reads the speed when it does.
+fitting::Candidate linear_inputs_network(const fitting::FittedModel& chosen, std::uint64_t seed);
 
 /// The grey relational placement's largest set of at most 4 sensors for `target`, renamed
 /// kNetworkSensorMethod; empty when placement ran no grey relational ranking.

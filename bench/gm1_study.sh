@@ -6,7 +6,8 @@
 #   3. check   the run wrote the TCP and axis columns, and the polynomial reproduces the axis
 #              points' error within the residual it reports
 #   4. place   sensors on the run's histories for the case's targets (placement --from the run)
-#   5. fit     models on a virtual campaign, judged on held-out duty cycles
+#   5. fit     models on a virtual campaign, judged on held-out duty cycles; the feed axis's
+#              points modelled too, and the axis polynomial from their predictions
 #
 #   bench/gm1_study.sh --short [--thermotwin PATH] [--out DIR]   coarse mesh, 1 h campaign runs, --quick fit:
 #                                                               the CI variant (a few minutes)
@@ -111,5 +112,18 @@ for t, v in s.items():
     print(f"gm1_study: fit {t}: {v['method']} {v['sensors']} {v['model']}: test S_M {v['test_sm_um']:.3f} um"
           f" (uncompensated {v['uncompensated_std_um']:.3f} um)")
     assert v["test_sm_um"] >= 0
+# The feed axis: a model per axis point and direction, and the axis polynomial fitted from their
+# predictions on the held-out runs must leave less than the uncompensated error (on the dominant
+# direction, the axis's own growth dx) and never less than the polynomial of the measured error.
+ax = json.load(open(sys.argv[1]))["axis"]
+assert len(ax["targets"]) == 3 * len(ax["points"]) == 33, len(ax["targets"])
+res = ax["polynomial_residual"]
+for d in ("dx", "dy", "dz"):
+    print(f"gm1_study: axis polynomial {d}: RMS uncompensated {res['uncompensated'][d]['rms_um']:.3f} um,"
+          f" of the linear models' predictions {res['linear'][d]['rms_um']:.3f} um,"
+          f" of the measured error {res['measured'][d]['rms_um']:.3f} um")
+    assert res["linear"][d]["rms_um"] >= res["measured"][d]["rms_um"] - 1e-9
+dom = max(("dx", "dy", "dz"), key=lambda d: res["uncompensated"][d]["rms_um"])
+assert res["linear"][dom]["rms_um"] < 0.5 * res["uncompensated"][dom]["rms_um"], (dom, res)
 PY
 step "done -> $out"

@@ -4,7 +4,9 @@
 #   bench/network_side_by_side.sh gm1 OUT   # cases/gm1_coarse.toml, held-out duty cycles
 # Runs `thermotwin fit [--data] --network` on 2 threads and prints, per target or channel, the
 # chosen model's and the network's held-out S_M and window MAE, the network's training time and
-# its median one-window inference time (from fit.json's summary).
+# its median one-window inference time (from fit.json's summary); on GM-1 also the feed axis: the
+# one network for every output against the linear model per axis point, and the axis polynomial
+# fitted from each one's predictions (fit.json's axis).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${THERMOTWIN:-$here/build/thermotwin}
@@ -33,4 +35,25 @@ for name, s in doc["summary"].items():
           f"{f(s.get('window_mae_continuous_um'))} | {f(n.get('window_mae_continuous_um'))} | "
           f"{f(s.get('published_mae_um'), 3)} | {f(n.get('training_seconds'), 1)} | "
           f"{f(n.get('inference_ms_median'), 3)} |")
+ax = doc.get("axis")
+if ax:
+    # GM-1's feed axis: the one network for every output against the linear model per point, and
+    # the axis polynomial fitted from each one's predictions on the test groups.
+    net = ax.get("network", {})
+    print(f"\none network for all {net.get('outputs', '-')} outputs on {net.get('sensors')}: "
+          f"training {f(net.get('training_seconds'), 1)} s, best epoch {net.get('best_epoch')} "
+          f"of {net.get('epochs')}")
+    print("\n| direction | axis points' mean test S_M, linear [um] | network [um] | uncompensated "
+          "std [um] |\n|---|---|---|---|")
+    for d in ("dx", "dy", "dz"):
+        ts = [v for k, v in ax["targets"].items() if k.endswith("_" + d)]
+        mean = lambda key: sum(t[key] for t in ts) / len(ts) if all(t.get(key) is not None for t in ts) else None
+        print(f"| {d} | {f(mean('test_sm_um'))} | {f(mean('network_test_sm_um'))} | "
+              f"{f(mean('uncompensated_std_um'))} |")
+    res = ax["polynomial_residual"]
+    print("\n| axis polynomial from | " + " | ".join(f"{d} RMS [um] | {d} max [um]" for d in ("dx", "dy", "dz"))
+          + " |\n|---|" + "---|" * 6)
+    for src, v in res.items():
+        print(f"| {src} | " + " | ".join(f"{f(v[d]['rms_um'])} | {f(v[d]['max_um'])}"
+                                          for d in ("dx", "dy", "dz")) + " |")
 PY

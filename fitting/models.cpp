@@ -52,7 +52,7 @@ int window_stride(const NetworkSettings& settings, const std::vector<Group>& gro
 }
 
 torchnet::Network network_fit(const torchnet::NetworkOptions& options, const FeatureMap& features,
-                              const std::vector<Group>& groups, int target) {
+                              const std::vector<Group>& groups, const std::vector<int>& targets) {
   // With three or more groups the last one stops the training early; with fewer, the adapter
   // holds out the last fifth of each group.
   torchnet::Sequences fit, validation;
@@ -60,7 +60,10 @@ torchnet::Network network_fit(const torchnet::NetworkOptions& options, const Fea
   for (std::size_t g = 0; g < groups.size(); ++g) {
     torchnet::Sequences& s = hold_last && g + 1 == groups.size() ? validation : fit;
     s.inputs.push_back(feature_matrix(features, groups[g]));
-    s.outputs.push_back(groups[g].error.col(target));
+    Eigen::MatrixXd y(groups[g].error.rows(), static_cast<Eigen::Index>(targets.size()));
+    for (std::size_t k = 0; k < targets.size(); ++k)
+      y.col(static_cast<Eigen::Index>(k)) = groups[g].error.col(targets[k]);
+    s.outputs.push_back(std::move(y));
   }
   return torchnet::trained_network(fit, validation, options);
 }
@@ -82,10 +85,10 @@ Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::Vect
   throw core::DataError("model kind '" + kind_name(spec.kind) + "' cannot be fitted on rows");
 }
 
-Eigen::VectorXd body_prediction(const Body& body, const Eigen::MatrixXd& x) {
+Eigen::VectorXd body_prediction(const Body& body, const Eigen::MatrixXd& x, int output = 0) {
   if (const auto* linear = std::get_if<LinearFit>(&body)) return linear_prediction(*linear, x);
   if (const auto* network = std::get_if<torchnet::Network>(&body))
-    return network->prediction(x).col(0);  // x: one group's rows in time order
+    return network->prediction(x).col(output);  // x: one group's rows in time order
   return ppr_prediction(std::get<PprModel>(body), x);
 }
 
@@ -140,8 +143,10 @@ std::string model_label(const ModelSpec& spec) {
     case ModelKind::cnn_bigru_attention:
       out << "(window=" << spec.network.options.window_steps << "x" << spec.network.window_span_s
           << "s,conv=" << spec.network.options.conv_channels
-          << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden
-          << ",seed=" << spec.network.options.seed << ")";
+          << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden;
+      if (spec.network.options.weight_decay > 0.0)
+        out << ",wd=" << spec.network.options.weight_decay;
+      out << ",seed=" << spec.network.options.seed << ")";
       break;
   }
   if (spec.use_inputs && spec.kind != ModelKind::no_compensation) out << "+inputs";
@@ -167,9 +172,11 @@ int coefficient_count(const ModelSpec& spec, int sensors, int inputs) {
   return base;
 }
 
-FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
-                         const std::vector<int>& sensors, int target) {
-  require_consistent_groups(groups);
+namespace {
+
+/// A model of `spec` on `target` with its features and groups named, not yet fitted.
+FittedModel unfitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
+                           const std::vector<int>& sensors, int target) {
   if (sensors.empty())
     throw core::DataError("model '" + model_label(spec) +
                           "' with no sensors; expected at least one temperature column");
@@ -183,14 +190,37 @@ FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups
   model.target = target;
   model.target_name = first.target_names[static_cast<std::size_t>(target)];
   for (const Group& g : groups) model.fitted_on.push_back(g.name);
-  if (spec.kind == ModelKind::cnn_bigru_attention) {
-    torchnet::NetworkOptions options = spec.network.options;
-    options.window_stride = window_stride(spec.network, groups);
-    model.body = network_fit(options, model.features, groups, target);
-    for (const Group& g : groups) model.rejection.samples += static_cast<int>(g.time.size());
-    model.rejection.passes = 1;
-    return model;
+  return model;
+}
+
+/// One network trained on `targets` at once: a model per target sharing it.
+std::vector<FittedModel> network_models(const ModelSpec& spec, const std::vector<Group>& groups,
+                                        const std::vector<int>& sensors,
+                                        const std::vector<int>& targets) {
+  std::vector<FittedModel> models;
+  for (int t : targets) models.push_back(unfitted_model(spec, groups, sensors, t));
+  torchnet::NetworkOptions options = spec.network.options;
+  options.window_stride = window_stride(spec.network, groups);
+  const torchnet::Network network = network_fit(options, models.front().features, groups, targets);
+  int samples = 0;
+  for (const Group& g : groups) samples += static_cast<int>(g.time.size());
+  for (std::size_t k = 0; k < models.size(); ++k) {
+    models[k].body = network;
+    models[k].output = static_cast<int>(k);
+    models[k].rejection.samples = samples;
+    models[k].rejection.passes = 1;
   }
+  return models;
+}
+
+}  // namespace
+
+FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
+                         const std::vector<int>& sensors, int target) {
+  require_consistent_groups(groups);
+  if (spec.kind == ModelKind::cnn_bigru_attention)
+    return network_models(spec, groups, sensors, {target}).front();
+  FittedModel model = unfitted_model(spec, groups, sensors, target);
 
   const StackedRows rows = stacked_rows(model.features, groups, target);
   const Eigen::Index n = rows.error.size();
@@ -228,6 +258,24 @@ FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups
     if (!is_kept[static_cast<std::size_t>(row)])
       model.rejection.rejected_rows.push_back(static_cast<int>(row));
   return model;
+}
+
+std::vector<FittedModel> fitted_network_models(const ModelSpec& spec,
+                                               const std::vector<Group>& groups,
+                                               const std::vector<int>& sensors,
+                                               const std::vector<int>& targets) {
+  require_consistent_groups(groups);
+  if (spec.kind != ModelKind::cnn_bigru_attention)
+    throw core::DataError("one model for several targets of kind '" + kind_name(spec.kind) +
+                          "'; expected cnn_bigru_attention (a network with an output per target)");
+  if (targets.empty())
+    throw core::DataError("a network for no targets; expected at least one target column");
+  for (std::size_t i = 0; i < targets.size(); ++i)
+    for (std::size_t j = i + 1; j < targets.size(); ++j)
+      if (targets[i] == targets[j])
+        throw core::DataError("target " + std::to_string(targets[i]) +
+                              " listed twice for one network; expected each target once");
+  return network_models(spec, groups, sensors, targets);
 }
 
 Eigen::VectorXd refitted_prediction(const FittedModel& chosen, const Group& group,
@@ -280,7 +328,7 @@ Eigen::VectorXd predicted_error(const FittedModel& model, const Group& group) {
                             model.features.sensor_names[k] +
                             "'; hint: predict on groups of the campaign the model was fitted on");
   }
-  return body_prediction(model.body, feature_matrix(model.features, group));
+  return body_prediction(model.body, feature_matrix(model.features, group), model.output);
 }
 
 Accuracy model_accuracy(const FittedModel& model, const std::vector<Group>& groups) {

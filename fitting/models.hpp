@@ -92,8 +92,11 @@ struct FittedModel {
   int target = 0;
   std::string target_name;
   /// LinearFit for least_squares, ridge and distributed_lag; PprModel for projection_pursuit;
-  /// a Network with one output for cnn_bigru_attention
+  /// a Network for cnn_bigru_attention
   std::variant<LinearFit, PprModel, torchnet::Network> body;
+  /// cnn_bigru_attention: the network's output that predicts the target (0 unless one network
+  /// was trained on several targets at once, fitted_network_models)
+  int output = 0;
   GrossErrorRejection rejection;
   /// names of the groups the coefficients were fitted on
   std::vector<std::string> fitted_on;
@@ -103,6 +106,15 @@ struct FittedModel {
 /// Throws DataError on inconsistent groups or too few samples.
 FittedModel fitted_model(const ModelSpec& spec, const std::vector<Group>& groups,
                          const std::vector<int>& sensors, int target);
+
+/// The gantry patent's one network for every output (seed 004): `spec` (cnn_bigru_attention)
+/// trained once on the error columns `targets` together, reading `sensors`. One model per target,
+/// in the order of `targets`, all sharing the network (output k predicts targets[k]). Throws
+/// DataError as fitted_model does, or when the spec is not a network or a target repeats.
+std::vector<FittedModel> fitted_network_models(const ModelSpec& spec,
+                                               const std::vector<Group>& groups,
+                                               const std::vector<int>& sensors,
+                                               const std::vector<int>& targets);
 
 /// The model's form refitted on the rows of `group` where fit_row is true (#samples), predicting
 /// every row of the group: #samples [m]. The features run from the group's first reading, so a

@@ -75,6 +75,8 @@ json settings_json(const fitting::ModelSpec& spec) {
       s["patience"] = o.patience;
       s["batch_size"] = o.batch_size;
       s["learning_rate"] = o.learning_rate;
+      s["weight_decay"] = o.weight_decay;
+      s["common_output_scale"] = o.common_output_scale;
       s["time_budget_s"] = o.time_budget_s;
       s["seed"] = o.seed;
       s["threads"] = o.threads;
@@ -185,6 +187,7 @@ json model_json(const FittedModel& model) {
     const auto& o = network->options();
     const auto& r = network->report();
     j["inputs"] = fitting::feature_names(model.features);
+    j["output"] = model.output;  // of the network's outputs, the one this target reads
     j["window_steps"] = o.window_steps;
     j["window_stride_samples"] = o.window_stride;
     j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;

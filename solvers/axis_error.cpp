@@ -1,6 +1,7 @@
 #include "solvers/axis_error.hpp"
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -20,22 +21,39 @@ Eigen::MatrixXd vandermonde(const Eigen::VectorXd& p, int degree) {
 }  // namespace
 
 AxisError axis_error(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::MatrixXd& u) {
-  AxisError e;
   const auto& ids = spec.mechanical.axis_points;
-  const int dir = spec.feed_axis.direction;
-  e.points = ids;
-  e.positions.resize(static_cast<Eigen::Index>(ids.size()));
-  e.values.resize(u.cols(), 3 * static_cast<Eigen::Index>(ids.size()));
+  Eigen::MatrixXd at_points(u.cols(), 3 * static_cast<Eigen::Index>(ids.size()));
   for (size_t i = 0; i < ids.size(); ++i) {
     const int node = mesh::named_node(m, ids[i]);
     if (node < 0)
       throw core::SolverError("mechanical.axis_points: '" + ids[i] +
                               "' is not a named point of the mesh");
-    const auto col = static_cast<Eigen::Index>(3 * i);
-    e.positions(static_cast<Eigen::Index>(i)) = m.nodes(node, dir);
     for (int d = 0; d < 3; ++d)
-      e.values.col(col + d) = (u.row(3 * node + d).array() - u(3 * node + d, 0)).transpose();
+      at_points.col(static_cast<Eigen::Index>(3 * i) + d) = u.row(3 * node + d).transpose();
   }
+  return axis_error_at_points(spec, at_points);
+}
+
+AxisError axis_error_at_points(const core::CaseSpec& spec, const Eigen::MatrixXd& u) {
+  AxisError e;
+  const auto& ids = spec.mechanical.axis_points;
+  const auto n = static_cast<Eigen::Index>(ids.size());
+  if (u.cols() != 3 * n)
+    throw core::SolverError("axis point displacements with " + std::to_string(u.cols()) +
+                            " columns for " + std::to_string(n) +
+                            " axis points; expected 3 per point (dx, dy, dz)");
+  e.points = ids;
+  e.positions.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& id = ids[static_cast<size_t>(i)];
+    const auto p = std::find_if(spec.points.begin(), spec.points.end(),
+                                [&](const auto& q) { return q.id == id; });
+    if (p == spec.points.end())
+      throw core::SolverError("mechanical.axis_points: '" + id +
+                              "' is not a named point of the case");
+    e.positions(i) = p->position(spec.feed_axis.direction);
+  }
+  e.values = u.rows() > 0 ? Eigen::MatrixXd(u.rowwise() - u.row(0)) : u;
   return e;
 }
 
@@ -88,6 +106,23 @@ Eigen::VectorXd axis_polynomial_value(const AxisPolynomial& poly, int direction,
   Eigen::VectorXd v = Eigen::VectorXd::Constant(p.size(), c(poly.degree));
   for (int k = poly.degree - 1; k >= 0; --k) v = (v.array() * p.array() + c(k)).matrix();
   return v;
+}
+
+Eigen::MatrixXd axis_polynomial_residual(const AxisPolynomial& poly, const AxisError& measured) {
+  const Eigen::Index n = measured.positions.size();
+  if (poly.coefficients[0].rows() != measured.values.rows() || measured.values.cols() != 3 * n)
+    throw core::SolverError("axis polynomial of " + std::to_string(poly.coefficients[0].rows()) +
+                            " times against an axis error of " +
+                            std::to_string(measured.values.rows()) + " times and " +
+                            std::to_string(measured.values.cols()) + " columns for " +
+                            std::to_string(n) + " points; expected the same times, 3 per point");
+  Eigen::MatrixXd r(measured.values.rows(), 3 * n);
+  for (Eigen::Index t = 0; t < r.rows(); ++t)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd fit = axis_polynomial_value(poly, d, t, measured.positions);
+      for (Eigen::Index i = 0; i < n; ++i) r(t, 3 * i + d) = measured.values(t, 3 * i + d) - fit(i);
+    }
+  return r;
 }
 
 }  // namespace tt::solvers

@@ -24,6 +24,14 @@ struct AxisError {
 AxisError axis_error(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                      const Eigen::MatrixXd& displacement);
 
+/// From the axis points' own displacements: #times x 3 #points, (dx, dy, dz) of each point in the
+/// case's axis_points order relative to any fixed state [m] (e.g. read through adjoint influence
+/// rows). Positions are the points' coordinates along the feed axis (a named point is a mesh
+/// vertex at exactly its position). Throws SolverError when an axis point is not a named point of
+/// the case or the columns do not match the points.
+AxisError axis_error_at_points(const core::CaseSpec& spec,
+                               const Eigen::MatrixXd& point_displacement);
+
 struct AxisPolynomial {
   int degree = 0;
   /// Per direction (x, y, z): #times x (degree + 1) coefficients c_k of e(p) = sum_k c_k p^k,
@@ -40,5 +48,11 @@ AxisPolynomial axis_polynomial(const AxisError& error, int degree);
 /// The polynomial's value at positions p (#p [m]) for one time and direction [m].
 Eigen::VectorXd axis_polynomial_value(const AxisPolynomial& poly, int direction, Eigen::Index time,
                                       const Eigen::VectorXd& positions);
+
+/// What is left at the axis points when a CNC compensates with `poly` (fitted to any estimate of
+/// the error, e.g. a model's predictions): #times x 3 #points, `measured` minus the polynomial at
+/// each point's position, columns as in AxisError::values [m]. Throws SolverError when the two
+/// differ in times or points.
+Eigen::MatrixXd axis_polynomial_residual(const AxisPolynomial& poly, const AxisError& measured);
 
 }  // namespace tt::solvers

@@ -9,6 +9,7 @@
 #include "solvers/elastic.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal_error.hpp"
+#include "solvers/twin.hpp"
 
 namespace tt::solvers {
 namespace {
@@ -57,7 +58,8 @@ void set_ambient(core::CaseSpec& s, double initial_c, const core::TimeTable& tab
   s.thermal.initial_temperature_c = initial_c;
 }
 
-std::vector<Segment> irregular_cycle(double end, std::uint64_t seed, const std::vector<double>& speeds) {
+std::vector<Segment> irregular_cycle(double end, std::uint64_t seed,
+                                     const std::vector<double>& speeds) {
   auto gen = core::generator(seed, 0);
   std::uniform_real_distribution<double> on_minutes(10, 50), off_minutes(5, 25);
   std::uniform_int_distribution<size_t> pick(0, speeds.size() - 1);
@@ -76,7 +78,8 @@ std::vector<Segment> irregular_cycle(double end, std::uint64_t seed, const std::
 
 }  // namespace
 
-std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed) {
+std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
+                                       std::uint64_t seed) {
   if (!(hours > 0) || !std::isfinite(hours))
     throw core::CaseError("campaign length (fit --hours) " + std::to_string(hours) +
                           " h: must be a finite number > 0");
@@ -90,17 +93,24 @@ std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
   const double q = end / 4;
   const double t0 = base.thermal.initial_temperature_c;
   std::vector<CampaignRun> runs;
-  runs.push_back({"p1_extended", "P-1 then running",
-                  with_cycle(base, {{0, 3000}, {600, 0}, {900, 3000}, {2100, 0}, {2400, 3000}}, end)});
-  runs.push_back({"staircase_up", "speed staircase", with_cycle(base, {{0, 1000}, {q, 2000}, {2 * q, 3000}, {3 * q, 4000}}, end)});
+  runs.push_back(
+      {"p1_extended", "P-1 then running",
+       with_cycle(base, {{0, 3000}, {600, 0}, {900, 3000}, {2100, 0}, {2400, 3000}}, end)});
+  runs.push_back({"staircase_up", "speed staircase",
+                  with_cycle(base, {{0, 1000}, {q, 2000}, {2 * q, 3000}, {3 * q, 4000}}, end)});
   runs.push_back({"staircase_down", "speed staircase",
                   with_cycle(base, {{0, 4500}, {q, 3000}, {2 * q, 1500}, {3 * q, 0}}, end)});
-  runs.push_back({"irregular_a", "irregular on/off",
-                  with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 1), {1500, 2500, 3500}), end)});
-  runs.push_back({"irregular_b", "irregular on/off",
-                  with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 2), {2000, 3000, 4500}), end)});
+  runs.push_back(
+      {"irregular_a", "irregular on/off",
+       with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 1), {1500, 2500, 3500}),
+                  end)});
+  runs.push_back(
+      {"irregular_b", "irregular on/off",
+       with_cycle(base, irregular_cycle(end, core::derived_seed(seed, 2), {2000, 3000, 4500}),
+                  end)});
   {
-    CampaignRun r{"warm_start", "warmer ambient", with_cycle(base, {{0, 2500}, {2 * q, 0}, {2.5 * q, 2500}}, end)};
+    CampaignRun r{"warm_start", "warmer ambient",
+                  with_cycle(base, {{0, 2500}, {2 * q, 0}, {2.5 * q, 2500}}, end)};
     set_ambient(r.spec, t0 + 4, core::TimeTable{{0.0}, {t0 + 4}});
     runs.push_back(std::move(r));
   }
@@ -110,19 +120,22 @@ std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
     set_ambient(r.spec, t0, core::TimeTable{{0.0, end / 2, end}, {t0, t0 + 3, t0 + 1.5}});
     runs.push_back(std::move(r));
   }
-  runs.push_back({"run_then_cool", "run then cool down", with_cycle(base, {{0, 3500}, {2 * q, 0}}, end)});
-  runs.push_back({"mixed_speeds", "mixed speeds",
-                  with_cycle(base, {{0, 2000}, {3600, 0}, {5400, 4000}, {9000, 0}, {10800, 3000}}, end)});
+  runs.push_back(
+      {"run_then_cool", "run then cool down", with_cycle(base, {{0, 3500}, {2 * q, 0}}, end)});
+  runs.push_back(
+      {"mixed_speeds", "mixed speeds",
+       with_cycle(base, {{0, 2000}, {3600, 0}, {5400, 4000}, {9000, 0}, {10800, 3000}}, end)});
   return runs;
 }
 
 std::vector<CampaignRun> validation_runs(const core::CaseSpec& base, std::uint64_t seed) {
   std::vector<CampaignRun> runs;
   runs.push_back({"own_cycle", "the case's own duty cycle", base});
-  runs.push_back({"staircase_6h", "speed staircase 1000-2000-4000-6000-3000-0 rpm",
-                  with_cycle(base, {{0, 1000}, {3600, 2000}, {7200, 4000}, {10800, 6000},
-                                    {14400, 3000}, {18000, 0}},
-                             6 * 3600.0)});
+  runs.push_back(
+      {"staircase_6h", "speed staircase 1000-2000-4000-6000-3000-0 rpm",
+       with_cycle(base,
+                  {{0, 1000}, {3600, 2000}, {7200, 4000}, {10800, 6000}, {14400, 3000}, {18000, 0}},
+                  6 * 3600.0)});
   // Draw until the cycle switches at least 15 times (each draw switches about 20 times in 8 h).
   const double end = 8 * 3600.0;
   std::vector<Segment> irregular;
@@ -138,14 +151,8 @@ std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const c
                                               const std::vector<int>& sampled_nodes) {
   const FullThermalSystem ops = thermal_system(mesh, base);
   const ElasticModel elastic(mesh, base);
-  const auto nodes = error_nodes(mesh, base);
-  // 9 influence vectors: (tcp, z1, z2) x (x, y, z).
-  std::vector<std::pair<int, int>> dofs;
-  for (int p = 0; p < 3; ++p)
-    for (int d = 0; d < 3; ++d) dofs.emplace_back(nodes[p], d);
-  const Eigen::MatrixXd influence = elastic.influence_rows(dofs);
-  const double distance = (mesh.nodes.row(nodes[2]) - mesh.nodes.row(nodes[1])).norm();
-
+  // Influence rows of the TCP, the probe points and the feed-axis points in one block solve.
+  const TwinOutputs outputs = full_outputs(mesh, base, &elastic);
   std::vector<CampaignResult> results;
   double done = 0, total = 0;
   for (const auto& r : runs) total += r.spec.duty_cycle.end;
@@ -154,14 +161,9 @@ std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const c
       if (progress) progress(done + t, total);
     });
     done += r.spec.duty_cycle.end;
-    CampaignResult c{r.name, r.shape, th.times, {}, {}, {}};
-    std::vector<int> point_nodes;
-    for (const auto& p : mesh.points) point_nodes.push_back(p.node);
-    c.point_temperature = nodal_history(th, point_nodes);
-    c.node_temperature = nodal_history(th, sampled_nodes);
-    const Eigen::MatrixXd u = influence * (th.temperature.array() - elastic.reference_temperature_k()).matrix();
-    c.error = thermal_error_of(u, distance).values;
-    results.push_back(std::move(c));
+    results.push_back(campaign_result(
+        outputs, r, th.times, output_history(outputs, outputs.rows * th.temperature, ops.uniform),
+        nodal_history(th, sampled_nodes)));
   }
   return results;
 }

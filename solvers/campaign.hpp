@@ -9,6 +9,7 @@
 
 #include "core/case_spec.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "solvers/axis_error.hpp"
 #include "solvers/thermal.hpp"
 
 namespace tt::solvers {
@@ -25,7 +26,8 @@ struct CampaignRun {
 /// run-then-cool-down. The base case's own duty cycle is ignored; a feed axis that moves in the
 /// base case reciprocates over its first stroke while the spindle runs (feed scaled with the
 /// spindle speed) and stands while it stops.
-std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours, std::uint64_t seed);
+std::vector<CampaignRun> campaign_runs(const core::CaseSpec& base, double hours,
+                                       std::uint64_t seed);
 
 /// Duty cycles for judging a reduced model against the full one, none of them used to build it:
 /// the base case's own cycle (P-1 on SB-1, the feed-axis cycle on GM-1), a 6-hour staircase
@@ -35,14 +37,16 @@ std::vector<CampaignRun> validation_runs(const core::CaseSpec& base, std::uint64
 
 struct CampaignResult {
   std::string name, shape;
-  std::vector<double> times;           /// [s], t = 0 first
-  Eigen::MatrixXd point_temperature;   /// #times x #named points [K]
-  Eigen::MatrixXd node_temperature;    /// #times x #sampled nodes [K] (candidate sensors)
-  Eigen::MatrixXd error;               /// #times x 9: thermal_error.csv's columns [m, rad]
+  std::vector<double> times;          /// [s], t = 0 first
+  Eigen::MatrixXd point_temperature;  /// #times x #named points [K]
+  Eigen::MatrixXd node_temperature;   /// #times x #sampled nodes [K] (candidate sensors)
+  Eigen::MatrixXd error;              /// #times x 9: thermal_error.csv's columns [m, rad]
+  AxisError axis;  /// the error at the case's feed-axis points (no points when it names none)
 };
 
 /// Simulates every run on `mesh` (built from `base`; runs may differ from it only in duty cycle,
-/// initial temperature and sinks). The thermal error comes from adjoint influence vectors.
+/// initial temperature and sinks). The thermal error at the tool and at the feed-axis points comes
+/// from adjoint influence vectors (the twin's outputs on the full mesh, full_outputs).
 /// Besides the named points, each run records the history at `sampled_nodes` (e.g. the surface
 /// vertices that are candidate sensors).
 std::vector<CampaignResult> simulate_campaign(const mesh::TetMesh& mesh, const core::CaseSpec& base,

@@ -237,15 +237,46 @@ TwinComparison compare_outputs(const TwinOutputs& out, const Eigen::MatrixXd& fu
   return c;
 }
 
+namespace {
+
+void require_tcp_rows(const TwinOutputs& out) {
+  if (!out.tcp)
+    throw core::SolverError(
+        "the model has no TCP rows: a campaign needs the thermal error at the tool "
+        "(mechanical.enabled and mechanical.tcp_point in the case it was built from)");
+}
+
+}  // namespace
+
+CampaignResult campaign_result(const TwinOutputs& out, const CampaignRun& run,
+                               const std::vector<double>& times, const Eigen::MatrixXd& history,
+                               Eigen::MatrixXd node_temperature) {
+  require_tcp_rows(out);
+  CampaignResult c{run.name, run.shape, times, {}, std::move(node_temperature), {}, {}};
+  c.point_temperature = history.leftCols(out.temperatures);
+  c.error =
+      thermal_error_of(history.middleCols(out.temperatures, 9).transpose(), out.probe_distance)
+          .values;
+  const auto& ids = run.spec.mechanical.axis_points;
+  Eigen::MatrixXd axis(history.rows(), 3 * static_cast<Eigen::Index>(ids.size()));
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    for (int d = 0; d < 3; ++d) {
+      const std::string name = ids[i] + "_d" + kAxes[d];
+      const auto at = std::find(out.names.begin(), out.names.end(), name);
+      if (at == out.names.end())
+        throw core::SolverError("the model has no output '" + name + "' for axis point '" + ids[i] +
+                                "'; hint: build the reduced model again from a case that names it "
+                                "in mechanical.axis_points");
+      axis.col(static_cast<Eigen::Index>(3 * i) + d) = history.col(at - out.names.begin());
+    }
+  c.axis = axis_error_at_points(run.spec, axis);
+  return c;
+}
+
 std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<CampaignRun>& runs,
                                           const Progress& progress,
                                           const std::vector<int>& sampled_nodes) {
-  const TwinOutputs& out = twin.outputs;
-  if (!out.tcp)
-    throw core::SolverError(
-        "the reduced model has no TCP rows: a campaign needs the thermal error at the "
-        "tool (mechanical.enabled and mechanical.tcp_point in the case it was built "
-        "from)");
+  require_tcp_rows(twin.outputs);
   Eigen::MatrixXd node_rows(static_cast<Eigen::Index>(sampled_nodes.size()), twin.model.states());
   for (std::size_t i = 0; i < sampled_nodes.size(); ++i) {
     if (sampled_nodes[i] < 0 || sampled_nodes[i] >= twin.model.basis.rows())
@@ -262,13 +293,8 @@ std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<Ca
       if (progress) progress(done + t, total);
     });
     done += r.spec.duty_cycle.end;
-    CampaignResult c{r.name, r.shape, run.times, {}, {}, {}};
-    c.point_temperature = run.outputs.leftCols(out.temperatures);
-    c.node_temperature = (node_rows * run.states).transpose();
-    c.error = thermal_error_of(run.outputs.middleCols(out.temperatures, 9).transpose(),
-                               out.probe_distance)
-                  .values;
-    results.push_back(std::move(c));
+    results.push_back(campaign_result(twin.outputs, r, run.times, run.outputs,
+                                      (node_rows * run.states).transpose()));
   }
   return results;
 }

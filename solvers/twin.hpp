@@ -59,8 +59,8 @@ Twin build_twin(const FullThermalSystem& full, const core::CaseSpec& spec,
 Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                const ReductionOptions& options = {});
 /// The same on the case's full system already assembled (thermal_system(mesh, spec)).
-Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-               const FullThermalSystem& full, const ReductionOptions& options = {});
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const FullThermalSystem& full,
+               const ReductionOptions& options = {});
 
 /// A run of the twin: the case's duty cycle stepped on the reduced states by the one stepper.
 struct TwinRun {
@@ -72,9 +72,10 @@ struct TwinRun {
 };
 TwinRun twin_run(const Twin& twin, const core::CaseSpec& spec, const Progress& progress = {});
 
-/// The error indicator of a reduced run of `spec` (the twin's model, or any reduced model): the full-order residual, in kelvin, of the
-/// steps that end at up to `samples` output times (spread evenly, the last included). Backward
-/// Euler only: for a Crank-Nicolson case it throws SolverError (use run --verify).
+/// The error indicator of a reduced run of `spec` (the twin's model, or any reduced model): the
+/// full-order residual, in kelvin, of the steps that end at up to `samples` output times (spread
+/// evenly, the last included). Backward Euler only: for a Crank-Nicolson case it throws SolverError
+/// (use run --verify).
 ErrorIndicator twin_indicator(const FullThermalSystem& full, const ReducedModel& model,
                               const core::CaseSpec& spec, int samples = 12);
 
@@ -98,10 +99,17 @@ struct TwinComparison {
 TwinComparison compare_outputs(const TwinOutputs& out, const Eigen::MatrixXd& full,
                                const Eigen::MatrixXd& reduced);
 
+/// One campaign run read from its output history (#times x #names, as output_history gives) and
+/// the sampled nodes' history: the named points' temperatures, the TCP's thermal error and the
+/// error at the run's feed-axis points. The one reading of simulate_campaign and twin_campaign.
+/// Throws SolverError when `out` has no TCP rows or no rows for an axis point of the run.
+CampaignResult campaign_result(const TwinOutputs& out, const CampaignRun& run,
+                               const std::vector<double>& times, const Eigen::MatrixXd& history,
+                               Eigen::MatrixXd node_temperature);
+
 /// The virtual campaign from the twin: each run stepped on the reduced states and read as
-/// simulate_campaign reads the full model (named points, `sampled_nodes` through the basis rows,
-/// the TCP's thermal error through the projected influence rows). Throws SolverError when the
-/// twin has no TCP rows.
+/// simulate_campaign reads the full model (campaign_result; `sampled_nodes` through the basis
+/// rows). Throws SolverError when the twin has no TCP rows.
 std::vector<CampaignResult> twin_campaign(const Twin& twin, const std::vector<CampaignRun>& runs,
                                           const Progress& progress = {},
                                           const std::vector<int>& sampled_nodes = {});

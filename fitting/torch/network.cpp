@@ -238,6 +238,7 @@ void require_options(const NetworkOptions& o) {
   if (o.patience < 1) bad("patience", o.patience, ">= 1");
   if (o.batch_size < 1) bad("batch_size", o.batch_size, ">= 1");
   if (!(o.learning_rate > 0.0)) bad("learning_rate", o.learning_rate, "> 0");
+  if (!(o.weight_decay >= 0.0)) bad("weight_decay", o.weight_decay, ">= 0");
   if (!(o.time_budget_s > 0.0)) bad("time_budget_s", o.time_budget_s, "> 0");
   if (o.threads < 1) bad("threads", o.threads, ">= 1");
 }
@@ -419,6 +420,9 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
   impl->in_scale = column_scale(x_all, impl->in_mean);
   impl->out_mean = y_all.colwise().mean().transpose();
   impl->out_scale = column_scale(y_all, impl->out_mean);
+  if (o.common_output_scale)
+    impl->out_scale.setConstant(
+        std::sqrt(impl->out_scale.squaredNorm() / static_cast<double>(impl->out_scale.size())));
 
   // Windows: every row of the fitting groups; the validation groups', or the last fifth of each
   // fitting group's rows when there are none.
@@ -456,7 +460,14 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
     at::Generator gen = at::detail::createCPUGenerator(o.seed);
     Net net(inputs, outputs, o);
     initialise(net, gen, o.gru_hidden);
-    torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(o.learning_rate));
+    std::unique_ptr<torch::optim::Optimizer> adam;
+    if (o.weight_decay > 0.0)
+      adam = std::make_unique<torch::optim::AdamW>(
+          net->parameters(),
+          torch::optim::AdamWOptions(o.learning_rate).weight_decay(o.weight_decay));
+    else
+      adam = std::make_unique<torch::optim::Adam>(net->parameters(),
+                                                  torch::optim::AdamOptions(o.learning_rate));
     std::vector<torch::Tensor> best;
     double best_loss = std::numeric_limits<double>::infinity();
     for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
@@ -464,11 +475,11 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
       net->train();
       for (int64_t b = 0; b < nf; b += o.batch_size) {
         const torch::Tensor idx = order.slice(0, b, std::min(nf, b + o.batch_size));
-        adam.zero_grad();
+        adam->zero_grad();
         const torch::Tensor loss =
             torch::mse_loss(net->forward(x_fit.index_select(0, idx)), y_fit.index_select(0, idx));
         loss.backward();
-        adam.step();
+        adam->step();
       }
       const double loss = mean_squared(net, x_val, y_val);
       impl->report.epochs = epoch;

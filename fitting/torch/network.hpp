@@ -3,8 +3,9 @@
 // Structure: standardised input windows -> two 1-D convolutions (ReLU) -> max pooling by 2 ->
 // batch normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
 // dimension of the last GRU output -> one fully connected layer to every output at once.
-// Trained on CPU with Adam on the mean squared standardised error, early stopping on validation
-// windows and a time budget. The same seed and thread count give the same weights.
+// Trained on CPU with Adam (AdamW with weight decay) on the mean squared standardised error, early
+// stopping on validation windows and a time budget. The same seed and thread count give the same
+// weights.
 #pragma once
 
 #include <Eigen/Dense>
@@ -37,6 +38,13 @@ struct NetworkOptions {
   int patience = 25;
   int batch_size = 64;
   double learning_rate = 3e-3;
+  /// decoupled weight decay (AdamW) per unit learning rate; 0: plain Adam. Shrinking the weights
+  /// keeps the gates off saturation, so the network leaves its training range more gently
+  double weight_decay = 0.0;
+  /// one scale for every output (the root mean square of their standard deviations) instead of
+  /// each its own: the loss then weighs outputs by their size, so a network for many outputs
+  /// does not spend itself on those that are mostly noise
+  bool common_output_scale = false;
   /// wall-clock limit of training [s]; reaching it ends training with the best weights so far
   /// (then the result depends on the machine's speed: the report says so)
   double time_budget_s = 300.0;

@@ -1,8 +1,10 @@
 // The CNN-BiGRU-attention model kind (seed 004) on a short synthetic campaign: it learns a lagged
 // response better than a constant, gives the same weights and predictions twice for one seed,
-// round-trips through its TorchScript file, and is tried only with its own sensor sets.
+// round-trips through its TorchScript file, and is tried only with its own sensor sets; one network
+// trained on two targets at once (the patent's every-output model) serves both.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "core/errors.hpp"
@@ -119,6 +121,73 @@ TEST_F(Network, TriedOnlyWithItsSensorMethod) {
   EXPECT_EQ(s.candidates[3].model->features.sensors, (std::vector<int>{0, 1, 3}));
 }
 
+TEST(NetworkOfEveryOutput, OneNetworkPredictsEachTargetAndBeatsAConstant) {
+  // Two targets with different lags: one network with an output per target.
+  auto groups = campaign(6, 91, lagged_truth, 0.1 * um, 4);
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    tt::fitting::test::add_target(
+        groups[i], "x",
+        [](const Group& g) -> Eigen::VectorXd {
+          return -2.0 * um * low_pass(g.time, increment(g, 1), 900.0).array();
+        },
+        0.1 * um, 2000, i);
+  const auto fit = group_subset(groups, {0, 1, 2, 3});
+  const auto models = fitted_network_models(small_network(), fit, {0, 1, 2, 3}, {1, 0});
+  ASSERT_EQ(models.size(), 2u);
+  EXPECT_EQ(models[0].target, 1);
+  EXPECT_EQ(models[0].output, 0);
+  EXPECT_EQ(models[1].target, 0);
+  EXPECT_EQ(models[1].output, 1);
+  const auto& a = std::get<tt::torchnet::Network>(models[0].body);
+  const auto& b = std::get<tt::torchnet::Network>(models[1].body);
+  EXPECT_EQ(a.outputs(), 2);
+  EXPECT_EQ(a.flat_weights(), b.flat_weights());  // one training, shared
+  const Group& g = groups[5];
+  const Eigen::MatrixXd both = a.prediction(feature_matrix(models[0].features, g));
+  EXPECT_EQ(predicted_error(models[0], g), Eigen::VectorXd(both.col(0)));
+  EXPECT_EQ(predicted_error(models[1], g), Eigen::VectorXd(both.col(1)));
+  const auto held_out = group_subset(groups, {4, 5});
+  for (const auto& m : models) {
+    std::vector<double> s;
+    for (const Group& h : held_out) {
+      const Eigen::VectorXd e = h.error.col(m.target);
+      s.push_back(residual_std((e.array() - e.mean()).matrix()));
+    }
+    EXPECT_LT(model_accuracy(m, held_out).sm, 0.5 * accuracy(s).sm) << m.target_name;
+  }
+  // The same seed gives the same network.
+  const auto again = fitted_network_models(small_network(), fit, {0, 1, 2, 3}, {1, 0});
+  EXPECT_EQ(std::get<tt::torchnet::Network>(again[0].body).flat_weights(), a.flat_weights());
+  // One scale for both outputs: the standardisation keeps their ratio of sizes.
+  ModelSpec common = small_network();
+  common.network.options.common_output_scale = true;
+  const auto scaled = fitted_network_models(common, fit, {0, 1, 2, 3}, {1, 0});
+  const auto& c = std::get<tt::torchnet::Network>(scaled[0].body);
+  EXPECT_EQ(c.output_scale()(0), c.output_scale()(1));
+  EXPECT_NE(a.output_scale()(0), a.output_scale()(1));
+  EXPECT_NEAR(c.output_scale().squaredNorm(), a.output_scale().squaredNorm(),
+              1e-12 * a.output_scale().squaredNorm());
+  EXPECT_THROW(fitted_network_models(small_network(), fit, {0, 1}, {0, 0}), tt::core::DataError);
+  EXPECT_THROW(fitted_network_models(ModelSpec{}, fit, {0, 1}, {0, 1}), tt::core::DataError);
+}
+
+TEST_F(Network, WeightDecayShrinksTheWeightsAndStaysDeterministic) {
+  ModelSpec spec = small_network();
+  spec.network.options.weight_decay = 1.0;
+  const auto fit = group_subset(*groups_, {0, 1, 2, 3});
+  const FittedModel a = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const FittedModel b = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const auto norm = [](const FittedModel& m) {
+    double sum = 0.0;
+    for (float w : std::get<tt::torchnet::Network>(m.body).flat_weights()) sum += double(w) * w;
+    return std::sqrt(sum);
+  };
+  EXPECT_EQ(std::get<tt::torchnet::Network>(a.body).flat_weights(),
+            std::get<tt::torchnet::Network>(b.body).flat_weights());
+  EXPECT_LT(norm(a), norm(*model_));
+  EXPECT_NE(model_label(spec).find("wd=1"), std::string::npos) << model_label(spec);
+}
+
 TEST(NetworkOptions, BadSettingsNameTheKey) {
   const auto groups = campaign(3, 5, lagged_truth, 0.1 * um, 4);
   ModelSpec spec = small_network();
@@ -128,5 +197,13 @@ TEST(NetworkOptions, BadSettingsNameTheKey) {
     FAIL() << "an even kernel was accepted";
   } catch (const tt::core::DataError& e) {
     EXPECT_NE(std::string(e.what()).find("kernel_size = 4"), std::string::npos) << e.what();
+  }
+  spec = small_network();
+  spec.network.options.weight_decay = -0.1;
+  try {
+    fitted_model(spec, groups, {0, 1}, 0);
+    FAIL() << "a negative weight decay was accepted";
+  } catch (const tt::core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("weight_decay"), std::string::npos) << e.what();
   }
 }

@@ -1,22 +1,28 @@
 // The feed axis (issue: GM-1 gantry): its motion law, heat that moves with it (total power exact
 // at every step, centred on the axis position), energy closure with moving sources, the thermal
 // error along the axis and its polynomial (reproduces the points within the residual it reports),
-// and the GM-1 case files (read, resolved round trip, named points on the axis).
+// the GM-1 case files (read, resolved round trip, named points on the axis), the virtual
+// campaign's error at the axis points on the coarse GM-1 (the adjoint rows against a direct
+// elastic solve), and the axis points' models in `fit` with the polynomial from their predictions.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
+#include "app/axis_fit.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/axis_error.hpp"
+#include "solvers/campaign.hpp"
 #include "solvers/feed_axis.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/thermal_stepper.hpp"
+#include "solvers/virtual_machine.hpp"
 #include "tests/common/gantry_bar.hpp"
 
 namespace tt::gantry_test {
@@ -176,6 +182,17 @@ TEST(AxisPolynomial, ReproducesThePointsWithinTheReportedResidual) {
       EXPECT_LE(worst, poly.max[d](t) * (1 + 1e-9) + 1e-15);
       EXPECT_NEAR(std::sqrt(sq / n), poly.rms[d](t), 1e-9 * poly.rms[d](t) + 1e-15);
     }
+  // What a CNC compensating with the polynomial leaves: the values minus the fit, column by column.
+  const Eigen::MatrixXd r = solvers::axis_polynomial_residual(poly, e);
+  for (int t = 0; t < 3; ++t)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd fit = solvers::axis_polynomial_value(poly, d, t, e.positions);
+      for (int i = 0; i < n; ++i)
+        EXPECT_NEAR(r(t, 3 * i + d), e.values(t, 3 * i + d) - fit(i), 1e-18);
+    }
+  solvers::AxisError fewer = e;
+  fewer.values = e.values.topRows(2);
+  EXPECT_THROW(solvers::axis_polynomial_residual(poly, fewer), core::SolverError);
 }
 
 TEST(Gm1Case, ReadsResolvesAndRoundTrips) {
@@ -253,6 +270,143 @@ TEST(Gm1Case, BadFeedAxisInputIsRefused) {
   refused(with("[mechanical]\nenabled = false\n",
                "[mechanical]\nenabled = false\ntargets = [\"dq\"]\n"),
           "mechanical.targets[0]");
+}
+
+/// The coarse GM-1 meshed once for the cases that simulate it.
+class Gm1Coarse : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    spec_ =
+        new core::CaseSpec(io::read_case(std::string(TT_SOURCE_DIR) + "/cases/gm1_coarse.toml"));
+    mesh_ = new mesh::TetMesh(mesh::mesh_case(*spec_));
+  }
+  static void TearDownTestSuite() {
+    delete mesh_;
+    delete spec_;
+  }
+  static core::CaseSpec* spec_;
+  static mesh::TetMesh* mesh_;
+};
+core::CaseSpec* Gm1Coarse::spec_ = nullptr;
+mesh::TetMesh* Gm1Coarse::mesh_ = nullptr;
+
+TEST_F(Gm1Coarse, CampaignRecordsTheAxisPointsAsADirectElasticSolveDoes) {
+  // The campaign's first run, 40 min of P-1 with the X axis reciprocating while the spindle runs:
+  // its axis-point error read through adjoint influence rows against the displacement field of a
+  // direct thermo-elastic run (simulate) read at the points.
+  auto runs = solvers::campaign_runs(*spec_, 40.0 / 60.0, spec_->seed);
+  runs.resize(1);
+  const auto campaign = solvers::simulate_campaign(*mesh_, *spec_, runs);
+  ASSERT_EQ(campaign.size(), 1u);
+  const solvers::AxisError& got = campaign[0].axis;
+  const solvers::VirtualRun direct = solvers::simulate(*mesh_, runs[0].spec);
+  ASSERT_TRUE(direct.elastic);
+  const solvers::AxisError want =
+      solvers::axis_error(*mesh_, runs[0].spec, direct.elastic->displacement);
+  EXPECT_EQ(got.points, spec_->mechanical.axis_points);
+  ASSERT_EQ(got.values.rows(), want.values.rows());
+  ASSERT_EQ(got.values.cols(), 33);
+  EXPECT_EQ(got.positions, want.positions);
+  EXPECT_NEAR(got.positions(0), -1.25, 1e-12);
+  const double peak = want.values.cwiseAbs().maxCoeff();
+  EXPECT_GT(peak, 1e-6);  // the axis moves by microns in 40 min: a real signal
+  EXPECT_EQ(got.values.row(0).cwiseAbs().maxCoeff(), 0.0);  // relative to t = 0
+  EXPECT_LE((got.values - want.values).cwiseAbs().maxCoeff(), 1e-6 * peak);
+  std::printf("[gantry] axis points over 40 min: peak %.3f um, adjoint vs direct %.2e um\n",
+              peak * 1e6, (got.values - want.values).cwiseAbs().maxCoeff() * 1e6);
+  // The TCP's error comes from the same block solve.
+  ASSERT_TRUE(direct.error);
+  EXPECT_LE((campaign[0].error - direct.error->values).cwiseAbs().maxCoeff(),
+            1e-6 * direct.error->values.cwiseAbs().maxCoeff());
+}
+
+/// Groups as `fit` builds them on GM-1 (its 37 candidate sensors, the TCP's dy and dz, then the
+/// axis points' dx, dy, dz), with synthetic temperatures: sensor 0 heats with the run's duty and
+/// the axis grows as a cubic in position times its increment; the TCP follows sensor 1.
+std::vector<fitting::Group> synthetic_gm1_groups(const core::CaseSpec& spec, int count) {
+  const auto axis = app::axis_target_names(spec);
+  std::vector<fitting::Group> groups;
+  for (int k = 0; k < count; ++k) {
+    fitting::Group g;
+    g.name = "run" + std::to_string(k);
+    const Eigen::Index n = 121;
+    g.time = Eigen::VectorXd::LinSpaced(n, 0.0, 120 * 60.0);
+    g.temperature.resize(n, 37);
+    for (int c = 0; c < 37; ++c) {
+      g.sensor_names.push_back("s" + std::to_string(c));
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double t = g.time(i) / 3600.0;
+        g.temperature(i, c) = 293.15 + (c == 0   ? (1 + 0.3 * k) * (1 - std::exp(-t * (1 + k % 3)))
+                                        : c == 1 ? 0.5 * std::sin(t * (1 + 0.2 * k))
+                                                 : 0.1 * std::cos(c * t + k));
+      }
+    }
+    g.target_names = {"dy", "dz"};
+    for (const auto& a : axis) g.target_names.push_back(a);
+    g.error.resize(n, 2 + static_cast<Eigen::Index>(axis.size()));
+    const Eigen::VectorXd d0 = g.temperature.col(0).array() - g.temperature(0, 0);
+    const Eigen::VectorXd d1 = g.temperature.col(1).array() - g.temperature(0, 1);
+    g.error.col(0) = 2e-6 * d1;
+    g.error.col(1) = -3e-6 * d1;
+    const solvers::AxisError points = solvers::axis_error_at_points(
+        spec, Eigen::MatrixXd::Zero(1, static_cast<Eigen::Index>(axis.size())));
+    for (Eigen::Index p = 0; p < points.positions.size(); ++p) {
+      const double x = points.positions(p);
+      g.error.col(2 + 3 * p) = 4e-6 * (1 + x + 0.5 * x * x * x) * d0;  // dx: the axis grows
+      g.error.col(3 + 3 * p) = 1e-6 * x * d1;                          // dy: linear in x
+      g.error.col(4 + 3 * p) = -2e-6 * (1 - x * x) * d0;               // dz: the beam bends
+    }
+    // A nanometre of deterministic measurement noise, so that the 3σ rejection sees residuals.
+    for (Eigen::Index c = 0; c < g.error.cols(); ++c)
+      for (Eigen::Index i = 0; i < n; ++i)
+        g.error(i, c) += 1e-9 * std::sin(12.9898 * static_cast<double>(i * 131 + c * 17 + k));
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
+TEST(AxisFit, LinearModelsAtThePointsGiveThePolynomialOfTheMeasuredError) {
+  const core::CaseSpec spec = io::read_case(std::string(TT_SOURCE_DIR) + "/cases/gm1_coarse.toml");
+  const auto groups = synthetic_gm1_groups(spec, 7);
+  const fitting::Split split{{0, 1, 2, 3}, {4}, {5, 6}};
+  const app::AxisFit fit =
+      app::axis_fit(spec, groups, split, 2, {}, {fitting::ModelSpec{}}, std::nullopt, {});
+  ASSERT_EQ(fit.linear.size(), 33u);
+  EXPECT_EQ(fit.targets.front(), 2);
+  EXPECT_EQ(fit.linear.front().target_name, "A01_dx");
+  EXPECT_EQ(fit.points.size(), 11u);
+  ASSERT_EQ(fit.compensation.size(), 3u);  // no network
+  const auto& none = fit.compensation[0];
+  const auto& measured = fit.compensation[1];
+  const auto& linear = fit.compensation[2];
+  EXPECT_EQ(none.source, "uncompensated");
+  EXPECT_EQ(linear.source, "linear");
+  for (std::size_t d = 0; d < 3; ++d) {
+    EXPECT_GT(none.rms_m[d], 1e-7) << d;
+    // The error is a cubic in position: its polynomial leaves the noise only, and the linear
+    // models (exact in the increments) little more.
+    EXPECT_LT(measured.rms_m[d], 2e-9) << d;
+    EXPECT_LT(linear.rms_m[d], 1e-2 * none.rms_m[d]) << d;
+    EXPECT_GE(linear.max_m[d], linear.rms_m[d]);
+  }
+  for (std::size_t k = 0; k < fit.linear.size(); ++k) {
+    // Each target reads the sensor it depends on (where its coefficient is not zero).
+    const double x = fit.positions(static_cast<Eigen::Index>(k / 3));
+    if ((k % 3 == 1 && std::abs(x) < 1e-9) || (k % 3 == 2 && std::abs(1 - x * x) < 1e-9)) continue;
+    const auto& sensors = fit.linear[k].model.features.sensor_names;
+    const std::string want = k % 3 == 1 ? "s1" : "s0";
+    EXPECT_NE(std::find(sensors.begin(), sensors.end(), want), sensors.end())
+        << fit.linear[k].target_name;
+  }
+  const nlohmann::json j = app::axis_fit_json(fit);
+  EXPECT_EQ(j["targets"].size(), 33u);
+  EXPECT_EQ(j["degree"], 3);
+  EXPECT_LT(j["polynomial_residual"]["linear"]["dx"]["rms_um"].get<double>(),
+            j["polynomial_residual"]["uncompensated"]["dx"]["rms_um"].get<double>());
+  EXPECT_NE(app::axis_fit_markdown(fit).find("| linear |"), std::string::npos);
+  // The axis columns must be the groups' last ones.
+  EXPECT_THROW(app::axis_fit(spec, groups, split, 1, {}, {fitting::ModelSpec{}}, std::nullopt, {}),
+               core::DataError);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // The reduced-order twin through the CLI and the library, on the coarse SB-1 and GM-1 cases:
 // `reduce` then `run --rom --verify`, refusals of damaged and foreign models, and the virtual
 // campaign on the twin against the full campaign (issue 15's accuracy limits: 0.01 K at the named
-// points, the TCP drift within 1 % of its peak or 0.02 um).
+// points, the TCP and feed-axis points' drift within 1 % of its peak or 0.02 um).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -78,11 +78,11 @@ TEST_F(Twin, AnotherDutyCycleFromTheCommandLine) {
                  log = dir_ / "staircase.log";
   std::ofstream(csv) << "time_s,speed_rpm\n0,1000\n3600,2000\n7200,4000\n10800,6000\n"
                         "14400,3000\n18000,0\n";
-  ASSERT_EQ(rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--duty-cycle",
-                     csv.string(), "--end-s", "21600", "--verify", "--out", out.string(),
-                     "--quiet"},
-                    {}, log),
-            0)
+  ASSERT_EQ(
+      rt::run({"run", rt::kCoarseCase.string(), "--rom", rom_.string(), "--duty-cycle",
+               csv.string(), "--end-s", "21600", "--verify", "--out", out.string(), "--quiet"},
+              {}, log),
+      0)
       << rt::read_text(log);
   const auto s = read_json(out / "summary.json");
   EXPECT_LE(s["model"]["verify"]["max_point_temperature_error_K"].get<double>(), 0.01);
@@ -166,6 +166,16 @@ void expect_campaign_matches(const fs::path& case_file, double hours, std::size_
       const Eigen::VectorXd f = full[r].error.col(d), g = reduced[r].error.col(d);
       const double limit = std::max(0.02e-6, 0.01 * f.cwiseAbs().maxCoeff());
       EXPECT_LE((f - g).cwiseAbs().maxCoeff(), limit) << runs[r].name << " direction " << d;
+    }
+    // The feed-axis points (GM-1), under the same limit per point and direction.
+    EXPECT_EQ(full[r].axis.points, spec.mechanical.axis_points);
+    EXPECT_EQ(reduced[r].axis.points, spec.mechanical.axis_points);
+    ASSERT_EQ(full[r].axis.values.cols(), reduced[r].axis.values.cols());
+    ASSERT_EQ(full[r].axis.values.rows(), reduced[r].axis.values.rows());
+    for (Eigen::Index c = 0; c < full[r].axis.values.cols(); ++c) {
+      const Eigen::VectorXd f = full[r].axis.values.col(c), g = reduced[r].axis.values.col(c);
+      const double limit = std::max(0.02e-6, 0.01 * f.cwiseAbs().maxCoeff());
+      EXPECT_LE((f - g).cwiseAbs().maxCoeff(), limit) << runs[r].name << " axis column " << c;
     }
     std::printf("[twin] %s %s: max |dT| %.2e K, |d dy| %.2e um, |d dz| %.2e um\n",
                 case_file.filename().c_str(), runs[r].name.c_str(), dt,

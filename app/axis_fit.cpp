@@ -1,0 +1,225 @@
+#include "app/axis_fit.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "fitting/metrics.hpp"
+#include "solvers/axis_error.hpp"
+
+namespace tt::app {
+
+namespace {
+
+constexpr const char* kDirections[3] = {"dx", "dy", "dz"};
+
+/// The axis points' error on one group, as the CNC's polynomial sees it: columns of `values`
+/// (#samples x 3 #points [m]).
+solvers::AxisError axis_values(const AxisFit& fit, Eigen::MatrixXd values) {
+  return solvers::AxisError{fit.points, fit.positions, std::move(values)};
+}
+
+/// Sums of squares, counts and largest |residual| per direction, over groups.
+struct Tally {
+  std::array<double, 3> squares{}, count{}, max{};
+  void add(const Eigen::MatrixXd& residual) {
+    for (Eigen::Index c = 0; c < residual.cols(); ++c) {
+      const auto d = static_cast<std::size_t>(c % 3);
+      squares[d] += residual.col(c).squaredNorm();
+      count[d] += static_cast<double>(residual.rows());
+      max[d] = std::max(max[d], residual.col(c).cwiseAbs().maxCoeff());
+    }
+  }
+  AxisCompensation result(const std::string& source) const {
+    AxisCompensation a{source, {}, {}};
+    for (std::size_t d = 0; d < 3; ++d) {
+      a.rms_m[d] = count[d] > 0 ? std::sqrt(squares[d] / count[d]) : std::nan("");
+      a.max_m[d] = max[d];
+    }
+    return a;
+  }
+};
+
+nlohmann::json um(double v) {
+  return std::isfinite(v) ? nlohmann::json(v * 1e6) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+std::vector<std::string> axis_target_names(const core::CaseSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& id : spec.mechanical.axis_points)
+    for (const char* d : kDirections) names.push_back(id + "_" + d);
+  return names;
+}
+
+double uncompensated_std(const std::vector<fitting::Group>& groups, const std::vector<int>& which,
+                         int target) {
+  double sum = 0;
+  for (int i : which) {
+    const Eigen::VectorXd e = groups[static_cast<std::size_t>(i)].error.col(target);
+    sum += fitting::residual_std((e.array() - e.mean()).matrix());
+  }
+  return sum / static_cast<double>(which.size());
+}
+
+AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& groups,
+                 const fitting::Split& split, int first_target,
+                 const std::vector<fitting::SensorSet>& extra_sets,
+                 const std::vector<fitting::ModelSpec>& specs,
+                 const std::optional<fitting::ModelSpec>& network,
+                 const std::vector<int>& network_sensors) {
+  if (split.test.empty())
+    throw core::DataError("the feed axis's models with no test group; expected at least one");
+  AxisFit fit;
+  fit.degree = spec.mechanical.axis_polynomial_degree;
+  const auto n = static_cast<int>(spec.mechanical.axis_points.size());
+  const int columns = static_cast<int>(groups.front().error.cols());
+  if (first_target < 0 || first_target + 3 * n != columns)
+    throw core::DataError("the groups have " + std::to_string(columns) +
+                          " error columns; expected the axis points' 3 x " + std::to_string(n) +
+                          " from column " + std::to_string(first_target) + " to the last");
+  // 1. Linear models per axis target, chosen on validation like the TCP's.
+  const std::vector<fitting::Group> fitting_groups = fitting::group_subset(groups, split.fitting);
+  for (int t = first_target; t < columns; ++t) {
+    std::vector<fitting::SensorSet> sets = fitting::correlation_sensor_sets(fitting_groups, t, 4);
+    for (auto& s : sets) s.method = "db3401_correlation";
+    sets.insert(sets.end(), extra_sets.begin(), extra_sets.end());
+    fit.targets.push_back(t);
+    fit.linear.push_back(fitting::evaluation(groups, split, t, sets, specs));
+    fit.uncompensated_std.push_back(uncompensated_std(groups, split.test, t));
+  }
+  // 2. The patent's network: every error column at once, trained on fitting and validation
+  //    groups (the last of them stops it early), tested on the test groups.
+  const std::vector<fitting::Group> test = fitting::group_subset(groups, split.test);
+  if (network) {
+    std::vector<int> refit = split.fitting;
+    refit.insert(refit.end(), split.validation.begin(), split.validation.end());
+    std::vector<int> all(static_cast<std::size_t>(columns));
+    for (int t = 0; t < columns; ++t) all[static_cast<std::size_t>(t)] = t;
+    // One scale for all outputs: the loss weighs them by size, so the 100 um dx of the far axis
+    // points counts for more than the 1 um dz that is mostly noise.
+    fitting::ModelSpec every_output = *network;
+    every_output.network.options.common_output_scale = true;
+    fit.network = fitting::fitted_network_models(every_output, fitting::group_subset(groups, refit),
+                                                 network_sensors, all);
+    for (const auto& m : fit.network) fit.network_test.push_back(fitting::model_accuracy(m, test));
+  }
+  // 3. The axis polynomial at every test time from each source, judged at the points.
+  const solvers::AxisError first = solvers::axis_error_at_points(
+      spec, Eigen::MatrixXd::Zero(1, 3 * static_cast<Eigen::Index>(n)));
+  fit.points = first.points;
+  fit.positions = first.positions;
+  Tally none, measured, linear, net;
+  for (const fitting::Group& g : test) {
+    const solvers::AxisError truth = axis_values(fit, g.error.rightCols(3 * n));
+    none.add(truth.values);
+    const auto residual_of = [&](Eigen::MatrixXd estimate) {
+      const auto poly = solvers::axis_polynomial(axis_values(fit, std::move(estimate)), fit.degree);
+      return solvers::axis_polynomial_residual(poly, truth);
+    };
+    measured.add(residual_of(truth.values));
+    Eigen::MatrixXd p(g.time.size(), 3 * n);
+    for (int k = 0; k < 3 * n; ++k) p.col(k) = fitting::predicted_error(fit.linear[k].model, g);
+    linear.add(residual_of(p));
+    if (!fit.network.empty()) {
+      for (int k = 0; k < 3 * n; ++k)
+        p.col(k) = fitting::predicted_error(fit.network[first_target + k], g);
+      net.add(residual_of(p));
+    }
+  }
+  fit.compensation = {none.result("uncompensated"), measured.result("measured"),
+                      linear.result("linear")};
+  if (!fit.network.empty()) fit.compensation.push_back(net.result("network"));
+  return fit;
+}
+
+nlohmann::json axis_fit_json(const AxisFit& fit) {
+  nlohmann::json targets = nlohmann::json::object();
+  for (std::size_t k = 0; k < fit.linear.size(); ++k) {
+    const auto& e = fit.linear[k];
+    const auto& chosen = e.sensor_sets[static_cast<std::size_t>(
+        e.selection.candidates[static_cast<std::size_t>(e.selection.best)].sensor_set)];
+    nlohmann::json t{{"method", chosen.method},
+                     {"sensors", e.model.features.sensor_names},
+                     {"model", fitting::model_label(e.model.spec)},
+                     {"test_sm_um", um(e.test.sm)},
+                     {"uncompensated_std_um", um(fit.uncompensated_std[k])}};
+    if (!fit.network.empty())
+      t["network_test_sm_um"] = um(fit.network_test[static_cast<std::size_t>(fit.targets[k])].sm);
+    targets[e.target_name] = t;
+  }
+  nlohmann::json polynomial = nlohmann::json::object();
+  for (const auto& c : fit.compensation)
+    for (int d = 0; d < 3; ++d) {
+      polynomial[c.source][kDirections[d]] = {{"rms_um", um(c.rms_m[static_cast<std::size_t>(d)])},
+                                              {"max_um", um(c.max_m[static_cast<std::size_t>(d)])}};
+    }
+  nlohmann::json j{
+      {"points", fit.points},
+      {"positions_m",
+       std::vector<double>(fit.positions.data(), fit.positions.data() + fit.positions.size())},
+      {"degree", fit.degree},
+      {"test_groups", fit.linear.empty() ? nlohmann::json::array()
+                                         : nlohmann::json(fit.linear.front().test_groups)},
+      {"targets", targets},
+      {"polynomial_residual", polynomial}};
+  if (!fit.network.empty()) {
+    const auto& net = std::get<torchnet::Network>(fit.network.front().body);
+    nlohmann::json test = nlohmann::json::object();
+    for (std::size_t k = 0; k < fit.network.size(); ++k)
+      test[fit.network[k].target_name] = um(fit.network_test[k].sm);
+    j["network"] = {{"model", fitting::model_label(fit.network.front().spec)},
+                    {"sensors", fit.network.front().features.sensor_names},
+                    {"fitted_on", fit.network.front().fitted_on},
+                    {"outputs", net.outputs()},
+                    {"training_seconds", net.report().seconds},
+                    {"epochs", net.report().epochs},
+                    {"best_epoch", net.report().best_epoch},
+                    {"time_budget_reached", net.report().budget_reached},
+                    {"test_sm_um", test}};
+  }
+  return j;
+}
+
+std::string axis_fit_markdown(const AxisFit& fit) {
+  std::ostringstream o;
+  o.precision(3);
+  o << "# The feed axis: models at the axis points and the axis polynomial\n\n"
+    << fit.points.size() << " axis points, polynomial of degree " << fit.degree
+    << " fitted at every time of the test groups";
+  if (!fit.linear.empty()) {
+    o << " (";
+    for (std::size_t i = 0; i < fit.linear.front().test_groups.size(); ++i)
+      o << (i ? ", " : "") << fit.linear.front().test_groups[i];
+    o << ")";
+  }
+  o << " from each source's estimate of the axis points' error; what it leaves at the points, "
+       "against the measured (simulated, with sensor noise) error.\n\n"
+    << "| source | dx RMS [um] | dx max [um] | dy RMS [um] | dy max [um] | dz RMS [um] | dz max "
+       "[um] |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& c : fit.compensation) {
+    o << "| " << c.source;
+    for (std::size_t d = 0; d < 3; ++d) o << " | " << c.rms_m[d] * 1e6 << " | " << c.max_m[d] * 1e6;
+    o << " |\n";
+  }
+  o << "\n\"measured\" is the polynomial of the measured error itself: what no model's "
+       "polynomial can beat.\n\n"
+    << "| target | chosen linear model | sensors | test S_M [um] | network test S_M [um] | "
+       "uncompensated std [um] |\n|---|---|---|---|---|---|\n";
+  for (std::size_t k = 0; k < fit.linear.size(); ++k) {
+    const auto& e = fit.linear[k];
+    o << "| " << e.target_name << " | " << fitting::model_label(e.model.spec) << " | ";
+    for (std::size_t s = 0; s < e.model.features.sensor_names.size(); ++s)
+      o << (s ? ", " : "") << e.model.features.sensor_names[s];
+    o << " | " << e.test.sm * 1e6 << " | ";
+    if (fit.network.empty())
+      o << "-";
+    else
+      o << fit.network_test[static_cast<std::size_t>(fit.targets[k])].sm * 1e6;
+    o << " | " << fit.uncompensated_std[k] * 1e6 << " |\n";
+  }
+  return o.str();
+}
+
+}  // namespace tt::app
