@@ -11,6 +11,7 @@
 #include "core/errors.hpp"
 #include "core/rng.hpp"
 #include "core/units.hpp"
+#include "mesh/mesher.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal.hpp"
 
@@ -348,14 +349,17 @@ std::vector<Patch> box_patches(const mesh::TetMesh& m, const ExteriorFaces& ext,
                                const std::vector<Eigen::Vector3d>& centres, double half) {
   std::vector<Patch> out;
   std::set<std::vector<int>> seen;
+  // The case's selectors' tolerance: the group written for a patch (augmented_case) holds the
+  // same faces, also those whose centroid lies on the box's edge.
+  const double tol = mesh::selection_tolerance(m.nodes);
   for (const Eigen::Vector3d& c : centres) {
     // One patch per boundary group and body in the box: heat through the bore is not heat through
     // the housing's outside, nor heat into the shaft across the gap, and a patch mixing them would
     // sit at neither.
     std::map<std::pair<int, int>, Patch> by_place;
     for (size_t e = 0; e < ext.face.size(); ++e) {
-      if ((ext.centroid[e].array() < (c.array() - half)).any() ||
-          (ext.centroid[e].array() > (c.array() + half)).any())
+      if ((ext.centroid[e].array() < (c.array() - half - tol)).any() ||
+          (ext.centroid[e].array() > (c.array() + half + tol)).any())
         continue;
       const int f = ext.face[e];
       const int body = core::index_of(m.tet_region[static_cast<size_t>(m.face_tet[f])]);

@@ -286,9 +286,7 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
   // Boundary groups: ordinary groups in order first, then the "rest" groups in order.
   for (const auto& grp : spec.groups) m.group_names.push_back(grp.name);
   m.face_group.assign(picked.size(), core::BoundaryId{-1});
-  Eigen::AlignedBox3d box;
-  for (const auto& p : nodes) box.extend(p);
-  const double tol = 1e-7 * box.diagonal().norm();
+  const double tol = selection_tolerance(m.nodes);
   for (int pass = 0; pass < 2; ++pass) {
     for (size_t gi = 0; gi < spec.groups.size(); ++gi) {
       if (spec.groups[gi].rest != (pass == 1)) continue;
@@ -415,6 +413,11 @@ MeshReport mesh_report(const TetMesh& m, const core::CaseSpec& spec) {
   for (const auto& p : m.points)
     r.point_distance.push_back((m.nodes.row(p.node).transpose() - p.position).norm());
   return r;
+}
+
+double selection_tolerance(const NodeMatrix& nodes) {
+  if (nodes.rows() == 0) return 0;
+  return 1e-7 * (nodes.colwise().maxCoeff() - nodes.colwise().minCoeff()).norm();
 }
 
 }  // namespace tt::mesh

@@ -63,4 +63,10 @@ std::vector<double> tet_volumes(const TetMesh& mesh);
 /// Area of every face [m^2].
 std::vector<double> face_areas(const TetMesh& mesh);
 
+/// The tolerance of the case's face selectors [m]: a face whose centroid lies within it outside a
+/// selector's box (or off its plane or cylinder) still belongs to the group; 1e-7 of the diagonal
+/// of the nodes' bounding box. Code that picks faces by the same boxes (calibration's heat-input
+/// patches) uses it too, so that a patch and the group written for it hold the same faces.
+double selection_tolerance(const NodeMatrix& nodes);
+
 }  // namespace tt::mesh
