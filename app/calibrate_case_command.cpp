@@ -201,7 +201,17 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
          << e["score"].get<double>() << " (noise threshold " << res.selection.null_score
          << ", floor " << e["model_form_floor"].get<double>() << ")\n  - parameters: `"
          << e["parameters"].dump() << "`\n  - location: `" << e["location"].dump() << "`\n";
+    for (const auto& e : res.effects)
+      if (e.contains("refit") && e["refit"].contains("linearised"))
+        md << "- " << e["name"].get<std::string>() << ": refitted about the updated model in "
+           << e["refit"]["iterations"].get<int>() << " Gauss–Newton step(s)"
+           << (e["refit"]["converged"].get<bool>() ? "" : " (iteration cap reached)")
+           << ": linearised `" << e["refit"]["linearised"].dump() << "`, refitted `"
+           << e["refit"]["refitted"].dump() << "`\n";
   }
+  for (const auto& e : res.refit_rejected)
+    md << "- not claimed: " << e["name"].get<std::string>() << ", whose size refitted about "
+       << "the updated model is unphysical (" << e.value("unphysical", "") << ")\n";
   md << "\n## Runners-up\n\nA candidate marked unphysical needs a value outside its bounds "
         "(docs/calibration.md) to fit and is never claimed, however well it scores.\n\n"
         "| kind | name | explained fraction | score | unphysical |\n| --- | --- | --- | --- | --- "

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include "calibration_checks.hpp"
 #include "core/errors.hpp"
@@ -229,6 +230,99 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
   const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
   std::printf("[calibration] air read from the sensor: test RMS u %.4g -> %.4g um\n",
               b.displacement_rms_um, a.displacement_rms_um);
+  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+}
+
+// Issue 16 item 2: heat that grows with temperature feeds back on itself, so its response is
+// not linear in the coefficient, and the fit linearised about the declared model's cooler
+// bearings overstates it. A coefficient of 0.07 /K on the front bearing (within the generator's
+// 0.02-0.08 range) is fitted visibly off by the linearisation; the refit about the updated model
+// must find it within 10 %: the declared model's own error against the generator's finer truth
+// (0.0023 K over the sensors) and the noise leave a few per cent (measured: docs/calibration.md,
+// "Refit").
+TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
+  const Study& s = study();
+  InjectedEffect e;
+  e.present = true;
+  e.kind = EffectKind::temperature_dependent_heat;
+  e.target = "front_bearing_friction";
+  e.magnitude = 0.07;
+  std::mt19937_64 rng = core::generator(31, 1);
+  std::vector<io::MeasuredRun> clean;
+  const auto runs = testing::effect_runs(s, e, rng, &clean);
+  const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, {}).dump(1);
+  const nlohmann::json& claim = res.effects[0];
+  ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
+  EXPECT_EQ(claim["location"]["source"], "front_bearing_friction");
+  ASSERT_TRUE(claim.contains("refit")) << claim.dump(1);
+  const double linearised =
+      claim["refit"]["linearised"]["temperature_coefficient_per_K"].get<double>();
+  const double refitted = claim["refit"]["refitted"]["temperature_coefficient_per_K"].get<double>();
+  const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
+  const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
+  const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
+  std::printf(
+      "[calibration] refit: true %.4g /K, linearised %.4g (%+.1f %%), refitted %.4g (%+.1f %%) in "
+      "%d steps (%s); whitened SS %.1f -> %.1f; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
+      e.magnitude, linearised, 100 * (linearised / e.magnitude - 1), refitted,
+      100 * (refitted / e.magnitude - 1), claim["refit"]["iterations"].get<int>(),
+      claim["refit"]["converged"].get<bool>() ? "converged" : "cap",
+      claim["refit"]["whitened_ss_at_linearised"].get<double>(),
+      claim["refit"]["whitened_ss_at_refitted"].get<double>(), b.displacement_rms_um,
+      a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
+  // The draw must show the linearisation's error, or the test shows nothing.
+  EXPECT_GT(std::abs(linearised / e.magnitude - 1), 0.10);
+  EXPECT_NEAR(refitted, e.magnitude, 0.10 * e.magnitude);
+  EXPECT_TRUE(claim["refit"]["converged"].get<bool>());
+  EXPECT_LT(claim["refit"]["whitened_ss_at_refitted"].get<double>(),
+            claim["refit"]["whitened_ss_at_linearised"].get<double>());
+  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+}
+
+// Issue 16 item 3: two undeclared effects at once, a film changed and a heat input, found as a
+// pair: both kinds claimed (scored jointly among the first round's best), both sized by the refit
+// about the model updated with the other.
+TEST(Pairs, TwoEffectsAreClaimedTogether) {
+  const Study& s = study();
+  std::mt19937_64 rng = core::generator(41, 1);
+  const InjectedEffect film = random_effect(EffectKind::boundary_conductance, s.declared,
+                                            s.gen_mesh, s.inst.sensor_points, rng);
+  const InjectedEffect heat =
+      random_effect(EffectKind::heat_input, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
+  std::vector<io::MeasuredRun> runs, clean;
+  for (int k = 0; k < 3; ++k) {
+    // The film first: the heat input's new group copies the covered group's (changed) film.
+    const core::CaseSpec t =
+        truth_case(truth_case(s.gen, film, s.duties[k], k), heat, s.duties[k], k);
+    clean.push_back(clean_run(s.gen_mesh, t, InjectedEffect{}, s.inst, s.gopt,
+                              (k < 2 ? "train " : "test ") + std::to_string(k)));
+    runs.push_back(with_noise(clean.back(), s.gopt, rng));
+  }
+  const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
+  const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
+  const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
+  std::printf("[calibration] two effects: %s %+.3g on %s, %s %.3g W at (%.3f, %.3f, %.3f)\n",
+              kind_name(film.kind).c_str(), film.magnitude, film.target.c_str(),
+              kind_name(heat.kind).c_str(), heat.magnitude, heat.centre(0), heat.centre(1),
+              heat.centre(2));
+  for (const auto& p : res.selection.pairs)
+    std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f %s\n",
+                p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first,
+                p.adds_second, p.admissible ? "admissible" : "");
+  for (const auto& e : res.effects)
+    std::printf("[calibration]   claimed %s: %s\n", e["name"].get<std::string>().c_str(),
+                e["parameters"].dump().c_str());
+  std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
+              res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
+              a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
+  ASSERT_EQ(res.effects.size(), 2u) << calibration_json(res, {}).dump(1);
+  std::set<std::string> kinds{res.effects[0]["kind"], res.effects[1]["kind"]};
+  EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "heat_input"}));
+  EXPECT_FALSE(res.selection.pairs.empty());
   EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
 }
 
