@@ -288,7 +288,14 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
                             const CalibrationOptions& o) {
   CalibrationResult res;
   const mesh::TetMesh& mesh = model.mesh();
-  res.selection = select_effects(train, o);
+  // Nonlinear candidates judged on their size, not on their linearisation's (refit_alone).
+  auto resizer = [&](const Catalogue& c) -> Resizer {
+    const Eigen::VectorXd sigma = noise_sigma(c.runs, c.readout.sensors, o);
+    return [&model, &declared, &c, sigma, &o](const EffectFit& f) {
+      return refit_alone(model, declared, c, f, sigma, o);
+    };
+  };
+  res.selection = select_effects(train, o, resizer(train));
   // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
   // grids around the best ones, and the choice made again with those candidates, so that the
   // noise rule and the ranking see them too.
@@ -299,7 +306,7 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
       refined = with_refined_heat_inputs(model, train, o);
     else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
       refined = with_refined_lag(train, first.sensor, first.time_constant, o);
-    if (refined) res.selection = select_effects(*refined, o);
+    if (refined) res.selection = select_effects(*refined, o, resizer(*refined));
   }
   const Catalogue& cat = refined ? *refined : train;
   const Readout& r = cat.readout;

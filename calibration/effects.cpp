@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -980,6 +981,43 @@ PairFit pair_fit(const Catalogue& cat, const std::vector<Whitened>& ws,
   return pf;
 }
 
+/// `cat` with the columns of its best nonlinear candidates whose linearised fit is unphysical
+/// replaced by their secant responses at the size `resize` finds (their `linearised` parameters
+/// kept by candidate); nothing when no candidate needs it.
+std::optional<Catalogue> resized_catalogue(const Catalogue& cat, const CalibrationOptions& o,
+                                           const Resizer& resize,
+                                           std::map<int, std::vector<double>>& linearised) {
+  const Eigen::VectorXd sigma = noise_sigma(cat.runs, cat.readout.sensors, o);
+  std::vector<Whitened> ws;
+  std::vector<Eigen::VectorXd> ys;
+  for (const auto& rm : cat.runs) {
+    ws.push_back(whitened(rm, sigma));
+    ys.push_back(ws.back().y);
+  }
+  std::vector<EffectFit> fits = score_all(cat, ws, ys, sigma, o, true);
+  std::vector<size_t> order(fits.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return fits[a].score > fits[b].score; });
+  std::optional<Catalogue> out;
+  int done = 0;
+  for (size_t i : order) {
+    const EffectFit& f = fits[i];
+    if (done >= o.resize_pool || f.score <= 0) break;
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (!nonlinear_in_parameter(c) || c.per_run || f.parameters.size() != 1 ||
+        unphysical_reason(c, f.parameters, {}, cat.runs, o).empty())
+      continue;
+    ++done;
+    Resized r = resize(f);
+    if (r.columns.size() != cat.runs.size()) continue;  // no size found: stays as linearised
+    if (!out) out = cat;
+    out->candidates[i].columns = std::move(r.columns);
+    linearised[f.candidate] = f.parameters;
+  }
+  return out;
+}
+
 /// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
 /// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
 void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
@@ -1142,11 +1180,22 @@ Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
   return out;
 }
 
-Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
-  if (cat.runs.size() < 2)
+Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
+                         const Resizer& resize) {
+  if (given.runs.size() < 2)
     throw core::DataError(
-        "calibration needs at least two training runs (got " + std::to_string(cat.runs.size()) +
+        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
         "): effects are chosen by how much they explain on a run held out from the fit");
+  std::map<int, std::vector<double>> linearised;
+  const std::optional<Catalogue> resized =
+      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
+  const Catalogue& cat = resized ? *resized : given;
+  // A resized candidate's fits report the linearised parameters it was found unphysical at.
+  auto mark = [&](std::vector<EffectFit>& fits) {
+    for (auto& f : fits)
+      if (const auto it = linearised.find(f.candidate); it != linearised.end())
+        f.linearised = it->second;
+  };
   Selection sel;
   const auto& r = cat.readout;
   sel.sigma = noise_sigma(cat.runs, r.sensors, o);
@@ -1191,6 +1240,7 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
   std::vector<int> first_order;
   for (int round = 0; round < o.max_effects; ++round) {
     std::vector<EffectFit> fits = score_all(cat, ws, current, sel.sigma, o, true);
+    mark(fits);
     for (auto& f : fits) {
       const Candidate& c = cat.candidates[f.candidate];
       const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());

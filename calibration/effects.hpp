@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -48,7 +49,7 @@ struct CalibrationOptions {
   int max_effects = 2;
   /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
   /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
-  int pair_pool = 6, pair_pool_per_kind = 2;
+  int pair_pool = 8, pair_pool_per_kind = 3;
   std::uint64_t seed = 20260107;
   // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
   // that needs a value outside these to fit is reported as unphysical and never claimed.
@@ -69,6 +70,7 @@ struct CalibrationOptions {
   // parameter moves by less than `refit_tolerance_sigmas` of its standard error (or by less than
   // `refit_tolerance_rel` of its value), at most `refit_max_iterations` steps.
   int refit_max_iterations = 8;
+  int resize_pool = 4;  /// candidates select_effects sizes about their update at most
   double refit_tolerance_sigmas = 0.05, refit_tolerance_rel = 1e-3;
 };
 
@@ -230,7 +232,22 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
 /// the greedy claims when it scores above them by more than the spread of the per-run gains (or,
 /// against one greedy claim, by more than the noise threshold and floor). Needs at least two
 /// runs.
-Selection select_effects(const Catalogue& cat, const CalibrationOptions& options);
+/// A candidate's size found about the model it updates (refit_alone): its parameters and, per
+/// training run, its secant response per unit parameter ((#samples #channels) x 1: the updated
+/// model's channels minus the declared model's, over the size). Empty columns: no size found.
+struct Resized {
+  std::vector<double> parameters;
+  std::vector<Eigen::MatrixXd> columns;
+};
+using Resizer = std::function<Resized(const EffectFit&)>;
+
+/// With `resize`, the best `options.resize_pool` candidates that are not linear in their parameter
+/// and whose linearised fit is unphysical are first sized about the model they update, and their
+/// columns replaced by the secant responses at that size, so that they are scored, judged and
+/// paired as what they do at their size, not as their first-order shadow (a film halved needs
+/// h -> 0 to its linearisation); their fits keep the linearised parameters in `linearised`.
+Selection select_effects(const Catalogue& cat, const CalibrationOptions& options,
+                         const Resizer& resize = {});
 
 /// Why `p` (fitted parameters of `c`; for a per-run air, `run_parameters` per run) is not
 /// physical on `runs` (the speeds their duty cycles use), empty when it is. Sets `duty_correlation`

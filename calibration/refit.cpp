@@ -24,6 +24,14 @@ struct Claims {
   const Candidate& candidate(size_t k) const {
     return cat->candidates.at(static_cast<size_t>(fits[k].candidate));
   }
+  /// Whether every shared claim is physical at `theta` on the catalogue's runs.
+  bool physical(const Eigen::VectorXd& theta, const CalibrationOptions& o) const {
+    for (size_t k = 0; k < fits.size(); ++k)
+      if (slot[k] >= 0 &&
+          !unphysical_reason(candidate(k), {theta(slot[k])}, {}, cat->runs, o).empty())
+        return false;
+    return true;
+  }
   bool changes_operators() const {
     for (size_t k = 0; k < fits.size(); ++k)
       if (candidate(k).kind == EffectKind::material_parameter && candidate(k).field != "expansion")
@@ -54,6 +62,7 @@ AugmentedCase updated_case(const core::CaseSpec& base, const Claims& cl,
 struct Step {
   Eigen::VectorXd y;
   Eigen::MatrixXd jacobian;
+  Eigen::MatrixXd prediction;  /// #samples x #channels [K | m]
 };
 
 Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared,
@@ -121,7 +130,7 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
   RunModel now = rm;
   now.base = prediction;
   const Whitened w = whitened(now, sigma);
-  return {w.y, whitened_rows(jac, w, sigma)};
+  return {w.y, whitened_rows(jac, w, sigma), prediction};
 }
 
 /// Gauss–Newton on the claims' shared parameters from their linearised values.
@@ -135,7 +144,7 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
   double ss_first = 0, ss_last = std::numeric_limits<double>::infinity();
   Eigen::VectorXd last_theta = theta, step = Eigen::VectorXd::Zero(p);
   int iterations = 0;
-  bool converged = false;
+  bool converged = false, at_bound = false;
   for (int it = 0; it < o.refit_max_iterations; ++it) {
     // The operators of the updated model: the declared case's with the claims' materials.
     std::optional<MarchModel> own;
@@ -169,6 +178,15 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
     for (Eigen::Index k = 0; k < p; ++k)
       converged &= std::abs(step(k)) <= std::max(o.refit_tolerance_sigmas * se(k),
                                                  o.refit_tolerance_rel * std::abs(theta(k)));
+    // The step stays within the physical bounds (a film clamped at 5 % of its h stops
+    // responding, and Gauss–Newton would walk on): halved until it does; a fit that still
+    // leaves them runs into its bound, and its size is not found.
+    for (int cut = 0; cut < 8 && !cl.physical(theta + step, o); ++cut) step /= 2;
+    if (!cl.physical(theta + step, o)) {
+      at_bound = true;
+      converged = false;
+      break;
+    }
     theta += step;
     ++iterations;
     if (converged) break;
@@ -180,6 +198,8 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
     f.refit_ss_linearised = ss_first;
     f.refit_ss = ss_last;
     if (cl.slot[k] < 0) continue;
+    if (at_bound)
+      f.unphysical = "refitted about the updated model, its size runs into the physical bounds";
     if (f.linearised.empty()) f.linearised = f.parameters;
     f.parameters = {theta(cl.slot[k])};
   }
@@ -196,6 +216,35 @@ bool wants_refit(const Claims& cl) {
 }
 
 }  // namespace
+
+Resized refit_alone(const MarchModel& model, const core::CaseSpec& declared, const Catalogue& cat,
+                    const EffectFit& fit, const Eigen::VectorXd& sigma,
+                    const CalibrationOptions& o) {
+  Claims cl;
+  cl.cat = &cat;
+  cl.fits = {fit};
+  cl.slot = {0};
+  EffectFit& f = cl.fits[0];
+  const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
+  for (int k = 0; k < 6 && !unphysical_reason(c, f.parameters, {}, cat.runs, o).empty(); ++k)
+    f.parameters[0] /= 2;
+  gauss_newton(model, declared, cl, sigma, o);
+  Resized out;
+  out.parameters = f.parameters;
+  if (!f.unphysical.empty()) return out;  // no physical size: it stays as linearised
+  const double size = f.parameters.at(0);
+  if (size == 0 || !std::isfinite(size)) return out;
+  // The secant response at the size: the updated model's channels minus the declared model's.
+  std::optional<MarchModel> own;
+  const Eigen::VectorXd theta = Eigen::VectorXd::Constant(1, size);
+  if (cl.changes_operators())
+    own.emplace(model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec));
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    const Step s = linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma);
+    out.columns.push_back(vec(s.prediction - cat.runs[ri].base) / size);
+  }
+  return out;
+}
 
 Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
                         const Catalogue& cat, Selection sel, const CalibrationOptions& o) {
@@ -218,7 +267,8 @@ Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
     std::vector<EffectFit> kept;
     for (auto& f : cl.fits) {
       const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
-      f.unphysical = unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o);
+      if (f.unphysical.empty())
+        f.unphysical = unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o);
       if (f.unphysical.empty())
         kept.push_back(f);
       else

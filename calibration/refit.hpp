@@ -26,4 +26,12 @@ namespace tt::calibration {
 Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
                         const Catalogue& cat, Selection sel, const CalibrationOptions& options);
 
+/// `fit` (a candidate of `cat` not linear in its parameter) sized alone about the declared model
+/// updated with it, as refit_claimed does, from its linearised value halved towards zero until it
+/// is physical (the linearisation overstates a film's or a feedback's size), with its secant
+/// responses at that size. select_effects' Resizer.
+Resized refit_alone(const MarchModel& model, const core::CaseSpec& declared, const Catalogue& cat,
+                    const EffectFit& fit, const Eigen::VectorXd& sigma,
+                    const CalibrationOptions& options);
+
 }  // namespace tt::calibration
