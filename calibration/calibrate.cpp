@@ -509,7 +509,11 @@ nlohmann::json calibration_json(const CalibrationResult& res,
        "fitted parameters are unphysical (field `unphysical`) is never claimed; when the best "
        "candidate of another kind that would be claimed too scores less than the spread of the "
        "two candidates' per-run held-out gain differences (sqrt(#runs) x their standard "
-       "deviation) below the best, neither is claimed and both are reported as `ambiguous`"},
+       "deviation) below the best, neither is claimed and both are reported as `ambiguous`; the best "
+       "pair of the first round's best candidates, scored jointly, replaces the claims made one "
+       "after the other when it scores above them by more than that spread and each member adds "
+       "more than the noise threshold and its floor to the other (`pairs`, `claimed_by`); the "
+       "claims' sizes are then refitted about the updated model by Gauss-Newton (`refit`)"},
       {"null_score", res.selection.null_score},
       {"training_residual_whitened_ss", res.selection.residual_ss},
       {"noise_sigma_per_channel", sigma}};
