@@ -1267,7 +1267,7 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
         const std::string key = kind_name(c.kind) + c.location.dump();
         if (!places.insert(key).second) continue;
         sel.ranking.push_back(fits[i]);
-        if (sel.ranking.size() >= 8) break;
+        if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
       }
     }
     // The best physical candidate, claimed when it beats noise and floor and no candidate of

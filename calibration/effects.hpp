@@ -47,6 +47,9 @@ struct CalibrationOptions {
   double noise_floor_K = 0.005, noise_floor_m = 0.01e-6;  /// least noise assumed per channel
   int null_trials = 10;                                   /// fits to pure noise for the threshold
   int max_effects = 2;
+  /// Candidates of the first round reported (best per kind and place): the several-places
+  /// candidates and the pairs' pool need more than the eight that one place each gave.
+  int ranking_size = 12;
   /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
   /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
   int pair_pool = 8, pair_pool_per_kind = 3;
@@ -209,7 +212,7 @@ struct PairFit {
 
 struct Selection {
   std::vector<EffectFit> claimed;  /// claimed effects, most important first
-  std::vector<EffectFit> ranking;  /// best candidate per (kind, place) of the first round
+  std::vector<EffectFit> ranking;  /// best per (kind, place) of the first round, ranking_size
   std::vector<Ambiguity> ambiguous;  /// the round at which the choice stopped undecided, if any
   /// Claims whose size, refitted about the updated model, is unphysical: not claimed.
   std::vector<EffectFit> refit_rejected;
