@@ -407,14 +407,14 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
   res.ambiguous = ambiguity_json(cat, res.selection);
   res.pairs = nlohmann::json::array();
   for (const auto& p : res.selection.pairs)
-    res.pairs.push_back({{"candidates", {effect_json(cat, p.first, false),
-                                         effect_json(cat, p.second, false)}},
-                         {"score", p.score},
-                         {"heldout_gain", p.heldout_gain},
-                         {"heldout_gain_per_training_run", p.fold_gains},
-                         {"adds_to_second_alone", p.adds_first},
-                         {"adds_to_first_alone", p.adds_second},
-                         {"admissible", p.admissible}});
+    res.pairs.push_back(
+        {{"candidates", {effect_json(cat, p.first, false), effect_json(cat, p.second, false)}},
+         {"score", p.score},
+         {"heldout_gain", p.heldout_gain},
+         {"heldout_gain_per_training_run", p.fold_gains},
+         {"adds_to_second_alone", p.adds_first},
+         {"adds_to_first_alone", p.adds_second},
+         {"admissible", p.admissible}});
   res.refit_rejected = nlohmann::json::array();
   for (const auto& f : res.selection.refit_rejected)
     res.refit_rejected.push_back(effect_json(cat, f, false));
@@ -495,8 +495,8 @@ nlohmann::json calibration_json(const CalibrationResult& res,
   j["ambiguous"] = res.ambiguous;
   j["refit_rejected"] = res.refit_rejected;
   j["pairs"] = res.pairs;
-  j["claimed_by"] = res.selection.by_pair ? "the best pair scored jointly"
-                                          : "one effect after the other";
+  j["claimed_by"] =
+      res.selection.by_pair ? "the best pair scored jointly" : "one effect after the other";
   nlohmann::json sigma = nlohmann::json::array();
   for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
     sigma.push_back(res.selection.sigma(c));
@@ -509,7 +509,8 @@ nlohmann::json calibration_json(const CalibrationResult& res,
        "fitted parameters are unphysical (field `unphysical`) is never claimed; when the best "
        "candidate of another kind that would be claimed too scores less than the spread of the "
        "two candidates' per-run held-out gain differences (sqrt(#runs) x their standard "
-       "deviation) below the best, neither is claimed and both are reported as `ambiguous`; the best "
+       "deviation) below the best, neither is claimed and both are reported as `ambiguous`; the "
+       "best "
        "pair of the first round's best candidates, scored jointly, replaces the claims made one "
        "after the other when it scores above them by more than that spread and each member adds "
        "more than the noise threshold and its floor to the other (`pairs`, `claimed_by`); the "

@@ -482,7 +482,8 @@ std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
       const Candidate* one = single(kind, entries[k]);
       if (!one) return;
       for (size_t ri = 0; ri < one->columns.size(); ++ri) {
-        if (c.columns.size() <= ri) c.columns.push_back(Eigen::MatrixXd::Zero(one->columns[ri].rows(), 1));
+        if (c.columns.size() <= ri)
+          c.columns.push_back(Eigen::MatrixXd::Zero(one->columns[ri].rows(), 1));
         c.columns[ri] += weights[k] * one->columns[ri];
       }
       for (size_t j = 0; j < one->unit_loads.size(); ++j) {
@@ -514,8 +515,7 @@ std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
     const std::string which = v ? "every film of an unfixed group" : "every film";
     const nlohmann::json where = {{"groups", v ? g_free : g_all}, {"share_of_h", true}};
     add(EffectKind::speed_dependent_convection, entries, v ? h_free : h_all,
-        which + " growing with speed by one share of its h", where,
-        "h_speed_gain / h" + at_ref);
+        which + " growing with speed by one share of its h", where, "h_speed_gain / h" + at_ref);
     add(EffectKind::boundary_conductance, entries, v ? h_free : h_all,
         which + " changed by one share of its h", where, "delta_h / h");
   }
@@ -526,8 +526,8 @@ std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
     names.push_back(declared.thermal.sources[i].name);
   }
   add(EffectKind::temperature_dependent_heat, sources, std::vector<double>(sources.size(), 1.0),
-      "heat of every source growing with its temperature by one coefficient",
-      {{"sources", names}}, "temperature_coefficient_per_K");
+      "heat of every source growing with its temperature by one coefficient", {{"sources", names}},
+      "temperature_coefficient_per_K");
   for (auto& c : added) cands.push_back(std::move(c));
   return cands;
 }
@@ -1043,7 +1043,8 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
   const auto best =
       std::find_if(pairs.begin(), pairs.end(), [](const PairFit& p) { return p.admissible; });
-  sel.pairs.assign(pairs.begin(), pairs.begin() + std::min<std::ptrdiff_t>(5, pairs.end() - pairs.begin()));
+  sel.pairs.assign(pairs.begin(),
+                   pairs.begin() + std::min<std::ptrdiff_t>(5, pairs.end() - pairs.begin()));
   // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
   if (best == pairs.end() || sel.claimed.empty()) return;
   for (const auto& f : sel.claimed) {

@@ -170,10 +170,10 @@ struct EffectFit {
   std::string name;
   std::vector<double> parameters;                   /// shared parameters
   std::vector<std::vector<double>> run_parameters;  /// per run (per-run candidates)
-  double heldout_gain = 0;        /// whitened sum of squares removed on held-out runs
-  double score = 0;               /// heldout_gain - penalty
-  double explained_fraction = 0;  /// share of the training residual's whitened SS removed alone
-  double floor = 0;               /// model-form allowance for this candidate
+  double heldout_gain = 0;         /// whitened sum of squares removed on held-out runs
+  double score = 0;                /// heldout_gain - penalty
+  double explained_fraction = 0;   /// share of the training residual's whitened SS removed alone
+  double floor = 0;                /// model-form allowance for this candidate
   std::vector<double> fold_gains;  /// held-out gain per training run (sums to heldout_gain)
   std::string unphysical;          /// why the fitted parameters are not physical; empty: they are
   double duty_correlation = 0;     /// per-run air: correlation of the fitted air with the speed
@@ -211,8 +211,8 @@ struct PairFit {
 };
 
 struct Selection {
-  std::vector<EffectFit> claimed;  /// claimed effects, most important first
-  std::vector<EffectFit> ranking;  /// best per (kind, place) of the first round, ranking_size
+  std::vector<EffectFit> claimed;    /// claimed effects, most important first
+  std::vector<EffectFit> ranking;    /// best per (kind, place) of the first round, ranking_size
   std::vector<Ambiguity> ambiguous;  /// the round at which the choice stopped undecided, if any
   /// Claims whose size, refitted about the updated model, is unphysical: not claimed.
   std::vector<EffectFit> refit_rejected;
@@ -220,9 +220,9 @@ struct Selection {
   /// when the claims are the best admissible pair rather than the greedy choice.
   std::vector<PairFit> pairs;
   bool by_pair = false;
-  double null_score = 0;           /// best score over fits to pure noise
-  Eigen::VectorXd sigma;           /// per channel noise estimate [K | m]
-  double residual_ss = 0;          /// training residual, whitened
+  double null_score = 0;   /// best score over fits to pure noise
+  Eigen::VectorXd sigma;   /// per channel noise estimate [K | m]
+  double residual_ss = 0;  /// training residual, whitened
 };
 
 /// Per channel white-noise level from second differences of the residuals (robust, pooled).

@@ -65,9 +65,8 @@ struct Step {
   Eigen::MatrixXd prediction;  /// #samples x #channels [K | m]
 };
 
-Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared,
-                       const Claims& cl, const Eigen::VectorXd& theta, size_t ri,
-                       const Eigen::VectorXd& sigma) {
+Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared, const Claims& cl,
+                       const Eigen::VectorXd& theta, size_t ri, const Eigen::VectorXd& sigma) {
   const RunModel& rm = cl.cat->runs[ri];
   const Readout& r = cl.cat->readout;
   const AugmentedCase aug = updated_case(rm.spec, cl, theta, ri);

@@ -312,13 +312,13 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
               kind_name(heat.kind).c_str(), heat.magnitude, heat.centre(0), heat.centre(1),
               heat.centre(2));
   for (const auto& f : res.selection.ranking)
-    std::printf("[calibration]   rank %s: score %.1f p %.4g (linearised %.4g) %s\n",
-                f.name.c_str(), f.score, f.parameters.empty() ? 0.0 : f.parameters[0],
+    std::printf("[calibration]   rank %s: score %.1f p %.4g (linearised %.4g) %s\n", f.name.c_str(),
+                f.score, f.parameters.empty() ? 0.0 : f.parameters[0],
                 f.linearised.empty() ? 0.0 : f.linearised[0], f.unphysical.c_str());
   for (const auto& p : res.selection.pairs)
     std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f %s\n",
-                p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first,
-                p.adds_second, p.admissible ? "admissible" : "");
+                p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
+                p.admissible ? "admissible" : "");
   for (const auto& e : res.effects)
     std::printf("[calibration]   claimed %s: %s\n", e["name"].get<std::string>().c_str(),
                 e["parameters"].dump().c_str());
