@@ -143,7 +143,8 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
   double ss_first = 0, ss_last = std::numeric_limits<double>::infinity();
   Eigen::VectorXd last_theta = theta, step = Eigen::VectorXd::Zero(p);
   int iterations = 0;
-  bool converged = false, at_bound = false;
+  bool converged = false;
+  Eigen::VectorXd beyond;  /// the step that left the bounds, when one did
   for (int it = 0; it < o.refit_max_iterations; ++it) {
     // The operators of the updated model: the declared case's with the claims' materials.
     std::optional<MarchModel> own;
@@ -182,7 +183,7 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
     // leaves them runs into its bound, and its size is not found.
     for (int cut = 0; cut < 8 && !cl.physical(theta + step, o); ++cut) step /= 2;
     if (!cl.physical(theta + step, o)) {
-      at_bound = true;
+      beyond = theta + step;
       converged = false;
       break;
     }
@@ -197,7 +198,8 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
     f.refit_ss_linearised = ss_first;
     f.refit_ss = ss_last;
     if (cl.slot[k] < 0) continue;
-    if (at_bound)
+    if (beyond.size() &&
+        !unphysical_reason(cl.candidate(k), {beyond(cl.slot[k])}, {}, cl.cat->runs, o).empty())
       f.unphysical = "refitted about the updated model, its size runs into the physical bounds";
     if (f.linearised.empty()) f.linearised = f.parameters;
     f.parameters = {theta(cl.slot[k])};

@@ -283,19 +283,26 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
 }
 
-// Issue 16 item 3: two undeclared effects at once, a film changed and a heat input, found as a
-// pair: both kinds claimed (scored jointly among the first round's best), both sized by the refit
-// about the model updated with the other.
+// Issue 16 item 3: two undeclared effects at once, the shaft's outer film doubled and the front
+// bearing's heat growing by 4 %/K, both not linear in their parameter: both kinds claimed (scored
+// jointly among the first round's best, or one after the other), both sized by the refit about the
+// model updated with the other. (A random heat-input draw is not used here: its box is drawn on the
+// generator's mesh, whose faces move with the build's floating point.)
 TEST(Pairs, TwoEffectsAreClaimedTogether) {
   const Study& s = study();
   std::mt19937_64 rng = core::generator(41, 1);
-  const InjectedEffect film = random_effect(EffectKind::boundary_conductance, s.declared,
-                                            s.gen_mesh, s.inst.sensor_points, rng);
-  const InjectedEffect heat =
-      random_effect(EffectKind::heat_input, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
+  InjectedEffect film;
+  film.present = true;
+  film.kind = EffectKind::boundary_conductance;
+  film.target = "shaft_outside";
+  film.magnitude = 1.0;
+  InjectedEffect heat;
+  heat.present = true;
+  heat.kind = EffectKind::temperature_dependent_heat;
+  heat.target = "front_bearing_friction";
+  heat.magnitude = 0.04;
   std::vector<io::MeasuredRun> runs, clean;
   for (int k = 0; k < 3; ++k) {
-    // The film first: the heat input's new group copies the covered group's (changed) film.
     const core::CaseSpec t =
         truth_case(truth_case(s.gen, film, s.duties[k], k), heat, s.duties[k], k);
     clean.push_back(clean_run(s.gen_mesh, t, InjectedEffect{}, s.inst, s.gopt,
@@ -307,10 +314,9 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
   const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
   const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
   const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
-  std::printf("[calibration] two effects: %s %+.3g on %s, %s %.3g W at (%.3f, %.3f, %.3f)\n",
+  std::printf("[calibration] two effects: %s %+.3g on %s, %s %.3g /K on %s\n",
               kind_name(film.kind).c_str(), film.magnitude, film.target.c_str(),
-              kind_name(heat.kind).c_str(), heat.magnitude, heat.centre(0), heat.centre(1),
-              heat.centre(2));
+              kind_name(heat.kind).c_str(), heat.magnitude, heat.target.c_str());
   for (const auto& f : res.selection.ranking)
     std::printf("[calibration]   rank %s: score %.1f p %.4g (linearised %.4g) %s\n", f.name.c_str(),
                 f.score, f.parameters.empty() ? 0.0 : f.parameters[0],
@@ -320,14 +326,14 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
                 p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
                 p.admissible ? "admissible" : "");
   for (const auto& e : res.effects)
-    std::printf("[calibration]   claimed %s: %s\n", e["name"].get<std::string>().c_str(),
-                e["parameters"].dump().c_str());
+    std::printf("[calibration]   claimed %s: %s, refit %s\n", e["name"].get<std::string>().c_str(),
+                e["parameters"].dump().c_str(), e.value("refit", nlohmann::json{}).dump().c_str());
   std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
               res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
               a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
   ASSERT_EQ(res.effects.size(), 2u) << calibration_json(res, {}).dump(1);
   std::set<std::string> kinds{res.effects[0]["kind"], res.effects[1]["kind"]};
-  EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "heat_input"}));
+  EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
   EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
 }
