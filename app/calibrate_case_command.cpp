@@ -6,8 +6,8 @@
 // inputs), DIR/augmented/<run>.toml per test run, DIR/sensor_corrections.json, DIR/residuals.csv
 // and the figures residual_before_after.png and effect.png.
 #include <cctype>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -72,15 +72,16 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const mesh::TetMesh mesh = mesh::mesh_case(declared);
   calibration::CalibrationOptions options;
   options.seed = declared.seed;
-  say(std::to_string(mesh.nodes.rows()) + " nodes; locating the channels (probes: elastic "
+  say(std::to_string(mesh.nodes.rows()) +
+      " nodes; locating the channels (probes: elastic "
       "influence rows)");
   const calibration::Readout r = calibration::readout(mesh, declared, train.front());
   // The model the candidates' responses are marched on: reduced (its basis holds the channels'
   // Krylov vectors, so that every candidate's response at the channels is kept) unless --full.
   const auto tm = Clock::now();
-  say(args.full ? "model: full order (" + std::to_string(mesh.nodes.rows()) +
-                      " nodes), as --full asks"
-                : "model: building the reduced model on the channels (--full for the full order)");
+  say(args.full
+          ? "model: full order (" + std::to_string(mesh.nodes.rows()) + " nodes), as --full asks"
+          : "model: building the reduced model on the channels (--full for the full order)");
   const calibration::MarchModel model =
       args.full ? calibration::MarchModel(mesh, declared)
                 : calibration::MarchModel(mesh, declared, r, solvers::ReductionOptions{});
@@ -152,8 +153,7 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
       }
     }
   write_text(dir / "residuals.csv", csv.str());
-  plot({"residuals", (dir / "residuals.csv").string(),
-        (dir / "residual_before_after.png").string(),
+  plot({"residuals", (dir / "residuals.csv").string(), (dir / "residual_before_after.png").string(),
         "--effect-out=" + (dir / "effect.png").string()});
 
   std::ostringstream md;
@@ -201,7 +201,17 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
          << e["score"].get<double>() << " (noise threshold " << res.selection.null_score
          << ", floor " << e["model_form_floor"].get<double>() << ")\n  - parameters: `"
          << e["parameters"].dump() << "`\n  - location: `" << e["location"].dump() << "`\n";
+    for (const auto& e : res.effects)
+      if (e.contains("refit") && e["refit"].contains("linearised"))
+        md << "- " << e["name"].get<std::string>() << ": refitted about the updated model in "
+           << e["refit"]["iterations"].get<int>() << " Gauss–Newton step(s)"
+           << (e["refit"]["converged"].get<bool>() ? "" : " (iteration cap reached)")
+           << ": linearised `" << e["refit"]["linearised"].dump() << "`, refitted `"
+           << e["refit"]["refitted"].dump() << "`\n";
   }
+  for (const auto& e : res.refit_rejected)
+    md << "- not claimed: " << e["name"].get<std::string>() << ", whose size refitted about "
+       << "the updated model is unphysical (" << e.value("unphysical", "") << ")\n";
   md << "\n## Runners-up\n\nA candidate marked unphysical needs a value outside its bounds "
         "(docs/calibration.md) to fit and is never claimed, however well it scores.\n\n"
         "| kind | name | explained fraction | score | unphysical |\n| --- | --- | --- | --- | --- "

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include "calibration/refit.hpp"
 #include "core/errors.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
@@ -45,6 +46,14 @@ void insert_group(core::CaseSpec& spec, int at, core::BoundaryGroup g) {
 
 nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p) {
   nlohmann::json j;
+  // A change in several places: the common parameter and each place's share (location order).
+  auto spread = [&](double v) -> nlohmann::json {
+    if (c.entries.size() <= 1) return v * (c.weights.empty() ? 1.0 : c.weights[0]);
+    j["common_parameter"] = v;
+    nlohmann::json each = nlohmann::json::array();
+    for (double w : c.weights) each.push_back(v * w);
+    return each;
+  };
   switch (c.kind) {
     case EffectKind::ambient_temperature:
       j["knots_s"] = c.knots;
@@ -57,15 +66,15 @@ nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p)
       if (c.law == "speed") j["ref_speed_rpm"] = c.ref_speed_rpm;
       break;
     case EffectKind::speed_dependent_convection:
-      j["h_speed_gain_W_m2K"] = p.at(0);
+      j["h_speed_gain_W_m2K"] = spread(p.at(0));
       j["speed_ref_rpm"] = c.ref_speed_rpm;
       j["speed_exponent"] = 1.0;
       break;
     case EffectKind::temperature_dependent_heat:
-      j["temperature_coefficient_per_K"] = p.at(0);
+      j["temperature_coefficient_per_K"] = spread(p.at(0));
       break;
     case EffectKind::boundary_conductance:
-      j["delta_h_W_m2K"] = p.at(0);
+      j["delta_h_W_m2K"] = spread(p.at(0));
       break;
     case EffectKind::material_parameter:
       j["relative_change"] = p.at(0);
@@ -195,21 +204,25 @@ AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
       }
       break;
     }
-    case EffectKind::speed_dependent_convection: {
-      auto& cv = conv.at(static_cast<size_t>(c.group));
-      cv.h_speed_gain = std::max(0.0, cv.h_speed_gain + p.at(0));
-      cv.speed_ref_rpm = c.ref_speed_rpm;
-      cv.speed_exponent = 1.0;
+    case EffectKind::speed_dependent_convection:
+      for (size_t k = 0; k < c.entries.size(); ++k) {
+        auto& cv = conv.at(static_cast<size_t>(c.entries[k]));
+        cv.h_speed_gain = std::max(0.0, cv.h_speed_gain + p.at(0) * c.weights.at(k));
+        cv.speed_ref_rpm = c.ref_speed_rpm;
+        cv.speed_exponent = 1.0;
+      }
       break;
-    }
     case EffectKind::temperature_dependent_heat:
-      s.thermal.sources.at(static_cast<size_t>(c.source)).temperature_coefficient += p.at(0);
+      for (size_t k = 0; k < c.entries.size(); ++k)
+        s.thermal.sources.at(static_cast<size_t>(c.entries[k])).temperature_coefficient +=
+            p.at(0) * c.weights.at(k);
       break;
-    case EffectKind::boundary_conductance: {
-      auto& cv = conv.at(static_cast<size_t>(c.group));
-      cv.h = std::max(0.05 * cv.h, cv.h + p.at(0));
+    case EffectKind::boundary_conductance:
+      for (size_t k = 0; k < c.entries.size(); ++k) {
+        auto& cv = conv.at(static_cast<size_t>(c.entries[k]));
+        cv.h = std::max(0.05 * cv.h, cv.h + p.at(0) * c.weights.at(k));
+      }
       break;
-    }
     case EffectKind::material_parameter: {
       auto& mat = s.materials.at(static_cast<size_t>(c.material));
       const double factor = std::max(0.1, 1 + p.at(0));
@@ -275,7 +288,14 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
                             const CalibrationOptions& o) {
   CalibrationResult res;
   const mesh::TetMesh& mesh = model.mesh();
-  res.selection = select_effects(train, o);
+  // Nonlinear candidates judged on their size, not on their linearisation's (refit_alone).
+  auto resizer = [&](const Catalogue& c) -> Resizer {
+    const Eigen::VectorXd sigma = noise_sigma(c.runs, c.readout.sensors, o);
+    return [&model, &declared, &c, sigma, &o](const EffectFit& f) {
+      return refit_alone(model, declared, c, f, sigma, o);
+    };
+  };
+  res.selection = select_effects(train, o, resizer(train));
   // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
   // grids around the best ones, and the choice made again with those candidates, so that the
   // noise rule and the ranking see them too.
@@ -286,10 +306,12 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
       refined = with_refined_heat_inputs(model, train, o);
     else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
       refined = with_refined_lag(train, first.sensor, first.time_constant, o);
-    if (refined) res.selection = select_effects(*refined, o);
+    if (refined) res.selection = select_effects(*refined, o, resizer(*refined));
   }
   const Catalogue& cat = refined ? *refined : train;
   const Readout& r = cat.readout;
+  // The claims' sizes about the model they update, not their linearisation about the declared one.
+  res.selection = refit_claimed(model, declared, cat, res.selection, o);
   // Per-run effects need their own fit on each test run (the air temperature is a signal of the
   // run, not of the machine): the ambient columns for the test runs.
   bool per_run = false;
@@ -383,6 +405,19 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
     if (!is_claimed) res.runners_up.push_back(describe(f, false));
   }
   res.ambiguous = ambiguity_json(cat, res.selection);
+  res.pairs = nlohmann::json::array();
+  for (const auto& p : res.selection.pairs)
+    res.pairs.push_back(
+        {{"candidates", {effect_json(cat, p.first, false), effect_json(cat, p.second, false)}},
+         {"score", p.score},
+         {"heldout_gain", p.heldout_gain},
+         {"heldout_gain_per_training_run", p.fold_gains},
+         {"adds_to_second_alone", p.adds_first},
+         {"adds_to_first_alone", p.adds_second},
+         {"admissible", p.admissible}});
+  res.refit_rejected = nlohmann::json::array();
+  for (const auto& f : res.selection.refit_rejected)
+    res.refit_rejected.push_back(effect_json(cat, f, false));
   return res;
 }
 
@@ -409,6 +444,20 @@ nlohmann::json effect_json(const Catalogue& cat, const EffectFit& f, bool claime
   j["heldout_gain_per_training_run"] = f.fold_gains;
   if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
   if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
+  if (f.refit_iterations > 0) {
+    // Per-run parameters and lags are held as fitted while the others are refitted about them.
+    nlohmann::json refit = {{"iterations", f.refit_iterations},
+                            {"converged", f.refit_converged},
+                            {"whitened_ss_at_linearised", f.refit_ss_linearised},
+                            {"whitened_ss_at_refitted", f.refit_ss}};
+    if (f.linearised.empty()) {
+      refit["held_as_fitted"] = true;
+    } else {
+      refit["linearised"] = parameters_json(c, f.linearised);
+      refit["refitted"] = parameters_json(c, f.parameters);
+    }
+    j["refit"] = refit;
+  }
   j["claimed"] = claimed;
   return j;
 }
@@ -444,6 +493,10 @@ nlohmann::json calibration_json(const CalibrationResult& res,
   j["effects"] = res.effects;
   j["runners_up"] = res.runners_up;
   j["ambiguous"] = res.ambiguous;
+  j["refit_rejected"] = res.refit_rejected;
+  j["pairs"] = res.pairs;
+  j["claimed_by"] =
+      res.selection.by_pair ? "the best pair scored jointly" : "one effect after the other";
   nlohmann::json sigma = nlohmann::json::array();
   for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
     sigma.push_back(res.selection.sigma(c));
@@ -456,7 +509,12 @@ nlohmann::json calibration_json(const CalibrationResult& res,
        "fitted parameters are unphysical (field `unphysical`) is never claimed; when the best "
        "candidate of another kind that would be claimed too scores less than the spread of the "
        "two candidates' per-run held-out gain differences (sqrt(#runs) x their standard "
-       "deviation) below the best, neither is claimed and both are reported as `ambiguous`"},
+       "deviation) below the best, neither is claimed and both are reported as `ambiguous`; the "
+       "best "
+       "pair of the first round's best candidates, scored jointly, replaces the claims made one "
+       "after the other when it scores above them by more than that spread and each member adds "
+       "more than the noise threshold and its floor to the other (`pairs`, `claimed_by`); the "
+       "claims' sizes are then refitted about the updated model by Gauss-Newton (`refit`)"},
       {"null_score", res.selection.null_score},
       {"training_residual_whitened_ss", res.selection.residual_ss},
       {"noise_sigma_per_channel", sigma}};

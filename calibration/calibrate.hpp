@@ -64,6 +64,13 @@ struct CalibrationResult {
   /// Mechanisms the choice could not tell apart (Selection::ambiguous): each {candidates: [two
   /// descriptions as in `effects`], score_difference, spread, distinguishing_channel, hint}.
   nlohmann::json ambiguous;
+  /// Claims whose size refitted about the updated model is unphysical (Selection::refit_rejected),
+  /// described as in `effects`: not claimed.
+  nlohmann::json refit_rejected;
+  /// Selection::pairs: each {candidates: [two descriptions with the joint parameters], score,
+  /// heldout_gain, heldout_gain_per_training_run, adds_to_second_alone, adds_to_first_alone,
+  /// admissible}.
+  nlohmann::json pairs;
 };
 
 /// The description of a fitted candidate in calibration.json (`effects`, `runners_up`): kind, name,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -16,15 +17,6 @@
 #include "solvers/thermal.hpp"
 
 namespace tt::calibration {
-
-namespace {
-
-/// Whitened residual rows of one run: vec(#samples x #channels) / sigma, with the mask of rows.
-struct Whitened {
-  Eigen::VectorXd y;               /// kept rows
-  std::vector<Eigen::Index> rows;  /// indices into the column-major vec
-  std::vector<int> channel;        /// channel of each kept row
-};
 
 Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma) {
   Whitened w;
@@ -42,19 +34,13 @@ Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma) {
   return w;
 }
 
-Eigen::MatrixXd rows_of(const Eigen::MatrixXd& a, const Whitened& w, const Eigen::VectorXd& sigma) {
+Eigen::MatrixXd whitened_rows(const Eigen::MatrixXd& a, const Whitened& w,
+                              const Eigen::VectorXd& sigma) {
   Eigen::MatrixXd out(static_cast<Eigen::Index>(w.rows.size()), a.cols());
   for (size_t k = 0; k < w.rows.size(); ++k)
     out.row(static_cast<Eigen::Index>(k)) = a.row(w.rows[k]) / sigma(w.channel[k]);
   return out;
 }
-
-/// Normal-equation pieces of one candidate on one run.
-struct Normal {
-  Eigen::MatrixXd g;  /// A^T A
-  Eigen::VectorXd b;  /// A^T y
-  double s = 0;       /// y^T y
-};
 
 Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, double ridge) {
   const Eigen::Index p = g.rows();
@@ -62,6 +48,28 @@ Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, 
   Eigen::MatrixXd a = g + (ridge * scale) * Eigen::MatrixXd::Identity(p, p);
   return a.ldlt().solve(b);
 }
+
+bool nonlinear_in_parameter(const Candidate& c) {
+  switch (c.kind) {
+    case EffectKind::speed_dependent_convection:
+    case EffectKind::boundary_conductance:
+    case EffectKind::temperature_dependent_heat:
+      return true;
+    case EffectKind::material_parameter:
+      return c.field != "expansion";  // the readout's change is exact in it
+    default:
+      return false;
+  }
+}
+
+namespace {
+
+/// Normal-equation pieces of one candidate on one run.
+struct Normal {
+  Eigen::MatrixXd g;  /// A^T A
+  Eigen::VectorXd b;  /// A^T y
+  double s = 0;       /// y^T y
+};
 
 double gain_of(const Normal& n, const Eigen::VectorXd& theta) {
   return 2 * theta.dot(n.b) - theta.dot(n.g * theta);
@@ -236,29 +244,37 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
       return {};
     case EffectKind::speed_dependent_convection:
     case EffectKind::boundary_conductance: {
-      const core::Convection& cv = spec.thermal.convection.at(static_cast<size_t>(c.group));
       const bool speed_law = c.kind == EffectKind::speed_dependent_convection;
-      if (speed_law && cv.h_speed_gain + p.at(0) < 0)
-        return "a film falling with speed (gain " + number(cv.h_speed_gain + p.at(0)) +
-               " W/m2K at " + number(c.ref_speed_rpm) + " rpm): the gain must be >= 0";
-      for (double n : speeds_used(runs)) {
-        const double h = solvers::film_coefficient(cv, n) +
-                         p.at(0) * (speed_law ? (n > 0 ? n / c.ref_speed_rpm : 0.0) : 1.0);
-        if (h <= 0)
-          return "film coefficient after the change " + number(h) + " W/m2K at " + number(n) +
-                 " rpm: must be > 0";
+      for (size_t k = 0; k < c.entries.size(); ++k) {
+        const core::Convection& cv = spec.thermal.convection.at(static_cast<size_t>(c.entries[k]));
+        const double change = p.at(0) * c.weights.at(k);
+        const std::string where =
+            c.entries.size() > 1 ? " on " + spec.groups.at(static_cast<size_t>(cv.group)).name : "";
+        if (speed_law && cv.h_speed_gain + change < 0)
+          return "a film falling with speed" + where + " (gain " +
+                 number(cv.h_speed_gain + change) + " W/m2K at " + number(c.ref_speed_rpm) +
+                 " rpm): the gain must be >= 0";
+        for (double n : speeds_used(runs)) {
+          const double h = solvers::film_coefficient(cv, n) +
+                           change * (speed_law ? (n > 0 ? n / c.ref_speed_rpm : 0.0) : 1.0);
+          if (h <= 0)
+            return "film coefficient after the change" + where + " " + number(h) + " W/m2K at " +
+                   number(n) + " rpm: must be > 0";
+        }
       }
       return {};
     }
-    case EffectKind::temperature_dependent_heat: {
-      const double a =
-          spec.thermal.sources.at(static_cast<size_t>(c.source)).temperature_coefficient + p.at(0);
-      if (a < o.temperature_coefficient_min_per_K || a > o.temperature_coefficient_max_per_K)
-        return "temperature coefficient after the change " + number(a) + " 1/K: outside " +
-               number(o.temperature_coefficient_min_per_K) + " .. " +
-               number(o.temperature_coefficient_max_per_K) + " 1/K";
+    case EffectKind::temperature_dependent_heat:
+      for (size_t k = 0; k < c.entries.size(); ++k) {
+        const auto& src = spec.thermal.sources.at(static_cast<size_t>(c.entries[k]));
+        const double a = src.temperature_coefficient + p.at(0) * c.weights.at(k);
+        if (a < o.temperature_coefficient_min_per_K || a > o.temperature_coefficient_max_per_K)
+          return "temperature coefficient after the change" +
+                 (c.entries.size() > 1 ? " of " + src.name : std::string()) + " " + number(a) +
+                 " 1/K: outside " + number(o.temperature_coefficient_min_per_K) + " .. " +
+                 number(o.temperature_coefficient_max_per_K) + " 1/K";
+      }
       return {};
-    }
     case EffectKind::material_parameter:
       if (p.at(0) < o.material_change_min || p.at(0) > o.material_change_max)
         return c.field + " changed by " + number(100 * p.at(0)) + " %: outside " +
@@ -441,6 +457,85 @@ Candidate lag_candidate(const std::vector<RunModel>& runs, const Readout& r, int
   return l;
 }
 
+/// `cands` with mechanisms that act in several places at once with one parameter, their columns
+/// and unit loads the weighted sums of the single places' (no further march): every film (and
+/// every film of a group that is not fixed, the air's) growing with speed, or changed, by the same
+/// share of its declared h; every heat source's heat growing with temperature by one coefficient.
+std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
+                                           const core::CaseSpec& declared, double ref_speed) {
+  const auto& conv = declared.thermal.convection;
+  auto single = [&](EffectKind kind, int entry) -> const Candidate* {
+    for (const auto& c : cands)
+      if (c.kind == kind && c.entries == std::vector<int>{entry}) return &c;
+    return nullptr;
+  };
+  std::vector<Candidate> added;
+  auto add = [&](EffectKind kind, const std::vector<int>& entries,
+                 const std::vector<double>& weights, const std::string& name,
+                 const nlohmann::json& location, const std::string& parameter) {
+    if (entries.size() < 2) return;
+    Candidate c;
+    c.kind = kind;
+    c.entries = entries;
+    c.weights = weights;
+    c.ref_speed_rpm = ref_speed;
+    c.name = name;
+    c.location = location;
+    c.parameters = {parameter};
+    for (size_t k = 0; k < entries.size(); ++k) {
+      const Candidate* one = single(kind, entries[k]);
+      if (!one) return;
+      for (size_t ri = 0; ri < one->columns.size(); ++ri) {
+        if (c.columns.size() <= ri)
+          c.columns.push_back(Eigen::MatrixXd::Zero(one->columns[ri].rows(), 1));
+        c.columns[ri] += weights[k] * one->columns[ri];
+      }
+      for (size_t j = 0; j < one->unit_loads.size(); ++j) {
+        c.unit_loads.push_back(one->unit_loads[j]);
+        c.unit_weights.push_back(weights[k] * one->unit_weights.at(j));
+      }
+    }
+    added.push_back(std::move(c));
+  };
+  std::vector<int> all, free;
+  std::vector<double> h_all, h_free;
+  nlohmann::json g_all = nlohmann::json::array(), g_free = nlohmann::json::array();
+  const auto& fixed = declared.mechanical.fixed_groups;
+  for (size_t e = 0; e < conv.size(); ++e) {
+    const std::string g = declared.groups[conv[e].group].name;
+    all.push_back(static_cast<int>(e));
+    h_all.push_back(conv[e].h);
+    g_all.push_back(g);
+    if (std::find(fixed.begin(), fixed.end(), conv[e].group) == fixed.end()) {
+      free.push_back(static_cast<int>(e));
+      h_free.push_back(conv[e].h);
+      g_free.push_back(g);
+    }
+  }
+  const std::string at_ref = " at " + std::to_string(ref_speed) + " rpm";
+  for (int v = 0; v < 2; ++v) {
+    const auto& entries = v ? free : all;
+    if (v && free.size() == all.size()) break;
+    const std::string which = v ? "every film of an unfixed group" : "every film";
+    const nlohmann::json where = {{"groups", v ? g_free : g_all}, {"share_of_h", true}};
+    add(EffectKind::speed_dependent_convection, entries, v ? h_free : h_all,
+        which + " growing with speed by one share of its h", where, "h_speed_gain / h" + at_ref);
+    add(EffectKind::boundary_conductance, entries, v ? h_free : h_all,
+        which + " changed by one share of its h", where, "delta_h / h");
+  }
+  std::vector<int> sources;
+  nlohmann::json names = nlohmann::json::array();
+  for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
+    sources.push_back(static_cast<int>(i));
+    names.push_back(declared.thermal.sources[i].name);
+  }
+  add(EffectKind::temperature_dependent_heat, sources, std::vector<double>(sources.size(), 1.0),
+      "heat of every source growing with its temperature by one coefficient", {{"sources", names}},
+      "temperature_coefficient_per_K");
+  for (auto& c : added) cands.push_back(std::move(c));
+  return cands;
+}
+
 }  // namespace
 
 std::vector<Patch> surface_patches(const mesh::TetMesh& m, double spacing, double half) {
@@ -561,6 +656,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
         Candidate c = heat_candidate(p, law, ref_speed, declared);
         sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
         sep.push_back(heat_column(m, p, c));
+        c.unit_separable = {sep.back()};
+        c.unit_weights = {1};
         cands.push_back(std::move(c));
       }
     }
@@ -571,7 +668,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
         Candidate c;
         c.kind =
             speed_law ? EffectKind::speed_dependent_convection : EffectKind::boundary_conductance;
-        c.group = static_cast<int>(e);
+        c.entries = {static_cast<int>(e)};
+        c.weights = {1};
         c.ref_speed_rpm = ref_speed;
         c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
         c.location = {{"group", gname}};
@@ -581,6 +679,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
         lc.name = c.name;
         lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
         sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+        c.unit_loads = {lc};
+        c.unit_weights = {1};
         loads.push_back(std::move(lc));
         cands.push_back(std::move(c));
       }
@@ -591,7 +691,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       const auto& srcspec = declared.thermal.sources[i];
       Candidate c;
       c.kind = EffectKind::temperature_dependent_heat;
-      c.source = static_cast<int>(i);
+      c.entries = {static_cast<int>(i)};
+      c.weights = {1};
       c.name = "heat of " + srcspec.name + " growing with its temperature";
       c.location = {{"source", srcspec.name}, {"body", declared.bodies[srcspec.body].name}};
       c.parameters = {"temperature_coefficient_per_K"};
@@ -599,6 +700,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       lc.name = c.name;
       lc.form = SourceGrowth{static_cast<int>(i), t0_k};
       sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+      c.unit_loads = {lc};
+      c.unit_weights = {1};
       loads.push_back(std::move(lc));
       cands.push_back(std::move(c));
     }
@@ -639,6 +742,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
           lc.name = c.name;
           lc.form = std::move(change);
           sources.push_back({Source::load, {static_cast<int>(loads.size())}});
+          c.unit_loads = {lc};
+          c.unit_weights = {1};
           loads.push_back(std::move(lc));
         }
         cands.push_back(std::move(c));
@@ -683,6 +788,7 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       c.columns.push_back(std::move(a));
     }
   }
+  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
   if (!ambient_only) {
     for (int s = 0; s < r.sensors; ++s) {
       Candidate c;
@@ -714,7 +820,7 @@ std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunMod
   std::vector<Eigen::Index> keep;
   for (size_t k = 0; k < w.rows.size(); ++k)
     if (r.sensors == 0 || w.channel[k] < r.sensors) keep.push_back(static_cast<Eigen::Index>(k));
-  const Eigen::MatrixXd a_all = rows_of(c.columns[run], w, sigma);
+  const Eigen::MatrixXd a_all = whitened_rows(c.columns[run], w, sigma);
   Eigen::MatrixXd a(static_cast<Eigen::Index>(keep.size()), a_all.cols());
   Eigen::VectorXd y(static_cast<Eigen::Index>(keep.size()));
   for (size_t k = 0; k < keep.size(); ++k) {
@@ -726,6 +832,32 @@ std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunMod
 }
 
 namespace {
+
+/// Shared parameters fitted across the runs from their normal equations: leave-one-run-out gains
+/// and the in-sample fit on all runs.
+struct SharedFit {
+  std::vector<double> fold_gains;
+  double heldout = 0, insample = 0;
+  Eigen::VectorXd full;
+};
+
+SharedFit shared_fit(const std::vector<Normal>& normals, const CalibrationOptions& o) {
+  SharedFit out;
+  Normal sum{Eigen::MatrixXd::Zero(normals[0].g.rows(), normals[0].g.cols()),
+             Eigen::VectorXd::Zero(normals[0].b.size()), 0};
+  for (const auto& nm : normals) {
+    sum.g += nm.g;
+    sum.b += nm.b;
+  }
+  for (size_t ri = 0; ri < normals.size(); ++ri) {
+    const Eigen::VectorXd th = solve_ridge(sum.g - normals[ri].g, sum.b - normals[ri].b, o.ridge);
+    out.fold_gains.push_back(gain_of(normals[ri], th));
+    out.heldout += out.fold_gains.back();
+  }
+  out.full = solve_ridge(sum.g, sum.b, o.ridge);
+  for (const auto& nm : normals) out.insample += gain_of(nm, out.full);
+  return out;
+}
 
 /// Scores every candidate on whitened residuals `ys` (per run); fills fits in candidate order.
 std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitened>& ws,
@@ -747,7 +879,7 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
     std::vector<Normal> normals(nr);
     double total_s = 0;
     for (size_t ri = 0; ri < nr; ++ri) {
-      const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sigma);
+      const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sigma);
       normals[ri] = {a.transpose() * a, a.transpose() * ys[ri], ys[ri].squaredNorm()};
       total_s += normals[ri].s;
     }
@@ -765,7 +897,7 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
       for (size_t ri = 0; ri < nr; ++ri) {
         // Fit on the run's temperatures, score on all of its channels.
         std::vector<Eigen::Index> keep;
-        const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sigma);
+        const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sigma);
         for (size_t k = 0; k < ws[ri].rows.size(); ++k)
           if (r.sensors == 0 || ws[ri].channel[k] < r.sensors)
             keep.push_back(static_cast<Eigen::Index>(k));
@@ -789,20 +921,11 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
       f.heldout_gain = heldout;
       f.score += heldout;
     } else {
-      Normal sum{Eigen::MatrixXd::Zero(normals[0].g.rows(), normals[0].g.cols()),
-                 Eigen::VectorXd::Zero(normals[0].b.size()), 0};
-      for (const auto& nm : normals) {
-        sum.g += nm.g;
-        sum.b += nm.b;
-      }
-      for (size_t ri = 0; ri < nr; ++ri) {
-        const Eigen::VectorXd th =
-            solve_ridge(sum.g - normals[ri].g, sum.b - normals[ri].b, o.ridge);
-        f.fold_gains[ri] = gain_of(normals[ri], th);
-        heldout += f.fold_gains[ri];
-      }
-      const Eigen::VectorXd full = solve_ridge(sum.g, sum.b, o.ridge);
-      for (const auto& nm : normals) insample += gain_of(nm, full);
+      const SharedFit sf = shared_fit(normals, o);
+      f.fold_gains = sf.fold_gains;
+      heldout = sf.heldout;
+      insample = sf.insample;
+      const Eigen::VectorXd& full = sf.full;
       f.heldout_gain = heldout;
       f.score = heldout - o.penalty_per_parameter * p;
       if (with_parameters) f.parameters.assign(full.data(), full.data() + full.size());
@@ -815,17 +938,142 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
 /// sqrt(#runs) x the standard deviation of the per-run held-out gain differences of a and b: how
 /// much their score difference could change with other runs. With two runs it exceeds the
 /// difference exactly when b gains more than a on one of them.
-double gain_spread(const EffectFit& a, const EffectFit& b) {
-  const size_t n = std::min(a.fold_gains.size(), b.fold_gains.size());
+double gain_spread(const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t n = std::min(a.size(), b.size());
   if (n < 2) return 0;
   double mean = 0, ss = 0;
-  for (size_t r = 0; r < n; ++r)
-    mean += (a.fold_gains[r] - b.fold_gains[r]) / static_cast<double>(n);
+  for (size_t r = 0; r < n; ++r) mean += (a[r] - b[r]) / static_cast<double>(n);
   for (size_t r = 0; r < n; ++r) {
-    const double d = a.fold_gains[r] - b.fold_gains[r] - mean;
+    const double d = a[r] - b[r] - mean;
     ss += d * d;
   }
   return std::sqrt(static_cast<double>(n) * ss / static_cast<double>(n - 1));
+}
+
+/// Candidates `a` and `b` (their single fits of the first round) fitted together: the joint
+/// leave-one-run-out gains, the joint in-sample parameters, each member judged physical with them.
+PairFit pair_fit(const Catalogue& cat, const std::vector<Whitened>& ws,
+                 const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
+                 const EffectFit& a, const EffectFit& b, double null_score,
+                 const CalibrationOptions& o) {
+  const Candidate& ca = cat.candidates[static_cast<size_t>(a.candidate)];
+  const Candidate& cb = cat.candidates[static_cast<size_t>(b.candidate)];
+  const Eigen::Index pa = ca.columns.front().cols(), pb = cb.columns.front().cols();
+  std::vector<Normal> normals;
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    Eigen::MatrixXd m(static_cast<Eigen::Index>(ws[ri].rows.size()), pa + pb);
+    m.leftCols(pa) = whitened_rows(ca.columns[ri], ws[ri], sigma);
+    m.rightCols(pb) = whitened_rows(cb.columns[ri], ws[ri], sigma);
+    normals.push_back({m.transpose() * m, m.transpose() * ys[ri], ys[ri].squaredNorm()});
+  }
+  const SharedFit sf = shared_fit(normals, o);
+  PairFit pf;
+  pf.first = a;
+  pf.second = b;
+  pf.fold_gains = sf.fold_gains;
+  pf.heldout_gain = sf.heldout;
+  pf.score = sf.heldout - o.penalty_per_parameter * static_cast<double>(pa + pb);
+  pf.first.parameters.assign(sf.full.data(), sf.full.data() + pa);
+  pf.second.parameters.assign(sf.full.data() + pa, sf.full.data() + pa + pb);
+  pf.first.unphysical = unphysical_reason(ca, pf.first.parameters, {}, cat.runs, o);
+  pf.second.unphysical = unphysical_reason(cb, pf.second.parameters, {}, cat.runs, o);
+  pf.adds_first = pf.score - b.score;
+  pf.adds_second = pf.score - a.score;
+  pf.admissible = pf.first.unphysical.empty() && pf.second.unphysical.empty() &&
+                  pf.adds_first > std::max(null_score, a.floor) &&
+                  pf.adds_second > std::max(null_score, b.floor);
+  return pf;
+}
+
+/// `cat` with the columns of its best nonlinear candidates whose linearised fit is unphysical
+/// replaced by their secant responses at the size `resize` finds (their `linearised` parameters
+/// kept by candidate); nothing when no candidate needs it.
+std::optional<Catalogue> resized_catalogue(const Catalogue& cat, const CalibrationOptions& o,
+                                           const Resizer& resize,
+                                           std::map<int, std::vector<double>>& linearised) {
+  const Eigen::VectorXd sigma = noise_sigma(cat.runs, cat.readout.sensors, o);
+  std::vector<Whitened> ws;
+  std::vector<Eigen::VectorXd> ys;
+  for (const auto& rm : cat.runs) {
+    ws.push_back(whitened(rm, sigma));
+    ys.push_back(ws.back().y);
+  }
+  std::vector<EffectFit> fits = score_all(cat, ws, ys, sigma, o, true);
+  std::vector<size_t> order(fits.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return fits[a].score > fits[b].score; });
+  std::optional<Catalogue> out;
+  int done = 0;
+  for (size_t i : order) {
+    const EffectFit& f = fits[i];
+    if (done >= o.resize_pool || f.score <= 0) break;
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (!nonlinear_in_parameter(c) || c.per_run || f.parameters.size() != 1 ||
+        unphysical_reason(c, f.parameters, {}, cat.runs, o).empty())
+      continue;
+    ++done;
+    Resized r = resize(f);
+    if (r.columns.size() != cat.runs.size()) continue;  // no size found: stays as linearised
+    if (!out) out = cat;
+    out->candidates[i].columns = std::move(r.columns);
+    linearised[f.candidate] = f.parameters;
+  }
+  return out;
+}
+
+/// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
+/// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
+void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
+                 const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
+                 const std::vector<int>& order, Selection& sel, const CalibrationOptions& o) {
+  std::vector<int> pool;
+  std::map<EffectKind, int> per_kind;
+  for (int i : order) {
+    const EffectFit& f = fits[static_cast<size_t>(i)];
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    // Shared parameters only: a per-run air or a fixed lag has no joint least squares here.
+    if (!f.unphysical.empty() || c.per_run || c.fixed || f.score <= 0) continue;
+    if (per_kind[f.kind]++ >= o.pair_pool_per_kind) continue;
+    pool.push_back(i);
+    if (static_cast<int>(pool.size()) >= o.pair_pool) break;
+  }
+  std::vector<PairFit> pairs;
+  for (size_t x = 0; x < pool.size(); ++x)
+    for (size_t y = x + 1; y < pool.size(); ++y)
+      pairs.push_back(pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(pool[x])],
+                               fits[static_cast<size_t>(pool[y])], sel.null_score, o));
+  std::sort(pairs.begin(), pairs.end(),
+            [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
+  const auto best =
+      std::find_if(pairs.begin(), pairs.end(), [](const PairFit& p) { return p.admissible; });
+  sel.pairs.assign(pairs.begin(),
+                   pairs.begin() + std::min<std::ptrdiff_t>(5, pairs.end() - pairs.begin()));
+  // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
+  if (best == pairs.end() || sel.claimed.empty()) return;
+  for (const auto& f : sel.claimed) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (c.per_run || c.fixed) return;  // the greedy choice holds what pairs cannot
+  }
+  auto same = [](const PairFit& p, int a, int b) {
+    return (p.first.candidate == a && p.second.candidate == b) ||
+           (p.first.candidate == b && p.second.candidate == a);
+  };
+  if (sel.claimed.size() >= 2) {
+    const EffectFit &g0 = sel.claimed[0], &g1 = sel.claimed[1];
+    if (same(*best, g0.candidate, g1.candidate)) return;
+    // The greedy pair scored the same way (its members from the first round's fits).
+    const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
+                                    fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
+    if (best->score - greedy.score <= gain_spread(best->fold_gains, greedy.fold_gains)) return;
+  } else if (best->score - sel.claimed[0].score <=
+             std::max(sel.null_score, std::max(best->first.floor, best->second.floor))) {
+    return;
+  }
+  const bool swap = best->second.score > best->first.score;
+  sel.claimed = {swap ? best->second : best->first, swap ? best->first : best->second};
+  sel.by_pair = true;
+  sel.ambiguous.clear();  // a later round's indecision is settled by the pair
 }
 
 /// The channel on which the two candidates' in-sample responses differ most, in sigmas (RMS over
@@ -903,6 +1151,8 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
         if (!seen.insert({parent->law, p.faces}).second) continue;
         Candidate c = heat_candidate(p, parent->law, parent->ref_speed_rpm, spec);
         sep.push_back(heat_column(m, p, c));
+        c.unit_separable = {sep.back()};
+        c.unit_weights = {1};
         added.push_back(std::move(c));
       }
     }
@@ -935,11 +1185,22 @@ Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
   return out;
 }
 
-Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
-  if (cat.runs.size() < 2)
+Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
+                         const Resizer& resize) {
+  if (given.runs.size() < 2)
     throw core::DataError(
-        "calibration needs at least two training runs (got " + std::to_string(cat.runs.size()) +
+        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
         "): effects are chosen by how much they explain on a run held out from the fit");
+  std::map<int, std::vector<double>> linearised;
+  const std::optional<Catalogue> resized =
+      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
+  const Catalogue& cat = resized ? *resized : given;
+  // A resized candidate's fits report the linearised parameters it was found unphysical at.
+  auto mark = [&](std::vector<EffectFit>& fits) {
+    for (auto& f : fits)
+      if (const auto it = linearised.find(f.candidate); it != linearised.end())
+        f.linearised = it->second;
+  };
   Selection sel;
   const auto& r = cat.readout;
   sel.sigma = noise_sigma(cat.runs, r.sensors, o);
@@ -980,8 +1241,11 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
   }
   std::vector<Eigen::VectorXd> current = ys;
   const double total = sel.residual_ss;
+  std::vector<EffectFit> first_fits;
+  std::vector<int> first_order;
   for (int round = 0; round < o.max_effects; ++round) {
     std::vector<EffectFit> fits = score_all(cat, ws, current, sel.sigma, o, true);
+    mark(fits);
     for (auto& f : fits) {
       const Candidate& c = cat.candidates[f.candidate];
       const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
@@ -1000,13 +1264,15 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
     std::sort(order.begin(), order.end(),
               [&](int a, int b) { return fits[a].score > fits[b].score; });
     if (round == 0) {
+      first_fits = fits;
+      first_order = order;
       std::set<std::string> places;
       for (int i : order) {
         const Candidate& c = cat.candidates[i];
         const std::string key = kind_name(c.kind) + c.location.dump();
         if (!places.insert(key).second) continue;
         sel.ranking.push_back(fits[i]);
-        if (sel.ranking.size() >= 8) break;
+        if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
       }
     }
     // The best physical candidate, claimed when it beats noise and floor and no candidate of
@@ -1024,7 +1290,7 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
     if (second_at != order.end()) {
       Ambiguity amb{best, fits[*second_at]};
       amb.difference = best.score - amb.second.score;
-      amb.spread = gain_spread(best, amb.second);
+      amb.spread = gain_spread(best.fold_gains, amb.second.fold_gains);
       if (amb.difference < amb.spread) {
         distinguishing_channel(cat, sel.sigma, amb);
         sel.ambiguous.push_back(std::move(amb));
@@ -1035,7 +1301,7 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
     // Remove the claimed effect's in-sample fit before looking for the next one.
     const Candidate& c = cat.candidates[best.candidate];
     for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
-      const Eigen::MatrixXd a = rows_of(c.columns[ri], ws[ri], sel.sigma);
+      const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sel.sigma);
       Eigen::VectorXd th;
       if (c.fixed)
         th = Eigen::VectorXd::Ones(1);
@@ -1047,6 +1313,8 @@ Selection select_effects(const Catalogue& cat, const CalibrationOptions& o) {
       current[ri] -= a * th;
     }
   }
+  if (o.max_effects >= 2 && !first_fits.empty())
+    choose_pair(cat, ws, ys, first_fits, first_order, sel, o);
   return sel;
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -46,6 +47,12 @@ struct CalibrationOptions {
   double noise_floor_K = 0.005, noise_floor_m = 0.01e-6;  /// least noise assumed per channel
   int null_trials = 10;                                   /// fits to pure noise for the threshold
   int max_effects = 2;
+  /// Candidates of the first round reported (best per kind and place): the several-places
+  /// candidates and the pairs' pool need more than the eight that one place each gave.
+  int ranking_size = 12;
+  /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
+  /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
+  int pair_pool = 8, pair_pool_per_kind = 3;
   std::uint64_t seed = 20260107;
   // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
   // that needs a value outside these to fit is reported as unphysical and never claimed.
@@ -61,6 +68,13 @@ struct CalibrationOptions {
   double material_change_min = -1.0 / 3, material_change_max = 0.5;
   /// Temperature coefficient of a heat source after the change [1/K].
   double temperature_coefficient_min_per_K = -0.05, temperature_coefficient_max_per_K = 0.15;
+  // Refit of the claims about the updated model (docs/calibration.md, "Refit"): Gauss–Newton on
+  // the claims' shared parameters, each step one march per training run; it stops when every
+  // parameter moves by less than `refit_tolerance_sigmas` of its standard error (or by less than
+  // `refit_tolerance_rel` of its value), at most `refit_max_iterations` steps.
+  int refit_max_iterations = 8;
+  int resize_pool = 4;  /// candidates select_effects sizes about their update at most
+  double refit_tolerance_sigmas = 0.05, refit_tolerance_rel = 1e-3;
 };
 
 /// One run reduced to what the fit needs.
@@ -82,15 +96,28 @@ struct Candidate {
   bool per_run = false;                 /// parameters fitted run by run (an unknown signal)
   bool fixed = false;                   /// one column whose amplitude is 1 (a lag filter)
   // What the augmented case needs.
-  int group = -1, material = -1, source = -1, sensor = -1;
+  /// Film kinds: the convection entries the change acts on; temperature_dependent_heat: the heat
+  /// sources; the air: the entries whose sinks move. One for a single place, several for a
+  /// mechanism that acts in several places at once with one parameter.
+  std::vector<int> entries;
+  /// Per entry (film kinds, temperature_dependent_heat): its change per unit parameter (gain or
+  /// Δh [W/(m^2 K)], coefficient [1/K]); 1 for a single place.
+  std::vector<double> weights;
+  int material = -1, sensor = -1;
   int body = -1;           /// heat input: the body whose faces take the heat
   std::string law, field;  /// heat-input law; material field
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
   double area = 0, ref_speed_rpm = 0, time_constant = 0;
   std::vector<double> knots;  /// ambient hat knots [s]
-  std::vector<int> entries;   /// ambient: convection entries whose sink moves
   std::vector<Eigen::MatrixXd>
       columns;  /// per run: (#samples #channels) x #parameters (column-major channels)
+  /// A one-parameter candidate's unit loads: their responses times `unit_weights` (separable
+  /// first, then loads) sum to its column. Kept so that the column can be marched again about an
+  /// updated model (refit_claimed). Empty for the air, the sensors' own effects and expansion,
+  /// whose columns are not loads of the thermal march.
+  std::vector<SeparableColumn> unit_separable;
+  std::vector<LoadColumn> unit_loads;
+  std::vector<double> unit_weights;
 };
 
 /// Channel histories of the declared model for each run and the catalogue of candidate effects
@@ -143,13 +170,20 @@ struct EffectFit {
   std::string name;
   std::vector<double> parameters;                   /// shared parameters
   std::vector<std::vector<double>> run_parameters;  /// per run (per-run candidates)
-  double heldout_gain = 0;        /// whitened sum of squares removed on held-out runs
-  double score = 0;               /// heldout_gain - penalty
-  double explained_fraction = 0;  /// share of the training residual's whitened SS removed alone
-  double floor = 0;               /// model-form allowance for this candidate
+  double heldout_gain = 0;         /// whitened sum of squares removed on held-out runs
+  double score = 0;                /// heldout_gain - penalty
+  double explained_fraction = 0;   /// share of the training residual's whitened SS removed alone
+  double floor = 0;                /// model-form allowance for this candidate
   std::vector<double> fold_gains;  /// held-out gain per training run (sums to heldout_gain)
   std::string unphysical;          /// why the fitted parameters are not physical; empty: they are
   double duty_correlation = 0;     /// per-run air: correlation of the fitted air with the speed
+  // Refit about the updated model (refit_claimed); iterations 0: not refitted.
+  std::vector<double> linearised;  /// the shared parameters as the linearised fit gave them
+  int refit_iterations = 0;        /// Gauss–Newton steps taken
+  bool refit_converged = false;    /// stopped by the rule, not by the iteration cap
+  /// Whitened training sum of squares of the updated model at the linearised and at the refitted
+  /// parameters (all claims together).
+  double refit_ss_linearised = 0, refit_ss = 0;
 };
 
 /// Two candidates of different kinds whose scores differ by less than the spread of their
@@ -162,13 +196,33 @@ struct Ambiguity {
   double channel_difference = 0;  /// that difference's RMS over the training runs [sigmas]
 };
 
+/// Two effects fitted and scored together on the training runs (leave-one-run-out, as a single
+/// candidate with both columns).
+struct PairFit {
+  EffectFit first, second;  /// the members: their single fits with the joint parameters
+  double score = 0;         /// joint held-out gain - penalty for both members' parameters
+  double heldout_gain = 0;
+  std::vector<double> fold_gains;  /// joint held-out gain per training run
+  /// What each member adds to the other alone: score - the other's single score.
+  double adds_first = 0, adds_second = 0;
+  /// Both physical with the joint parameters, and each adds more than the noise threshold and its
+  /// model-form floor to the other.
+  bool admissible = false;
+};
+
 struct Selection {
-  std::vector<EffectFit> claimed;  /// claimed effects, most important first
-  std::vector<EffectFit> ranking;  /// best candidate per (kind, place) of the first round
+  std::vector<EffectFit> claimed;    /// claimed effects, most important first
+  std::vector<EffectFit> ranking;    /// best per (kind, place) of the first round, ranking_size
   std::vector<Ambiguity> ambiguous;  /// the round at which the choice stopped undecided, if any
-  double null_score = 0;           /// best score over fits to pure noise
-  Eigen::VectorXd sigma;           /// per channel noise estimate [K | m]
-  double residual_ss = 0;          /// training residual, whitened
+  /// Claims whose size, refitted about the updated model, is unphysical: not claimed.
+  std::vector<EffectFit> refit_rejected;
+  /// The best pairs of the first round's best candidates scored jointly, best first; `by_pair`
+  /// when the claims are the best admissible pair rather than the greedy choice.
+  std::vector<PairFit> pairs;
+  bool by_pair = false;
+  double null_score = 0;   /// best score over fits to pure noise
+  Eigen::VectorXd sigma;   /// per channel noise estimate [K | m]
+  double residual_ss = 0;  /// training residual, whitened
 };
 
 /// Per channel white-noise level from second differences of the residuals (robust, pooled).
@@ -176,8 +230,27 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
                             const CalibrationOptions& options);
 
 /// Chooses effects: leave-one-run-out gains, penalty, noise threshold, model-form floor; greedy
-/// over up to options.max_effects effects. Needs at least two runs.
-Selection select_effects(const Catalogue& cat, const CalibrationOptions& options);
+/// over up to options.max_effects effects, then the best pairs of the first round's best
+/// candidates scored jointly (docs/calibration.md, "Pairs"): the best admissible pair replaces
+/// the greedy claims when it scores above them by more than the spread of the per-run gains (or,
+/// against one greedy claim, by more than the noise threshold and floor). Needs at least two
+/// runs.
+/// A candidate's size found about the model it updates (refit_alone): its parameters and, per
+/// training run, its secant response per unit parameter ((#samples #channels) x 1: the updated
+/// model's channels minus the declared model's, over the size). Empty columns: no size found.
+struct Resized {
+  std::vector<double> parameters;
+  std::vector<Eigen::MatrixXd> columns;
+};
+using Resizer = std::function<Resized(const EffectFit&)>;
+
+/// With `resize`, the best `options.resize_pool` candidates that are not linear in their parameter
+/// and whose linearised fit is unphysical are first sized about the model they update, and their
+/// columns replaced by the secant responses at that size, so that they are scored, judged and
+/// paired as what they do at their size, not as their first-order shadow (a film halved needs
+/// h -> 0 to its linearisation); their fits keep the linearised parameters in `linearised`.
+Selection select_effects(const Catalogue& cat, const CalibrationOptions& options,
+                         const Resizer& resize = {});
 
 /// Why `p` (fitted parameters of `c`; for a per-run air, `run_parameters` per run) is not
 /// physical on `runs` (the speeds their duty cycles use), empty when it is. Sets `duty_correlation`
@@ -197,6 +270,25 @@ Eigen::VectorXd bounded_air(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
 std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,
                                        const Readout& r, const Eigen::VectorXd& sigma,
                                        const CalibrationOptions& options);
+
+/// Whitened residual rows of one run: vec(#samples x #channels) of (measured - base) / sigma,
+/// finite readings only.
+struct Whitened {
+  Eigen::VectorXd y;               /// kept rows
+  std::vector<Eigen::Index> rows;  /// indices into the column-major vec
+  std::vector<int> channel;        /// channel of each kept row
+};
+Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma);
+/// The rows of `a` ((#samples #channels) x k, column-major channels) that `w` keeps, whitened.
+Eigen::MatrixXd whitened_rows(const Eigen::MatrixXd& a, const Whitened& w,
+                              const Eigen::VectorXd& sigma);
+
+/// Least squares from the normal equations g x = b, ridged by `ridge` x g's mean diagonal.
+Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, double ridge);
+
+/// Whether `c`'s channel response is not linear in its parameter (films, heat that grows with
+/// temperature, conductivity and capacity): its size needs the refit about the updated model.
+bool nonlinear_in_parameter(const Candidate& c);
 
 /// First-order lag of x sampled at `times` (exact for x linear between samples), y(0) = x(0).
 Eigen::VectorXd lagged(const Eigen::VectorXd& times, const Eigen::VectorXd& x, double tau);

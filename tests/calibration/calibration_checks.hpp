@@ -39,6 +39,12 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
   for (const auto& a : res.selection.ambiguous)
     std::printf("[calibration]   ambiguous: %s / %s (difference %.1f, spread %.1f)\n",
                 a.first.name.c_str(), a.second.name.c_str(), a.difference, a.spread);
+  for (const auto& c : res.effects)
+    if (c.contains("refit") && c["refit"].contains("linearised"))
+      std::printf("[calibration] refit of %s: linearised %s, refitted %s in %d steps%s\n",
+                  c["name"].get<std::string>().c_str(), c["refit"]["linearised"].dump().c_str(),
+                  c["refit"]["refitted"].dump().c_str(), c["refit"]["iterations"].get<int>(),
+                  c["refit"]["converged"].get<bool>() ? "" : " (cap)");
   std::string first = res.effects.empty() ? "none" : res.effects[0]["kind"].get<std::string>();
   if (first == "sensor_lag")
     std::printf("[calibration] lag found %.4g s\n",

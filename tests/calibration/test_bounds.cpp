@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "calibration/calibrate.hpp"
 #include "core/rng.hpp"
@@ -70,8 +71,8 @@ Candidate candidate(EffectKind kind, const std::string& name,
   c.name = name;
   c.location = {{"name", name}};
   c.parameters = {"p"};
-  c.group = 0;
-  c.source = 0;
+  c.entries = {0};  // the one film, the one source
+  c.weights = {1};
   c.material = 0;
   c.field = "conductivity";
   c.area = 0.01;
@@ -314,6 +315,46 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   EXPECT_TRUE(one.ambiguous.empty());
   ASSERT_FALSE(one.claimed.empty());
   EXPECT_EQ(one.claimed[0].kind, EffectKind::heat_input);
+}
+
+// Two effects (a heat input and a conductivity) whose sum a third candidate (a speed gain of
+// convection) nearly matches alone: one after the other takes the third first and can only patch
+// what it leaves; scored jointly, the pair of the two fits and is claimed instead.
+TEST(Pairs, JointPairBeatsOneAfterTheOther) {
+  std::vector<RunModel> runs{run_model("a", 3, 1800, 0), run_model("b", 3, 2400, 1)};
+  std::vector<Eigen::VectorXd> x, y, z;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    x.push_back(speed_response(runs[r], 900));
+    y.push_back(0.5 * (runs[r].times.array() / 10800).matrix() + speed_response(runs[r], 300));
+    z.push_back(x[r] + y[r] + 0.3 * speed_response(runs[r], 3000));
+    runs[r].measured.col(0) += 0.5 * (x[r] + y[r]);
+    add_noise(runs[r], 0.01, 50 + r);
+  }
+  Catalogue cat = one_channel(runs);
+  cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", x));
+  cat.candidates.push_back(
+      candidate(EffectKind::material_parameter, "conductivity", {2.5 * y[0], 2.5 * y[1]}));
+  cat.candidates.push_back(candidate(EffectKind::speed_dependent_convection, "speed gain", z));
+  const Selection sel = select_effects(cat, CalibrationOptions{});
+  for (const auto& p : sel.pairs)
+    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
+                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
+                p.admissible ? " admissible" : "");
+  ASSERT_FALSE(sel.ranking.empty());
+  EXPECT_EQ(sel.ranking[0].kind, EffectKind::speed_dependent_convection);  // greedy's first
+  ASSERT_EQ(sel.claimed.size(), 2u);
+  EXPECT_TRUE(sel.by_pair);
+  std::set<EffectKind> kinds{sel.claimed[0].kind, sel.claimed[1].kind};
+  EXPECT_EQ(kinds, (std::set<EffectKind>{EffectKind::heat_input, EffectKind::material_parameter}));
+  for (const auto& f : sel.claimed)
+    EXPECT_NEAR(f.parameters.at(0), f.kind == EffectKind::heat_input ? 0.5 : 0.2, 0.02) << f.name;
+  // Without pairs (one effect at most) the greedy choice stands.
+  CalibrationOptions one;
+  one.max_effects = 1;
+  const Selection single = select_effects(cat, one);
+  ASSERT_EQ(single.claimed.size(), 1u);
+  EXPECT_EQ(single.claimed[0].kind, EffectKind::speed_dependent_convection);
+  EXPECT_FALSE(single.by_pair);
 }
 
 TEST(Ambiguity, HintNamesTheAmbientSensorAndADutyCycle) {

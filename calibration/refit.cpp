@@ -1,0 +1,286 @@
+#include "calibration/refit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "calibration/calibrate.hpp"
+#include "core/errors.hpp"
+
+namespace tt::calibration {
+
+namespace {
+
+Eigen::VectorXd vec(const Eigen::MatrixXd& a) {
+  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
+}
+
+/// The claims and where their shared parameter sits in the refitted vector (-1: held).
+struct Claims {
+  const Catalogue* cat = nullptr;
+  std::vector<EffectFit> fits;
+  std::vector<int> slot;
+  const Candidate& candidate(size_t k) const {
+    return cat->candidates.at(static_cast<size_t>(fits[k].candidate));
+  }
+  /// Whether every shared claim is physical at `theta` on the catalogue's runs.
+  bool physical(const Eigen::VectorXd& theta, const CalibrationOptions& o) const {
+    for (size_t k = 0; k < fits.size(); ++k)
+      if (slot[k] >= 0 &&
+          !unphysical_reason(candidate(k), {theta(slot[k])}, {}, cat->runs, o).empty())
+        return false;
+    return true;
+  }
+  bool changes_operators() const {
+    for (size_t k = 0; k < fits.size(); ++k)
+      if (candidate(k).kind == EffectKind::material_parameter && candidate(k).field != "expansion")
+        return true;
+    return false;
+  }
+};
+
+/// `base` with every claim but the heat inputs declared at `theta` (the per-run ones at their
+/// run-`ri` values): what augmented_case writes, so that the refitted model is the written one.
+/// Heat inputs stay out: they need new boundary groups, and the march carries them as columns.
+AugmentedCase updated_case(const core::CaseSpec& base, const Claims& cl,
+                           const Eigen::VectorXd& theta, size_t ri) {
+  AugmentedCase aug{base, {}};
+  for (size_t k = 0; k < cl.fits.size(); ++k) {
+    const Candidate& c = cl.candidate(k);
+    if (c.kind == EffectKind::heat_input) continue;
+    std::vector<double> p = cl.fits[k].parameters;
+    if (c.per_run) p = cl.fits[k].run_parameters.at(ri);
+    if (cl.slot[k] >= 0) p = {theta(cl.slot[k])};
+    aug = augmented_case(aug, c, p, cl.cat->readout);
+  }
+  return aug;
+}
+
+/// The updated model on run `ri`: its whitened residual and the Jacobian of its channels in the
+/// shared parameters (whitened rows).
+struct Step {
+  Eigen::VectorXd y;
+  Eigen::MatrixXd jacobian;
+  Eigen::MatrixXd prediction;  /// #samples x #channels [K | m]
+};
+
+Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared, const Claims& cl,
+                       const Eigen::VectorXd& theta, size_t ri, const Eigen::VectorXd& sigma) {
+  const RunModel& rm = cl.cat->runs[ri];
+  const Readout& r = cl.cat->readout;
+  const AugmentedCase aug = updated_case(rm.spec, cl, theta, ri);
+  Readout ru = r;
+  if (r.displacement.rows()) ru.displacement = displacement_with_expansions(r, declared, aug.spec);
+  // Columns: per shared claim, its unit loads (weighted), or its expansion readout.
+  std::vector<SeparableColumn> sep;
+  std::vector<LoadColumn> loads;
+  std::vector<Eigen::MatrixXd> extra;
+  struct Where {
+    std::vector<int> sep, load;
+    std::vector<double> sep_w, load_w;
+    int extra = -1;
+  };
+  std::vector<Where> where(cl.fits.size());
+  for (size_t k = 0; k < cl.fits.size(); ++k) {
+    if (cl.slot[k] < 0) continue;
+    const Candidate& c = cl.candidate(k);
+    const size_t ns = c.unit_separable.size();
+    for (size_t j = 0; j < ns; ++j) {
+      where[k].sep.push_back(static_cast<int>(sep.size()));
+      where[k].sep_w.push_back(c.unit_weights.at(j));
+      sep.push_back(c.unit_separable[j]);
+    }
+    for (size_t j = 0; j < c.unit_loads.size(); ++j) {
+      where[k].load.push_back(static_cast<int>(loads.size()));
+      where[k].load_w.push_back(c.unit_weights.at(ns + j));
+      loads.push_back(c.unit_loads[j]);
+    }
+    if (c.kind == EffectKind::material_parameter && c.field == "expansion") {
+      where[k].extra = static_cast<int>(extra.size());
+      extra.push_back(r.expansion.at(static_cast<size_t>(c.material)));
+    }
+  }
+  const Responses rs = march(model_u, aug.spec, ru, rm.times, sep, loads, extra);
+  const Eigen::Index ns = rm.times.size(), nc = r.channels();
+  // The heat inputs' share of the prediction, then the sensors' own corrections.
+  Eigen::MatrixXd prediction = rs.base;
+  for (size_t k = 0; k < cl.fits.size(); ++k)
+    if (cl.candidate(k).kind == EffectKind::heat_input)
+      for (size_t j = 0; j < where[k].sep.size(); ++j)
+        prediction += theta(cl.slot[k]) * where[k].sep_w[j] *
+                      rs.columns[static_cast<size_t>(where[k].sep[j])];
+  prediction = corrected(prediction, rm.times, r, aug.sensors);
+  std::vector<SensorCorrection> lags = aug.sensors;  // a lagged channel's tangent is lagged too
+  for (auto& s : lags) s.offset_K = 0;
+  Eigen::MatrixXd jac = Eigen::MatrixXd::Zero(ns * nc, theta.size());
+  for (size_t k = 0; k < cl.fits.size(); ++k) {
+    if (cl.slot[k] < 0) continue;
+    const Candidate& c = cl.candidate(k);
+    Eigen::MatrixXd col = Eigen::MatrixXd::Zero(ns, nc);
+    for (size_t j = 0; j < where[k].sep.size(); ++j)
+      col += where[k].sep_w[j] * rs.columns[static_cast<size_t>(where[k].sep[j])];
+    for (size_t j = 0; j < where[k].load.size(); ++j)
+      col += where[k].load_w[j] * rs.columns[sep.size() + static_cast<size_t>(where[k].load[j])];
+    if (where[k].extra >= 0) col = rs.extra[static_cast<size_t>(where[k].extra)];
+    if (c.kind == EffectKind::sensor_offset) col.col(c.sensor).setOnes();
+    jac.col(cl.slot[k]) = vec(corrected(col, rm.times, r, lags));
+  }
+  RunModel now = rm;
+  now.base = prediction;
+  const Whitened w = whitened(now, sigma);
+  return {w.y, whitened_rows(jac, w, sigma), prediction};
+}
+
+/// Gauss–Newton on the claims' shared parameters from their linearised values.
+void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claims& cl,
+                  const Eigen::VectorXd& sigma, const CalibrationOptions& o) {
+  Eigen::VectorXd theta(static_cast<Eigen::Index>(
+      std::count_if(cl.slot.begin(), cl.slot.end(), [](int s) { return s >= 0; })));
+  for (size_t k = 0; k < cl.fits.size(); ++k)
+    if (cl.slot[k] >= 0) theta(cl.slot[k]) = cl.fits[k].parameters.at(0);
+  const Eigen::Index p = theta.size();
+  double ss_first = 0, ss_last = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd last_theta = theta, step = Eigen::VectorXd::Zero(p);
+  int iterations = 0;
+  bool converged = false;
+  Eigen::VectorXd beyond;  /// the step that left the bounds, when one did
+  for (int it = 0; it < o.refit_max_iterations; ++it) {
+    // The operators of the updated model: the declared case's with the claims' materials.
+    std::optional<MarchModel> own;
+    if (cl.changes_operators())
+      own.emplace(model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec));
+    const MarchModel& model_u = own ? *own : model;
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
+    double ss = 0;
+    for (size_t ri = 0; ri < cl.cat->runs.size(); ++ri) {
+      const Step s = linearised_on_run(model_u, declared, cl, theta, ri, sigma);
+      g += s.jacobian.transpose() * s.jacobian;
+      b += s.jacobian.transpose() * s.y;
+      ss += s.y.squaredNorm();
+    }
+    if (it == 0) ss_first = ss;
+    if (ss > ss_last && it > 0) {
+      // The last step overshot: take half of it from where it started.
+      step /= 2;
+      theta = last_theta + step;
+      ++iterations;
+      continue;
+    }
+    ss_last = ss;
+    last_theta = theta;
+    step = solve_ridge(g, b, 1e-12);
+    // Standard errors of the parameters (whitened residuals: unit noise).
+    const Eigen::VectorXd se =
+        g.ldlt().solve(Eigen::MatrixXd::Identity(p, p)).diagonal().cwiseAbs().cwiseSqrt();
+    converged = true;
+    for (Eigen::Index k = 0; k < p; ++k)
+      converged &= std::abs(step(k)) <= std::max(o.refit_tolerance_sigmas * se(k),
+                                                 o.refit_tolerance_rel * std::abs(theta(k)));
+    // The step stays within the physical bounds (a film clamped at 5 % of its h stops
+    // responding, and Gauss–Newton would walk on): halved until it does; a fit that still
+    // leaves them runs into its bound, and its size is not found.
+    for (int cut = 0; cut < 8 && !cl.physical(theta + step, o); ++cut) step /= 2;
+    if (!cl.physical(theta + step, o)) {
+      beyond = theta + step;
+      converged = false;
+      break;
+    }
+    theta += step;
+    ++iterations;
+    if (converged) break;
+  }
+  for (size_t k = 0; k < cl.fits.size(); ++k) {
+    EffectFit& f = cl.fits[k];
+    f.refit_iterations = iterations;
+    f.refit_converged = converged;
+    f.refit_ss_linearised = ss_first;
+    f.refit_ss = ss_last;
+    if (cl.slot[k] < 0) continue;
+    if (beyond.size() &&
+        !unphysical_reason(cl.candidate(k), {beyond(cl.slot[k])}, {}, cl.cat->runs, o).empty())
+      f.unphysical = "refitted about the updated model, its size runs into the physical bounds";
+    if (f.linearised.empty()) f.linearised = f.parameters;
+    f.parameters = {theta(cl.slot[k])};
+  }
+}
+
+bool wants_refit(const Claims& cl) {
+  int shared = 0;
+  bool nonlinear = false;
+  for (size_t k = 0; k < cl.fits.size(); ++k) {
+    shared += cl.slot[k] >= 0;
+    nonlinear |= nonlinear_in_parameter(cl.candidate(k));
+  }
+  return shared > 0 && (nonlinear || cl.fits.size() > 1);
+}
+
+}  // namespace
+
+Resized refit_alone(const MarchModel& model, const core::CaseSpec& declared, const Catalogue& cat,
+                    const EffectFit& fit, const Eigen::VectorXd& sigma,
+                    const CalibrationOptions& o) {
+  Claims cl;
+  cl.cat = &cat;
+  cl.fits = {fit};
+  cl.slot = {0};
+  EffectFit& f = cl.fits[0];
+  const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
+  for (int k = 0; k < 6 && !unphysical_reason(c, f.parameters, {}, cat.runs, o).empty(); ++k)
+    f.parameters[0] /= 2;
+  gauss_newton(model, declared, cl, sigma, o);
+  Resized out;
+  out.parameters = f.parameters;
+  if (!f.unphysical.empty()) return out;  // no physical size: it stays as linearised
+  const double size = f.parameters.at(0);
+  if (size == 0 || !std::isfinite(size)) return out;
+  // The secant response at the size: the updated model's channels minus the declared model's.
+  std::optional<MarchModel> own;
+  const Eigen::VectorXd theta = Eigen::VectorXd::Constant(1, size);
+  if (cl.changes_operators())
+    own.emplace(model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec));
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    const Step s = linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma);
+    out.columns.push_back(vec(s.prediction - cat.runs[ri].base) / size);
+  }
+  return out;
+}
+
+Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
+                        const Catalogue& cat, Selection sel, const CalibrationOptions& o) {
+  while (!sel.claimed.empty()) {
+    Claims cl;
+    cl.cat = &cat;
+    cl.fits = sel.claimed;
+    int next = 0;
+    for (const auto& f : cl.fits) {
+      const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
+      const bool shared = !c.per_run && !c.fixed && f.parameters.size() == 1 &&
+                          (!c.unit_separable.empty() || !c.unit_loads.empty() ||
+                           c.kind == EffectKind::sensor_offset ||
+                           (c.kind == EffectKind::material_parameter && c.field == "expansion"));
+      cl.slot.push_back(shared ? next++ : -1);
+    }
+    if (!wants_refit(cl)) return sel;
+    gauss_newton(model, declared, cl, sel.sigma, o);
+    // A size that is unphysical once found is not claimed; the others are sized without it.
+    std::vector<EffectFit> kept;
+    for (auto& f : cl.fits) {
+      const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
+      if (f.unphysical.empty())
+        f.unphysical = unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o);
+      if (f.unphysical.empty())
+        kept.push_back(f);
+      else
+        sel.refit_rejected.push_back(f);
+    }
+    sel.claimed = kept;
+    if (kept.size() == cl.fits.size()) return sel;
+    for (auto& f : sel.claimed)
+      if (!f.linearised.empty()) f.parameters = f.linearised;
+  }
+  return sel;
+}
+
+}  // namespace tt::calibration
