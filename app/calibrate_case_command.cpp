@@ -72,6 +72,7 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const mesh::TetMesh mesh = mesh::mesh_case(declared);
   calibration::CalibrationOptions options;
   options.seed = declared.seed;
+  if (args.refit) options.refit_max_iterations = 8;
   say(std::to_string(mesh.nodes.rows()) +
       " nodes; locating the channels (probes: elastic "
       "influence rows)");

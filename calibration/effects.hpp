@@ -71,8 +71,11 @@ struct CalibrationOptions {
   // Refit of the claims about the updated model (docs/calibration.md, "Refit"): Gauss–Newton on
   // the claims' shared parameters, each step one march per training run; it stops when every
   // parameter moves by less than `refit_tolerance_sigmas` of its standard error (or by less than
-  // `refit_tolerance_rel` of its value), at most `refit_max_iterations` steps.
-  int refit_max_iterations = 8;
+  // `refit_tolerance_rel` of its value), at most `refit_max_iterations` steps. Off (0) by
+  // default until the refit has a held-out check of its own: on the CI's speed-dependent film
+  // draw (true law speed^0.8, candidate speed^1) it sized the wrong law on the training runs and
+  // the test run's after/before went from 0.26 to 0.302, past the 0.3 target. 8 turns it on.
+  int refit_max_iterations = 0;
   int resize_pool = 4;  /// candidates select_effects sizes about their update at most
   double refit_tolerance_sigmas = 0.05, refit_tolerance_rel = 1e-3;
 };

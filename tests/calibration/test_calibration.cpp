@@ -253,7 +253,9 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   std::vector<io::MeasuredRun> clean;
   const auto runs = testing::effect_runs(s, e, rng, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
-  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  CalibrationOptions refit = s.copt;
+  refit.refit_max_iterations = 8;  // off by default (effects.hpp says why)
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, refit);
   ASSERT_FALSE(res.effects.empty()) << calibration_json(res, {}).dump(1);
   const nlohmann::json& claim = res.effects[0];
   ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
