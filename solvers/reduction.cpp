@@ -246,22 +246,21 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   // basis in the fixed order above, so the basis does not depend on the thread count.
   // The shifted operators share one pattern: one analysis (ordering, symbolic factor) for all.
   constexpr std::size_t kWave = 2;
-  std::optional<cholmod::Analysis> analysis;
-  if (!shifted.empty()) {
-    Sparse a = stiffness[shifted[0].first] + shifted[0].second * full.capacity;
+  const auto shifted_operator = [&](std::size_t i) {
+    Sparse a = stiffness[shifted[i].first] + shifted[i].second * full.capacity;
     a.makeCompressed();
-    analysis.emplace(a, "reduction: the pattern of K(h) + s C");
-  }
+    return a;
+  };
+  std::optional<cholmod::Analysis> analysis;
+  if (!shifted.empty()) analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
   for (std::size_t first = 0; first < shifted.size(); first += kWave) {
     const std::size_t count = std::min(kWave, shifted.size() - first);
     std::vector<std::vector<Eigen::MatrixXd>> moments(count);
     core::parallel_for(static_cast<std::ptrdiff_t>(count), [&](std::ptrdiff_t i) {
-      const auto [state, s] = shifted[first + static_cast<std::size_t>(i)];
-      Sparse a = stiffness[state] + s * full.capacity;
-      a.makeCompressed();
+      const std::size_t at = first + static_cast<std::size_t>(i);
       std::ostringstream what;
-      what << "reduction: K(h) + s C at s = " << s << " 1/s";
-      const cholmod::Factor factor(*analysis, a, what.str());
+      what << "reduction: K(h) + s C at s = " << shifted[at].second << " 1/s";
+      const cholmod::Factor factor(*analysis, shifted_operator(at), what.str());
       auto& out = moments[static_cast<std::size_t>(i)];
       out.push_back(factor.solve(rhs));
       if (options.second_moment) out.push_back(factor.solve(full.capacity * out.back()));
