@@ -860,6 +860,20 @@ SharedFit shared_fit(const std::vector<Normal>& normals, const CalibrationOption
 }
 
 /// Scores every candidate on whitened residuals `ys` (per run); fills fits in candidate order.
+/// Every run whitened with `sigma`: the kept rows, and their values apart (score_all's inputs).
+struct WhitenedRuns {
+  std::vector<Whitened> ws;
+  std::vector<Eigen::VectorXd> ys;
+};
+WhitenedRuns whitened_runs(const std::vector<RunModel>& runs, const Eigen::VectorXd& sigma) {
+  WhitenedRuns out;
+  for (const auto& rm : runs) {
+    out.ws.push_back(whitened(rm, sigma));
+    out.ys.push_back(out.ws.back().y);
+  }
+  return out;
+}
+
 std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitened>& ws,
                                  const std::vector<Eigen::VectorXd>& ys,
                                  const Eigen::VectorXd& sigma, const CalibrationOptions& o,
@@ -992,12 +1006,7 @@ std::optional<Catalogue> resized_catalogue(const Catalogue& cat, const Calibrati
                                            const Resizer& resize,
                                            std::map<int, std::vector<double>>& linearised) {
   const Eigen::VectorXd sigma = noise_sigma(cat.runs, cat.readout.sensors, o);
-  std::vector<Whitened> ws;
-  std::vector<Eigen::VectorXd> ys;
-  for (const auto& rm : cat.runs) {
-    ws.push_back(whitened(rm, sigma));
-    ys.push_back(ws.back().y);
-  }
+  const auto [ws, ys] = whitened_runs(cat.runs, sigma);
   std::vector<EffectFit> fits = score_all(cat, ws, ys, sigma, o, true);
   std::vector<size_t> order(fits.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -1106,12 +1115,7 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
   const core::CaseSpec& spec = out.runs.front().spec;
   const mesh::TetMesh& m = model.mesh();
   const Eigen::VectorXd sigma = noise_sigma(out.runs, out.readout.sensors, o);
-  std::vector<Whitened> ws;
-  std::vector<Eigen::VectorXd> ys;
-  for (const auto& rm : out.runs) {
-    ws.push_back(whitened(rm, sigma));
-    ys.push_back(ws.back().y);
-  }
+  const auto [ws, ys] = whitened_runs(out.runs, sigma);
   const ExteriorFaces ext = exterior_faces(m);
   const double half = o.patch_half_size * o.heat_refine_half_scale;
   std::set<std::pair<std::string, std::vector<int>>> seen;
@@ -1204,13 +1208,8 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
   Selection sel;
   const auto& r = cat.readout;
   sel.sigma = noise_sigma(cat.runs, r.sensors, o);
-  std::vector<Whitened> ws;
-  std::vector<Eigen::VectorXd> ys;
-  for (const auto& rm : cat.runs) {
-    ws.push_back(whitened(rm, sel.sigma));
-    ys.push_back(ws.back().y);
-    sel.residual_ss += ys.back().squaredNorm();
-  }
+  const auto [ws, ys] = whitened_runs(cat.runs, sel.sigma);
+  for (const auto& y : ys) sel.residual_ss += y.squaredNorm();
   // Noise alone: the best score over every candidate on white noise at the estimated level.
   std::mt19937_64 rng = core::generator(o.seed, 7);
   std::normal_distribution<double> normal(0.0, 1.0);
