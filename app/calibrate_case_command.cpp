@@ -116,7 +116,7 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const auto& dir = out.path();
   std::vector<std::string> train_names;
   for (const auto& t : train) train_names.push_back(t.run);
-  nlohmann::json j = calibration::calibration_json(res, train_names);
+  nlohmann::json j = calibration::calibration_json(res, r, train_names);
   std::filesystem::create_directories(dir / "augmented");
   nlohmann::json corrections = nlohmann::json::array();
   nlohmann::json files = nlohmann::json::array();

@@ -314,6 +314,12 @@ int calibrate_data_command(const CalibrateArgs& args) {
         {"segments", block_origin + "; each segment's drift re-zeroed at its start"}}},
       {"speed_input", has_speed},
       {"after_worse_than_before_on_test", worse}};
+  // The header that both calibrate modes write (docs/schemas/calibration.schema.json).
+  doc["format"] = "thermotwin-calibration/1";
+  doc["training_runs"] = nlohmann::json::array();
+  doc["test_runs"] = nlohmann::json::array();
+  for (const auto& s : splits)
+    doc[s["role"] == "train" ? "training_runs" : "test_runs"].push_back(s["folder"]);
 
   // 4. Outputs, all or nothing.
   const auto& dir = out.path();

@@ -478,18 +478,71 @@ nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& sel) {
   return out;
 }
 
-nlohmann::json calibration_json(const CalibrationResult& res,
+ChannelFigures channel_figures(const std::vector<Eigen::MatrixXd>& measured,
+                               const std::vector<Eigen::MatrixXd>& simulated, int channel) {
+  double sum_sq = 0, sum_abs = 0, largest = 0, n = 0;
+  for (size_t r = 0; r < measured.size(); ++r)
+    for (Eigen::Index i = 0; i < measured[r].rows(); ++i) {
+      const double e = measured[r](i, channel) - simulated[r](i, channel);
+      if (!std::isfinite(e)) continue;
+      sum_sq += e * e;
+      sum_abs += std::abs(e);
+      largest = std::max(largest, std::abs(e));
+      n += 1;
+    }
+  if (n == 0) return {};
+  return {std::sqrt(sum_sq / n), largest, sum_abs / n};
+}
+
+namespace {
+
+/// calibration.json's per-channel test figures, in the units the data-driven mode writes:
+/// {rms, max_abs, mae} with the suffix _K for temperatures and _um for displacements.
+nlohmann::json figures_json(const ChannelFigures& f, bool temperature) {
+  const double scale = temperature ? 1.0 : 1e6;
+  const std::string unit = temperature ? "_K" : "_um";
+  return {{"rms" + unit, f.rms * scale},
+          {"max_abs" + unit, f.max_abs * scale},
+          {"mae" + unit, f.mae * scale}};
+}
+
+}  // namespace
+
+nlohmann::json calibration_json(const CalibrationResult& res, const Readout& r,
                                 const std::vector<std::string>& train_names) {
   nlohmann::json j;
   j["format"] = "thermotwin-calibration/1";
+  j["mode"] = "model (--case)";
   j["training_runs"] = train_names;
   nlohmann::json tests = nlohmann::json::array();
   for (const auto& t : res.tests) tests.push_back(t.name);
   j["test_runs"] = tests;
+  std::vector<Eigen::MatrixXd> measured, before, after;
+  for (const auto& t : res.tests) {
+    measured.push_back(t.measured);
+    before.push_back(t.before);
+    after.push_back(t.after);
+  }
+  nlohmann::json channels_before = nlohmann::json::object();
+  nlohmann::json channels_after = nlohmann::json::object();
+  nlohmann::json worse = nlohmann::json::array();
+  for (int c = 0; c < r.channels(); ++c) {
+    const bool temperature = c < r.sensors;
+    const ChannelFigures b = channel_figures(measured, before, c);
+    const ChannelFigures a = channel_figures(measured, after, c);
+    const bool is_worse = a.rms > b.rms * (1 + 1e-12);
+    channels_before[r.ids[static_cast<size_t>(c)]] = figures_json(b, temperature);
+    channels_after[r.ids[static_cast<size_t>(c)]] = figures_json(a, temperature);
+    channels_after[r.ids[static_cast<size_t>(c)]]["worse_than_before"] = is_worse;
+    if (is_worse) worse.push_back(r.ids[static_cast<size_t>(c)]);
+  }
   j["before"] = {{"temperature_rms_K", res.before.temperature_rms_K},
-                 {"displacement_rms_um", res.before.displacement_rms_um}};
+                 {"displacement_rms_um", res.before.displacement_rms_um},
+                 {"channels", channels_before}};
   j["after"] = {{"temperature_rms_K", res.after.temperature_rms_K},
-                {"displacement_rms_um", res.after.displacement_rms_um}};
+                {"displacement_rms_um", res.after.displacement_rms_um},
+                {"channels", channels_after}};
+  j["after_worse_than_before_on_test"] = worse;
   j["effects"] = res.effects;
   j["runners_up"] = res.runners_up;
   j["ambiguous"] = res.ambiguous;

@@ -95,8 +95,17 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
                             const Catalogue& train, const std::vector<io::MeasuredRun>& test,
                             const CalibrationOptions& options);
 
-/// The calibration.json document.
-nlohmann::json calibration_json(const CalibrationResult& result,
+/// One channel's test residual, measured - simulated, over the finite samples of all runs, in
+/// the channel's unit [K | m].
+struct ChannelFigures {
+  double rms = 0, max_abs = 0, mae = 0;
+};
+ChannelFigures channel_figures(const std::vector<Eigen::MatrixXd>& measured,
+                               const std::vector<Eigen::MatrixXd>& simulated, int channel);
+
+/// The calibration.json document (docs/schemas/calibration.schema.json, shared with calibrate's
+/// data-driven mode): `r` names the channels of the per-channel test figures.
+nlohmann::json calibration_json(const CalibrationResult& result, const Readout& r,
                                 const std::vector<std::string>& train_names);
 
 }  // namespace tt::calibration

@@ -16,6 +16,7 @@
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
+#include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace tt::calibration {
@@ -58,7 +59,9 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
   EXPECT_NE(progress.find("model: reduced, order"), std::string::npos) << progress;
   EXPECT_NE(progress.find("calibrate responses 100 %"), std::string::npos) << progress;
 
+  EXPECT_TRUE(tt::test::matches_output_schemas("calibrate", out));
   const auto j = nlohmann::json::parse(rt::read_text(out / "calibration.json"));
+  EXPECT_EQ(j["mode"], "model (--case)");
   EXPECT_EQ(j["model"]["kind"], "reduced");
   EXPECT_LT(j["model"]["order"].get<int>(), j["model"]["nodes"].get<int>() / 10);
   EXPECT_FALSE(j["model"]["indicator"]["above_tolerance"].get<bool>());
