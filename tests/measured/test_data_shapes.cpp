@@ -19,6 +19,7 @@
 #include "fitting/segments.hpp"
 #include "io/measured_data.hpp"
 #include "io/measured_segments.hpp"
+#include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace fs = std::filesystem;
@@ -94,7 +95,10 @@ void drop_inputs_key(const fs::path& folder) {
   std::ofstream(folder / "meta.json") << meta.dump(1);
 }
 
+/// fit.json or calibration.json, its folder checked against the command's schemas first.
 nlohmann::json json_of(const fs::path& file) {
+  EXPECT_TRUE(tt::test::matches_output_schemas(
+      file.filename() == "fit.json" ? "fit" : "calibrate", file.parent_path()));
   return nlohmann::json::parse(read_text(file));
 }
 

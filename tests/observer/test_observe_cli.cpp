@@ -13,6 +13,7 @@
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
+#include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace tt::observe_cli_test {
@@ -66,6 +67,7 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(j["recalibrate_since_s"].get<double>(), 900.0);  // the offset is there from t = 0
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
   // 3. A sensor the model does not name: refused, naming it; nothing written.
   const fs::path bad = dir / "bad", bad_log = dir / "bad.log";
   EXPECT_NE(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",

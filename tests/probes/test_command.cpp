@@ -6,6 +6,7 @@
 #include "core/errors.hpp"
 #include "probe_fixtures.hpp"
 #include "probes/command.hpp"
+#include "tests/common/output_schema.hpp"
 
 using namespace tt::probes;
 namespace fs = std::filesystem;
@@ -46,6 +47,7 @@ TEST(ProbesCommand, RunsOnAVirtualRawFileAndShowsTheGainOfAlignment) {
   for (const char* f : {"drift.csv", "drift_xcorr.csv", "drift_noalign.csv", "drift_revmean.csv",
                         "alignment.csv", "summary.json"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+  EXPECT_TRUE(tt::test::matches_output_schemas("probes", dir / "out"));
   EXPECT_EQ(first_line(dir / "out" / "drift.csv"),
             "time_s,x1_um,y1_um,x2_um,y2_um,tilt_x_urad,tilt_y_urad");
 

@@ -11,6 +11,7 @@
 #include "mesh/mesher.hpp"
 #include "solvers/campaign.hpp"
 #include "solvers/twin.hpp"
+#include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace tt::twin_test {
@@ -51,6 +52,7 @@ TEST_F(Twin, ReduceWritesAModelItsValidationPasses) {
   const auto& v = j["validation"][0];
   EXPECT_LE(v["max_temperature_error_K"].get<double>(), 0.01);
   EXPECT_TRUE(fs::exists(rom_ / "validation.csv"));
+  EXPECT_TRUE(tt::test::matches_output_schemas("reduce", rom_));
 }
 
 TEST_F(Twin, RunFromTheReducedModelMatchesTheFullRun) {
@@ -70,6 +72,7 @@ TEST_F(Twin, RunFromTheReducedModelMatchesTheFullRun) {
         << "direction " << d;
   for (const char* f : {"temperatures.csv", "thermal_error.csv", "fields.pvd", "mesh.vtu"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_TRUE(tt::test::matches_output_schemas("run", out));
 }
 
 TEST_F(Twin, AnotherDutyCycleFromTheCommandLine) {
