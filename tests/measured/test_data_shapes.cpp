@@ -154,10 +154,10 @@ TEST(DataShapes, EmptyInputsListMeansNoSpeed) {
 TEST(DataShapes, OneRunWithSpeedCycles) {
   const fs::path dir = scratch("shapes_speed_cycles");
   const fs::path data = written(dir, "run", synthetic_run(48.0, true, 3));
-  ASSERT_EQ(
-      run({"fit", "--data", data.string(), "--out", (dir / "fit").string(), "--quiet", "--quick"},
-          {}, dir / "fit.log"),
-      0)
+  // The full candidate grid, as calibrate uses it (below).
+  ASSERT_EQ(run({"fit", "--data", data.string(), "--out", (dir / "fit").string(), "--quiet"}, {},
+                dir / "fit.log"),
+            0)
       << read_text(dir / "fit.log");
   const auto fit = json_of(dir / "fit" / "fit.json");
   EXPECT_NE(fit["blocks"].get<std::string>().find("speed cycles"), std::string::npos);
@@ -187,6 +187,21 @@ TEST(DataShapes, OneRunWithSpeedCycles) {
         << channel;
   }
   expect_fit_helps(fit);
+  // calibrate split at the same time starts from the same choice on the same speed cycles and
+  // tests it on the same data (the study's terms then include the speed's).
+  ASSERT_EQ(run({"calibrate", "--train", data.string(), "--test", data.string(), "--split-s",
+                 std::to_string(from), "--out", (dir / "cal").string(), "--quiet"},
+                {}, dir / "cal.log"),
+            0)
+      << read_text(dir / "cal.log");
+  const auto cal = json_of(dir / "cal" / "calibration.json");
+  EXPECT_TRUE(cal["speed_input"].get<bool>());
+  for (const auto& [channel, s] : fit["summary"].items()) {
+    SCOPED_TRACE(channel);
+    EXPECT_EQ(cal["models"][channel]["baseline_choice"]["model"], s["model"]);
+    EXPECT_NEAR(cal["before"]["channels"][channel]["rms_um"].get<double>(),
+                s["test_rms_um"].get<double>(), 1e-6 * s["test_rms_um"].get<double>());
+  }
 }
 
 TEST(DataShapes, ThreeOrMoreRunsTestTheLastWithoutCrashing) {
