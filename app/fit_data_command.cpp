@@ -12,7 +12,8 @@
 //    drift is re-zeroed at its first reading, as the standard's intercept assumes.
 // 2. Candidates: no compensation; least squares with and without the standard's 3σ criterion,
 //    ridge and ridge on the temperatures with their first-order lags (600 s, 3600 s) and the
-//    speed, on all sensors, over a grid of ridge strengths (--quick: a coarser grid).
+//    speed, on all sensors, over a grid of ridge strengths (--quick: a coarser grid);
+//    fitting::measured_data_candidates, which calibrate without --case chooses among too.
 // 3. Per displacement channel, blocked cross-validation (each piece held out in turn) chooses the
 //    lowest mean held-out S², guarded by one standard error against no compensation
 //    (fitting::blocked_evaluation); the choice is refitted on all training pieces and tested on
