@@ -12,7 +12,8 @@
 //    drift is re-zeroed at its first reading, as the standard's intercept assumes.
 // 2. Candidates: no compensation; least squares with and without the standard's 3σ criterion,
 //    ridge and ridge on the temperatures with their first-order lags (600 s, 3600 s) and the
-//    speed, on all sensors, over a grid of ridge strengths (--quick: a coarser grid).
+//    speed, on all sensors, over a grid of ridge strengths (--quick: a coarser grid);
+//    fitting::measured_data_candidates, which calibrate without --case chooses among too.
 // 3. Per displacement channel, blocked cross-validation (each piece held out in turn) chooses the
 //    lowest mean held-out S², guarded by one standard error against no compensation
 //    (fitting::blocked_evaluation); the choice is refitted on all training pieces and tested on
@@ -179,45 +180,6 @@ placement::PlacementResult placed_on(const std::vector<fitting::Group>& groups,
   return placement::place_all(in, options);
 }
 
-/// The candidates of one channel: no compensation; least squares on all temperature rises, as the
-/// standard fits it (3σ criterion) and plain; ridge on them and on them with their first-order lags
-/// (and the speed with its lags, where there is one) over a grid of ridge strengths: the strength
-/// is chosen by cross-validation, never fixed. Sensor subsets are left out: on
-/// data/fl-thermal-measured the best of 72 subset candidates on validation was 1.5 to 3 times worse
-/// on the test window than the lagged ridge (docs/real-data.md): choosing among many subsets on a
-/// few validation blocks selects on noise.
-std::vector<fitting::Candidate> data_candidates(int sensor_count, bool has_inputs, bool quick) {
-  fitting::SensorSet all{"all", {}};
-  for (int c = 0; c < sensor_count; ++c) all.sensors.push_back(c);
-  std::vector<fitting::Candidate> out;
-  fitting::ModelSpec none;
-  none.kind = fitting::ModelKind::no_compensation;
-  none.reject_gross_errors = false;
-  out.push_back({all, none});
-  out.push_back({all, fitting::ModelSpec{}});
-  fitting::ModelSpec plain;
-  plain.reject_gross_errors = false;
-  out.push_back({all, plain});
-  const std::vector<double> lambdas =
-      quick ? std::vector<double>{1e-4, 1e-2, 1.0}
-            : std::vector<double>{1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0};
-  for (double lambda : lambdas) {
-    // Ridge is not the standard's model: its shrinkage, not the 3σ criterion, guards it.
-    fitting::ModelSpec ridge;
-    ridge.kind = fitting::ModelKind::ridge;
-    ridge.ridge_lambda = lambda;
-    ridge.reject_gross_errors = false;
-    out.push_back({all, ridge});
-    // Heat reaches the structure through lags that the surface sensors do not show.
-    fitting::ModelSpec lagged = ridge;
-    lagged.kind = fitting::ModelKind::distributed_lag;
-    lagged.time_constants = {600.0, 3600.0};
-    lagged.use_inputs = has_inputs;
-    out.push_back({all, lagged});
-  }
-  return out;
-}
-
 nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
@@ -377,7 +339,7 @@ int fit_data_command(const FitDataArgs& args) {
   nlohmann::json summary = nlohmann::json::object();
   std::map<std::string, Eigen::MatrixXd>
       window_rows;  /// per channel: time_s, measured_um, predicted_um
-  const auto candidates = data_candidates(sensor_count, has_speed, args.quick);
+  const auto candidates = fitting::measured_data_candidates(sensor_count, has_speed, args.quick);
   for (int target = 0; target < static_cast<int>(targets.size()); ++target) {
     evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, candidates));
     if (placed) {

@@ -20,29 +20,59 @@ namespace {
 /// The fits run in µm so that sums of squares stay far from underflow and cancellation.
 constexpr double kMicrometres = 1e6;
 
-/// Normal-equation pieces of one segment: [1 X]ᵀ[1 X], [1 X]ᵀy, yᵀy (y in µm).
+/// How the baseline's form fits: with an intercept or not, and its ridge strength (linear_fit's
+/// λ, dimensionless).
+struct Form {
+  bool intercept = true;
+  double lambda = 0.0;
+};
+
+Form form_of(const Baseline& b) {
+  const bool ridge = b.spec.kind == ModelKind::ridge || b.spec.kind == ModelKind::distributed_lag;
+  return {b.spec.kind != ModelKind::no_compensation, ridge ? b.spec.ridge_lambda : 0.0};
+}
+
+/// Normal-equation pieces of one segment: AᵀA, Aᵀy, yᵀy with A = [1 X] (or X with no intercept),
+/// y in µm.
 struct Gram {
   Eigen::MatrixXd xx;
   Eigen::VectorXd xy;
   double yy = 0.0;
 };
 
-Gram gram_of(const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
-  Eigen::MatrixXd a(x.rows(), x.cols() + 1);
-  a.col(0).setOnes();
+Gram gram_of(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Form& form) {
+  const Eigen::Index first = form.intercept ? 1 : 0;
+  Eigen::MatrixXd a(x.rows(), x.cols() + first);
+  if (form.intercept) a.col(0).setOnes();
   a.rightCols(x.cols()) = x;
   return {a.transpose() * a, a.transpose() * y, y.squaredNorm()};
 }
 
-Eigen::VectorXd solved(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
-  // A small relative ridge keeps nearly collinear temperatures solvable; it is far below the data.
-  const double jitter = 1e-10 * std::max(1.0, a.diagonal().cwiseAbs().maxCoeff());
-  const Eigen::MatrixXd regular = a + jitter * Eigen::MatrixXd::Identity(a.rows(), a.cols());
-  return regular.ldlt().solve(b);
+/// The coefficients minimising linear_fit's objective from the normal matrix `a` of the fitting
+/// rows: λ times each regressor's centred sum of squares (its row count when the column is
+/// constant) on the diagonal, the intercept (column 0) not shrunk. The system is scaled to a unit
+/// diagonal, so temperatures in K and a speed in rpm are treated alike, and a relative ridge far
+/// below the data keeps nearly collinear columns solvable.
+Eigen::VectorXd solved(Eigen::MatrixXd a, const Eigen::VectorXd& b, const Form& form) {
+  if (a.rows() == 0) return Eigen::VectorXd(0);
+  if (form.intercept && form.lambda > 0.0) {
+    const double n = a(0, 0);
+    for (Eigen::Index j = 1; j < a.rows(); ++j) {
+      const double centred = a(j, j) - a(0, j) * a(0, j) / n;
+      a(j, j) += form.lambda * (centred > 0.0 ? centred : n);
+    }
+  }
+  Eigen::VectorXd scale = a.diagonal().cwiseAbs().cwiseSqrt();
+  for (Eigen::Index j = 0; j < scale.size(); ++j)
+    if (!(scale(j) > 0.0)) scale(j) = 1.0;
+  const Eigen::VectorXd inverse = scale.cwiseInverse();
+  Eigen::MatrixXd unit = inverse.asDiagonal() * a * inverse.asDiagonal();
+  unit.diagonal().array() += 1e-10;
+  return inverse.asDiagonal() * unit.ldlt().solve(inverse.asDiagonal() * b);
 }
 
 /// Leave-one-segment-out residual sum of squares [µm²] of each segment, from per-segment Grams.
-Eigen::VectorXd heldout_rss_per_segment(const std::vector<Gram>& grams) {
+Eigen::VectorXd heldout_rss_per_segment(const std::vector<Gram>& grams, const Form& form) {
   Gram total{Eigen::MatrixXd::Zero(grams[0].xx.rows(), grams[0].xx.cols()),
              Eigen::VectorXd::Zero(grams[0].xy.size()), 0.0};
   for (const auto& g : grams) {
@@ -52,16 +82,11 @@ Eigen::VectorXd heldout_rss_per_segment(const std::vector<Gram>& grams) {
   Eigen::VectorXd rss(static_cast<Eigen::Index>(grams.size()));
   for (std::size_t k = 0; k < grams.size(); ++k) {
     const auto& g = grams[k];
-    const Eigen::VectorXd beta = solved(total.xx - g.xx, total.xy - g.xy);
+    const Eigen::VectorXd beta = solved(total.xx - g.xx, total.xy - g.xy, form);
     rss(static_cast<Eigen::Index>(k)) =
         std::max(0.0, g.yy - 2.0 * beta.dot(g.xy) + beta.dot(g.xx * beta));
   }
   return rss;
-}
-
-/// Leave-one-segment-out residual sum of squares [µm²] from per-segment Grams.
-double heldout_rss_of(const std::vector<Gram>& grams) {
-  return heldout_rss_per_segment(grams).sum();
 }
 
 Eigen::VectorXd increment(const Segment& s, int sensor) {
@@ -99,11 +124,10 @@ Eigen::MatrixXd term_columns(const EffectTerm& term, const std::vector<int>& sen
   return Eigen::MatrixXd(n, 0);
 }
 
-Eigen::MatrixXd base_columns(const std::vector<int>& sensors, const Segment& s) {
-  Eigen::MatrixXd x(s.group.time.size(), static_cast<Eigen::Index>(sensors.size()));
-  for (std::size_t k = 0; k < sensors.size(); ++k)
-    x.col(static_cast<Eigen::Index>(k)) = increment(s, sensors[k]);
-  return x;
+Eigen::MatrixXd base_columns(const Baseline& baseline, const Segment& s) {
+  if (baseline.spec.kind == ModelKind::no_compensation)
+    return Eigen::MatrixXd(s.group.time.size(), 0);
+  return feature_matrix(baseline.features, s.group);
 }
 
 Eigen::MatrixXd joined_columns(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
@@ -167,7 +191,9 @@ std::vector<EffectTerm> term_grid(EffectKind kind, const std::vector<int>& senso
         for (double tau : options.time_constants) grid.push_back({kind, tau, -1});
       break;
     case EffectKind::lag:
-      for (double tau : options.time_constants) grid.push_back({kind, tau, -1});
+      // A lag filters the baseline's sensors: none to filter on no compensation.
+      if (!sensors.empty())
+        for (double tau : options.time_constants) grid.push_back({kind, tau, -1});
       break;
     case EffectKind::ambient_temperature:
       if (options.ambient_sensor >= 0 &&
@@ -191,14 +217,15 @@ std::vector<EffectTerm> term_grid(EffectKind kind, const std::vector<int>& senso
 struct Workspace {
   std::vector<Eigen::MatrixXd> current;  /// per segment, the current model's regressors
   std::vector<Eigen::VectorXd> y;        /// per segment, the target [µm]
+  Form form;
 };
 
 Eigen::VectorXd rss_per_segment_with(const Workspace& w,
                                      const std::vector<Eigen::MatrixXd>& extra) {
   std::vector<Gram> grams;
   for (std::size_t g = 0; g < w.y.size(); ++g)
-    grams.push_back(gram_of(joined_columns(w.current[g], extra[g]), w.y[g]));
-  return heldout_rss_per_segment(grams);
+    grams.push_back(gram_of(joined_columns(w.current[g], extra[g]), w.y[g], w.form));
+  return heldout_rss_per_segment(grams, w.form);
 }
 
 double rss_with(const Workspace& w, const std::vector<Eigen::MatrixXd>& extra) {
@@ -272,11 +299,12 @@ std::pair<int, double> best_of_grid(
   return {best, best_rss / (kMicrometres * kMicrometres)};
 }
 
-Workspace workspace(const std::vector<Segment>& segments, int target,
-                    const std::vector<int>& sensors, const std::vector<EffectTerm>& terms) {
+Workspace workspace(const std::vector<Segment>& segments, int target, const Baseline& baseline,
+                    const std::vector<EffectTerm>& terms) {
   Workspace w;
+  w.form = form_of(baseline);
   for (const auto& s : segments) {
-    w.current.push_back(term_regressors(sensors, terms, s));
+    w.current.push_back(term_regressors(baseline, terms, s));
     w.y.push_back(target_um(s, target));
   }
   return w;
@@ -316,19 +344,51 @@ std::string effect_kind_name(EffectKind kind) {
   return "unknown";
 }
 
-Eigen::MatrixXd term_regressors(const std::vector<int>& sensors,
-                                const std::vector<EffectTerm>& terms, const Segment& segment) {
-  Eigen::MatrixXd x = base_columns(sensors, segment);
-  for (const auto& term : terms) x = joined_columns(x, term_columns(term, sensors, segment));
+Baseline baseline_of(const FittedModel& model) {
+  switch (model.spec.kind) {
+    case ModelKind::no_compensation:
+      return {model.spec, FeatureMap{}};
+    case ModelKind::least_squares:
+    case ModelKind::ridge:
+    case ModelKind::distributed_lag:
+      return {model.spec, model.features};
+    default:
+      break;
+  }
+  throw core::DataError("residual study from a '" + model_label(model.spec) +
+                        "' model: expected a model linear in its regressors (least squares, "
+                        "ridge, distributed lag) or no compensation");
+}
+
+Baseline least_squares_baseline(const std::vector<int>& sensors,
+                                const std::vector<std::string>& sensor_names) {
+  Baseline b;
+  b.spec.kind = ModelKind::least_squares;
+  b.spec.reject_gross_errors = false;
+  b.features.sensors = sensors;
+  for (int c : sensors)
+    b.features.sensor_names.push_back(sensor_names.at(static_cast<std::size_t>(c)));
+  return b;
+}
+
+const std::vector<int>& baseline_sensors(const Baseline& baseline) {
+  return baseline.features.sensors;
+}
+
+Eigen::MatrixXd term_regressors(const Baseline& baseline, const std::vector<EffectTerm>& terms,
+                                const Segment& segment) {
+  Eigen::MatrixXd x = base_columns(baseline, segment);
+  for (const auto& term : terms)
+    x = joined_columns(x, term_columns(term, baseline_sensors(baseline), segment));
   return x;
 }
 
-std::vector<std::string> term_regressor_names(const std::vector<int>& sensors,
+std::vector<std::string> term_regressor_names(const Baseline& baseline,
                                               const std::vector<EffectTerm>& terms,
                                               const std::vector<std::string>& sensor_names) {
   const auto dt = [&](int c) { return "dT[" + sensor_names.at(static_cast<std::size_t>(c)) + "]"; };
   std::vector<std::string> names;
-  for (int c : sensors) names.push_back(dt(c));
+  if (baseline.spec.kind != ModelKind::no_compensation) names = feature_names(baseline.features);
   for (const auto& term : terms) {
     const std::string lp =
         "lp" + std::to_string(static_cast<long>(std::lround(term.time_constant))) + "s(";
@@ -341,7 +401,7 @@ std::vector<std::string> term_regressor_names(const std::vector<int>& sensors,
         names.push_back(lp + "speed_krpm)");
         break;
       case EffectKind::lag:
-        for (int c : sensors) names.push_back(lp + dt(c) + ")");
+        for (int c : baseline_sensors(baseline)) names.push_back(lp + dt(c) + ")");
         break;
       case EffectKind::ambient_temperature:
       case EffectKind::missing_sensor:
@@ -356,43 +416,57 @@ std::vector<std::string> term_regressor_names(const std::vector<int>& sensors,
 }
 
 Eigen::VectorXd term_prediction(const TermModel& model, const Segment& segment) {
-  return linear_prediction(model.fit, term_regressors(model.sensors, model.terms, segment));
+  return linear_prediction(model.fit, term_regressors(model.baseline, model.terms, segment));
 }
 
 TermModel fitted_term_model(const std::vector<Segment>& segments, int target,
-                            const std::vector<int>& sensors, const std::vector<EffectTerm>& terms) {
+                            const Baseline& baseline, const std::vector<EffectTerm>& terms) {
   require_segments(segments, target);
-  const Workspace w = workspace(segments, target, sensors, terms);
-  Gram total = gram_of(w.current[0], w.y[0]);
+  TermModel model;
+  model.target = target;
+  model.baseline = baseline;
+  model.terms = terms;
+  const bool none = baseline.spec.kind == ModelKind::no_compensation;
+  if (terms.empty() && none) {
+    model.fit = LinearFit{0.0, Eigen::VectorXd(0)};
+    return model;
+  }
+  if (terms.empty()) {
+    // The baseline alone is fitted as the model choice fits it (the 3σ criterion included).
+    const FittedModel fitted =
+        fitted_model(baseline.spec, segment_groups(segments), baseline_sensors(baseline), target);
+    model.fit = std::get<LinearFit>(fitted.body);
+    return model;
+  }
+  const Workspace w = workspace(segments, target, baseline, terms);
+  Gram total = gram_of(w.current[0], w.y[0], w.form);
   for (std::size_t g = 1; g < segments.size(); ++g) {
-    const Gram next = gram_of(w.current[g], w.y[g]);
+    const Gram next = gram_of(w.current[g], w.y[g], w.form);
     total.xx += next.xx;
     total.xy += next.xy;
   }
-  const Eigen::VectorXd beta = solved(total.xx, total.xy) / kMicrometres;
-  TermModel model;
-  model.target = target;
-  model.sensors = sensors;
-  model.terms = terms;
-  model.fit.intercept = beta(0);
-  model.fit.coefficients = beta.tail(beta.size() - 1);
+  const Eigen::VectorXd beta = solved(total.xx, total.xy, w.form) / kMicrometres;
+  const Eigen::Index first = w.form.intercept ? 1 : 0;
+  model.fit.intercept = w.form.intercept ? beta(0) : 0.0;
+  model.fit.coefficients = beta.tail(beta.size() - first);
   return model;
 }
 
-double heldout_rss(const std::vector<Segment>& segments, int target,
-                   const std::vector<int>& sensors, const std::vector<EffectTerm>& terms) {
+double heldout_rss(const std::vector<Segment>& segments, int target, const Baseline& baseline,
+                   const std::vector<EffectTerm>& terms) {
   require_segments(segments, target);
   if (segments.size() < 2)
     throw core::DataError("held-out residual on " + std::to_string(segments.size()) +
                           " segment: expected at least 2 training runs or segments");
-  const Workspace w = workspace(segments, target, sensors, terms);
+  const Workspace w = workspace(segments, target, baseline, terms);
   std::vector<Gram> grams;
-  for (std::size_t g = 0; g < segments.size(); ++g) grams.push_back(gram_of(w.current[g], w.y[g]));
-  return heldout_rss_of(grams) / (kMicrometres * kMicrometres);
+  for (std::size_t g = 0; g < segments.size(); ++g)
+    grams.push_back(gram_of(w.current[g], w.y[g], w.form));
+  return heldout_rss_per_segment(grams, w.form).sum() / (kMicrometres * kMicrometres);
 }
 
 ChannelStudy residual_study(const std::vector<Segment>& training, int target,
-                            const ResidualStudyOptions& options) {
+                            const Baseline& baseline, const ResidualStudyOptions& options) {
   require_segments(training, target);
   if (training.size() < 2)
     throw core::DataError(
@@ -410,29 +484,10 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   study.target = target;
   study.target_name = training.front().group.target_names[static_cast<std::size_t>(target)];
 
-  // 1. Baseline: forward selection of sensors on the held-out residual. The first sensor is taken
-  //    even when it alone does not beat the intercept (a pair can when neither alone does); each
-  //    further one must remove 1 %.
-  std::vector<int> sensors;
-  double rss = heldout_rss(training, target, sensors, {});
-  while (static_cast<int>(sensors.size()) < std::min(options.max_sensors, sensor_count)) {
-    int best = -1;
-    double best_rss = std::numeric_limits<double>::infinity();
-    for (int c = 0; c < sensor_count; ++c) {
-      if (std::find(sensors.begin(), sensors.end(), c) != sensors.end()) continue;
-      std::vector<int> trial = sensors;
-      trial.push_back(c);
-      const double r = heldout_rss(training, target, trial, {});
-      if (r < best_rss) {
-        best_rss = r;
-        best = c;
-      }
-    }
-    if (best < 0 || (!sensors.empty() && best_rss > 0.99 * rss)) break;
-    sensors.push_back(best);
-    rss = best_rss;
-  }
-  rss = heldout_rss(training, target, sensors, {});
+  // 1. The baseline's held-out residual, each segment predicted by the baseline fitted on the
+  //    others.
+  const std::vector<int>& sensors = baseline_sensors(baseline);
+  double rss = heldout_rss(training, target, baseline, {});
   study.heldout_rss_before = rss;
   const double baseline_rss = rss;
 
@@ -446,7 +501,7 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   std::vector<EffectKind> used;
   std::uint64_t stream = 0;
   for (int step = 0; step < options.max_effects && rss > 0.0; ++step) {
-    const Workspace w = workspace(training, target, sensors, terms);
+    const Workspace w = workspace(training, target, baseline, terms);
     std::vector<Effect> tested;
     std::vector<std::vector<EffectTerm>> grids;
     for (EffectKind kind : kinds) {
@@ -508,11 +563,11 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
     study.effects.push_back(e);
     terms.push_back(e.term);
     used.push_back(e.term.kind);
-    rss = heldout_rss(training, target, sensors, terms);
+    rss = heldout_rss(training, target, baseline, terms);
   }
   study.heldout_rss_after = rss;
-  study.before = fitted_term_model(training, target, sensors, {});
-  study.after = fitted_term_model(training, target, sensors, terms);
+  study.before = fitted_term_model(training, target, baseline, {});
+  study.after = terms.empty() ? study.before : fitted_term_model(training, target, baseline, terms);
   return study;
 }
 

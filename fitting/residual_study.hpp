@@ -1,11 +1,13 @@
 // What a fitted thermal-error model lacks, traced from its residual on held-out training data.
-// The model E = β0 + Σ β_k ΔT_k (the standard's form) is fitted on training segments; candidate
-// terms built from what a measured run holds (speed, time, temperatures) are added one at a time,
-// each scored by the share of the leave-one-segment-out residual it removes, and claimed only when
-// that share, less a penalty per added coefficient, beats the best share reached by surrogates of
-// the same term: the same amplitude spectrum with random phases (as smooth and as strong, with no
-// timing relation to the residual). A circular shift would not do: a 50 % on/off duty shifted by
-// half a cycle is the same regressor with its sign flipped.
+// The study starts from a baseline model (in calibrate without --case, the one fit --data chooses
+// by blocked cross-validation: ridge or least squares on the temperature rises, possibly with
+// their first-order lags and the speed, or no compensation) fitted on training segments;
+// candidate terms built from what a measured run holds (speed, time, temperatures) are added one
+// at a time, each scored by the share of the leave-one-segment-out residual it removes, and
+// claimed only when that share, less a penalty per added coefficient, beats the best share reached
+// by surrogates of the same term: the same amplitude spectrum with random phases (as smooth and as
+// strong, with no timing relation to the residual). A circular shift would not do: a 50 % on/off
+// duty shifted by half a cycle is the same regressor with its sign flipped.
 #pragma once
 
 #include <Eigen/Dense>
@@ -14,7 +16,9 @@
 #include <string>
 #include <vector>
 
+#include "fitting/features.hpp"
 #include "fitting/linear.hpp"
+#include "fitting/models.hpp"
 #include "fitting/segments.hpp"
 
 namespace tt::fitting {
@@ -47,34 +51,59 @@ struct EffectTerm {
   int sensor = -1;
 };
 
-/// A linear model: intercept, ΔT of `sensors`, then the regressors of each term in order.
+/// The model a study starts from: a linear model's form (its spec: least squares, ridge or
+/// distributed lag with its ridge strength, or no compensation) and its regressors. Terms are
+/// fitted jointly with the baseline's regressors under the baseline's ridge strength (the 3σ
+/// criterion of the standard's least squares applies to the baseline alone). No compensation has
+/// no regressors and no intercept: the terms added to it are fitted without one.
+struct Baseline {
+  ModelSpec spec;
+  /// empty for no compensation
+  FeatureMap features;
+};
+
+/// The baseline of a fitted linear model (e.g. blocked_evaluation's choice); throws DataError for
+/// a model that is not linear in its regressors (PPR, the network).
+Baseline baseline_of(const FittedModel& model);
+
+/// The standard's least squares (no 3σ criterion) on the temperature rises of `sensors`.
+Baseline least_squares_baseline(const std::vector<int>& sensors,
+                                const std::vector<std::string>& sensor_names);
+
+/// The temperature columns the baseline reads (what a lag filters and a missing sensor is not).
+const std::vector<int>& baseline_sensors(const Baseline& baseline);
+
+/// A linear model: intercept (none on a no-compensation baseline), the baseline's regressors,
+/// then the regressors of each term in order.
 struct TermModel {
   int target = 0;
-  std::vector<int> sensors;
+  Baseline baseline;
   std::vector<EffectTerm> terms;
-  /// intercept [m] and coefficients [m per regressor unit: K, krpm, krpm², h]
+  /// intercept [m] and coefficients [m per regressor unit: K, rpm (the baseline's speed), krpm,
+  /// krpm², h]
   LinearFit fit;
 };
 
 /// #samples x #regressors of a model on a segment, without the intercept column.
-Eigen::MatrixXd term_regressors(const std::vector<int>& sensors,
-                                const std::vector<EffectTerm>& terms, const Segment& segment);
+Eigen::MatrixXd term_regressors(const Baseline& baseline, const std::vector<EffectTerm>& terms,
+                                const Segment& segment);
 
-/// Names of term_regressors' columns, e.g. "dT[t5]", "speed_krpm", "lp3600s(speed_krpm)".
-std::vector<std::string> term_regressor_names(const std::vector<int>& sensors,
+/// Names of term_regressors' columns, e.g. "dT[t5]", "lp600s(d[speed_rpm])", "speed_krpm",
+/// "lp3600s(speed_krpm)".
+std::vector<std::string> term_regressor_names(const Baseline& baseline,
                                               const std::vector<EffectTerm>& terms,
                                               const std::vector<std::string>& sensor_names);
 
 /// #samples predicted error [m] of the model's target on a segment.
 Eigen::VectorXd term_prediction(const TermModel& model, const Segment& segment);
 
-/// The model least-squares fitted on the segments' target column (all rows stacked).
+/// The model fitted on the segments' target column (all rows stacked). With no terms it is the
+/// baseline exactly as fitting::fitted_model fits it (so calibrate's before is fit --data's
+/// chosen model); with terms, the joint fit under the baseline's ridge strength.
 TermModel fitted_term_model(const std::vector<Segment>& segments, int target,
-                            const std::vector<int>& sensors, const std::vector<EffectTerm>& terms);
+                            const Baseline& baseline, const std::vector<EffectTerm>& terms);
 
 struct ResidualStudyOptions {
-  /// the baseline picks up to this many sensors by forward selection on held-out residual
-  int max_sensors = 4;
   /// time constants tried for lag and lagged_speed [s]
   std::vector<double> time_constants{900.0, 1800.0, 3600.0, 7200.0, 14400.0};
   /// phase-randomised surrogates per tested term; the claim threshold is their largest share (19
@@ -123,7 +152,7 @@ struct Effect {
 struct ChannelStudy {
   int target = 0;
   std::string target_name;
-  /// the baseline: ΔT of forward-selected sensors, fitted on all training segments
+  /// the baseline, fitted on all training segments
   TermModel before;
   /// the baseline with the claimed effects, fitted on all training segments
   TermModel after;
@@ -137,13 +166,15 @@ struct ChannelStudy {
   double heldout_rss_after = 0.0;
 };
 
-/// The study for one error column of at least 2 training segments. Throws DataError on fewer
-/// segments or inconsistent ones.
+/// The study for one error column of at least 2 training segments, from `baseline`. Throws
+/// DataError on fewer segments or inconsistent ones.
 ChannelStudy residual_study(const std::vector<Segment>& training, int target,
-                            const ResidualStudyOptions& options);
+                            const Baseline& baseline, const ResidualStudyOptions& options);
 
-/// Leave-one-segment-out residual sum of squares [m²] of the model (sensors, terms).
-double heldout_rss(const std::vector<Segment>& segments, int target,
-                   const std::vector<int>& sensors, const std::vector<EffectTerm>& terms);
+/// Leave-one-segment-out residual sum of squares [m²] of the model (baseline, terms), each fold
+/// fitted as fitted_term_model fits it with terms (the baseline's ridge on the fold's own column
+/// scales; no 3σ criterion).
+double heldout_rss(const std::vector<Segment>& segments, int target, const Baseline& baseline,
+                   const std::vector<EffectTerm>& terms);
 
 }  // namespace tt::fitting

@@ -269,6 +269,38 @@ Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vecto
   return result;
 }
 
+std::vector<Candidate> measured_data_candidates(int sensor_count, bool has_inputs, bool quick) {
+  SensorSet all{"all", {}};
+  for (int c = 0; c < sensor_count; ++c) all.sensors.push_back(c);
+  std::vector<Candidate> out;
+  ModelSpec none;
+  none.kind = ModelKind::no_compensation;
+  none.reject_gross_errors = false;
+  out.push_back({all, none});
+  out.push_back({all, ModelSpec{}});
+  ModelSpec plain;
+  plain.reject_gross_errors = false;
+  out.push_back({all, plain});
+  const std::vector<double> lambdas =
+      quick ? std::vector<double>{1e-4, 1e-2, 1.0}
+            : std::vector<double>{1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0};
+  for (double lambda : lambdas) {
+    // Ridge is not the standard's model: its shrinkage, not the 3σ criterion, guards it.
+    ModelSpec ridge;
+    ridge.kind = ModelKind::ridge;
+    ridge.ridge_lambda = lambda;
+    ridge.reject_gross_errors = false;
+    out.push_back({all, ridge});
+    // Heat reaches the structure through lags that the surface sensors do not show.
+    ModelSpec lagged = ridge;
+    lagged.kind = ModelKind::distributed_lag;
+    lagged.time_constants = {600.0, 3600.0};
+    lagged.use_inputs = has_inputs;
+    out.push_back({all, lagged});
+  }
+  return out;
+}
+
 std::vector<OutOfRange> out_of_training_range(const std::vector<Group>& training,
                                               const std::vector<Group>& test) {
   require_consistent_groups(training);

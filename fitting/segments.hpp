@@ -97,6 +97,16 @@ Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vecto
                               const std::vector<int>& test, int target,
                               const std::vector<Candidate>& candidates);
 
+/// The candidates fit --data and calibrate (without --case) choose among for a channel of measured
+/// runs: no compensation; least squares on all temperature rises, as the standard fits it (3σ
+/// criterion) and plain; ridge on them and on them with their first-order lags at 600 s and 3600 s
+/// (and the inputs with their lags, has_inputs) over a grid of ridge strengths λ in 1e-6..10
+/// (quick: 1e-4, 1e-2, 1), so that the strength is chosen by blocked_evaluation, never fixed.
+/// Sensor subsets are left out: on data/fl-thermal-measured the best of 72 subset candidates on
+/// validation was 1.5 to 3 times worse on the test window than the lagged ridge
+/// (docs/real-data.md): choosing among many subsets on a few validation blocks selects on noise.
+std::vector<Candidate> measured_data_candidates(int sensor_count, bool has_inputs, bool quick);
+
 /// A temperature or input increment the test groups take outside the training groups' range.
 struct OutOfRange {
   /// e.g. "dT[t3]", "d[speed_rpm]"

@@ -158,10 +158,10 @@ TEST(DataShapes, EmptyInputsListMeansNoSpeed) {
 TEST(DataShapes, OneRunWithSpeedCycles) {
   const fs::path dir = scratch("shapes_speed_cycles");
   const fs::path data = written(dir, "run", synthetic_run(48.0, true, 3));
-  ASSERT_EQ(
-      run({"fit", "--data", data.string(), "--out", (dir / "fit").string(), "--quiet", "--quick"},
-          {}, dir / "fit.log"),
-      0)
+  // The full candidate grid, as calibrate uses it (below).
+  ASSERT_EQ(run({"fit", "--data", data.string(), "--out", (dir / "fit").string(), "--quiet"}, {},
+                dir / "fit.log"),
+            0)
       << read_text(dir / "fit.log");
   const auto fit = json_of(dir / "fit" / "fit.json");
   EXPECT_NE(fit["blocks"].get<std::string>().find("speed cycles"), std::string::npos);
@@ -191,6 +191,21 @@ TEST(DataShapes, OneRunWithSpeedCycles) {
         << channel;
   }
   expect_fit_helps(fit);
+  // calibrate split at the same time starts from the same choice on the same speed cycles and
+  // tests it on the same data (the study's terms then include the speed's).
+  ASSERT_EQ(run({"calibrate", "--train", data.string(), "--test", data.string(), "--split-s",
+                 std::to_string(from), "--out", (dir / "cal").string(), "--quiet"},
+                {}, dir / "cal.log"),
+            0)
+      << read_text(dir / "cal.log");
+  const auto cal = json_of(dir / "cal" / "calibration.json");
+  EXPECT_TRUE(cal["speed_input"].get<bool>());
+  for (const auto& [channel, s] : fit["summary"].items()) {
+    SCOPED_TRACE(channel);
+    EXPECT_EQ(cal["models"][channel]["baseline_choice"]["model"], s["model"]);
+    EXPECT_NEAR(cal["before"]["channels"][channel]["rms_um"].get<double>(),
+                s["test_rms_um"].get<double>(), 1e-6 * s["test_rms_um"].get<double>());
+  }
 }
 
 TEST(DataShapes, ThreeOrMoreRunsTestTheLastWithoutCrashing) {
@@ -219,7 +234,8 @@ TEST(DataShapes, DaysAsRunsWithHeldOutDays) {
   fit_args.insert(fit_args.end(), train.begin(), train.end());
   fit_args.push_back("--test");
   fit_args.insert(fit_args.end(), test.begin(), test.end());
-  fit_args.insert(fit_args.end(), {"--out", (dir / "fit").string(), "--quiet", "--quick"});
+  // The full candidate grid, as calibrate uses it, so that calibrate's before is this choice.
+  fit_args.insert(fit_args.end(), {"--out", (dir / "fit").string(), "--quiet"});
   ASSERT_EQ(run(fit_args, {}, dir / "fit.log"), 0) << read_text(dir / "fit.log");
   const auto fit = json_of(dir / "fit" / "fit.json");
   EXPECT_EQ(fit["groups"].size(), 6u);
@@ -231,6 +247,22 @@ TEST(DataShapes, DaysAsRunsWithHeldOutDays) {
   cal_args.insert(cal_args.end(), {"--out", (dir / "cal").string(), "--quiet"});
   ASSERT_EQ(run(cal_args, {}, dir / "cal.log"), 0) << read_text(dir / "cal.log");
   const auto cal = json_of(dir / "cal" / "calibration.json");
+  // calibrate's baseline is fit --data's chosen model on the same blocks: the same form and the
+  // same test error per channel.
+  for (const auto& [channel, s] : fit["summary"].items()) {
+    SCOPED_TRACE(channel);
+    EXPECT_EQ(cal["models"][channel]["baseline_choice"]["model"], s["model"]);
+    EXPECT_EQ(cal["models"][channel]["before"]["form"], s["model"]);
+    EXPECT_NEAR(cal["before"]["channels"][channel]["rms_um"].get<double>(),
+                s["test_rms_um"].get<double>(), 1e-6 * s["test_rms_um"].get<double>());
+    EXPECT_NEAR(cal["models"][channel]["baseline_choice"]["validation_rms_um"].get<double>(),
+                s["validation_rms_um"].get<double>(), 1e-6 * s["validation_rms_um"].get<double>());
+  }
+  for (const auto& [channel, c] : cal["after"]["channels"].items())
+    if (c["worse_than_before"].get<bool>())
+      EXPECT_NE(std::find(cal["after_worse_than_before_on_test"].begin(),
+                          cal["after_worse_than_before_on_test"].end(), channel),
+                cal["after_worse_than_before_on_test"].end());
   for (const auto& e : cal["effects"]) {
     EXPECT_GE(e["null_fraction"].get<double>(), 0.0);
     EXPECT_GT(e["heldout_gain_t"].get<double>(), 2.0);
@@ -310,7 +342,14 @@ TEST(DataShapes, ClaimThresholdIsNeverNegative) {
   const auto blocks = fitting::cross_validation_blocks(io::measured_segments(r, "run"));
   fitting::ResidualStudyOptions options;
   options.null_draws = 5;
-  const auto study = fitting::residual_study(blocks.segments, 1, options);
+  // From the baseline calibrate takes: fit --data's choice on the same blocks.
+  const auto groups = fitting::segment_groups(blocks.segments);
+  std::vector<int> pool;
+  for (std::size_t i = 0; i < groups.size(); ++i) pool.push_back(static_cast<int>(i));
+  const auto choice = fitting::blocked_evaluation(
+      groups, pool, {}, 1, fitting::measured_data_candidates(4, false, false));
+  const auto study =
+      fitting::residual_study(blocks.segments, 1, fitting::baseline_of(choice.model), options);
   for (const auto& step : study.steps)
     for (const auto& e : step)
       if (std::isfinite(e.null_fraction)) EXPECT_GE(e.null_fraction, 0.0);
