@@ -259,7 +259,7 @@ int fit_command(const FitArgs& args) {
   io::ModellingConditions conditions;
   conditions.machine_model = spec.machine.empty() ? spec.name : spec.machine;
   conditions.machine_number = "virtual";
-  conditions.modelling_date = "2026-11-21";
+  conditions.modelling_date = io::modelling_date_today();
   conditions.initial_ambient_temperature =
       spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   double max_speed = 0;

@@ -49,52 +49,6 @@
 namespace tt::app {
 namespace {
 
-/// A figure published for a data set: the test window and the MAE per channel [µm].
-struct Published {
-  std::string model, source, note;
-  double from_s = 0.0, to_s = 0.0;
-  std::map<std::string, double> mae_um;
-  std::map<std::string, std::map<std::string, double>> others_um;
-};
-
-/// The published figure of the FL_THERMAL data (shared/data/fl_thermal_spindle_5probe/SOURCE.md).
-std::optional<Published> published_for(const io::MeasuredRun& run) {
-  const auto it = run.meta.find("source");
-  if (it == run.meta.end() || !it->is_string() ||
-      it->get<std::string>().find("FL_THERMAL") == std::string::npos)
-    return std::nullopt;
-  Published p;
-  p.model = "seq2seq v2 (GRU encoder-decoder with attention)";
-  p.source = "github.com/CAIVIAC/FL_THERMAL, figures images/test_ch*(um)_S2S2[e100].png";
-  p.note =
-      "test window inferred from the plotted ground truth (rows ~6581-8800); the split is not "
-      "stated, so the "
-      "comparison is context, not a gate";
-  p.from_s = 98700.0;
-  p.to_s = 132000.0;
-  p.mae_um = {{"ch1", 3.561}, {"ch2", 3.755}, {"ch3", 3.704}, {"ch4", 3.461}, {"ch5", 4.284}};
-  p.others_um = {
-      {"random_forest",
-       {{"ch1", 6.456}, {"ch2", 4.501}, {"ch3", 7.330}, {"ch4", 7.178}, {"ch5", 12.440}}},
-      {"xgboost", {{"ch1", 5.611}, {"ch2", 4.966}, {"ch3", 6.039}, {"ch4", 7.804}, {"ch5", 9.535}}},
-      {"seq2seq_v1",
-       {{"ch1", 5.576}, {"ch2", 5.943}, {"ch3", 4.183}, {"ch4", 4.160}, {"ch5", 6.499}}}};
-  return p;
-}
-
-std::optional<Eigen::AlignedBox3d> machine_box(const std::filesystem::path& folder) {
-  std::ifstream in(folder / "meta.json");
-  try {
-    const auto meta = nlohmann::json::parse(in);
-    if (meta.value("machine", std::string()) == "SB-1")
-      return Eigen::AlignedBox3d(Eigen::Vector3d(-0.16, 0.0, -0.04),
-                                 Eigen::Vector3d(0.16, 0.30, 0.58));
-  } catch (const std::exception&) {
-    // read_measured_run reports a malformed meta.json with its location.
-  }
-  return std::nullopt;
-}
-
 /// The chosen model form refitted on the whole run outside [from, to): one group from the run's
 /// start, fitted on the rows outside the window, predicting the rows inside. #window rows [m].
 struct WindowPrediction {
@@ -216,9 +170,7 @@ int fit_data_command(const FitDataArgs& args) {
   io::OutputDir out(args.out, inputs);
   std::vector<io::MeasuredRun> runs;
   const auto read = [&](const std::filesystem::path& folder) {
-    io::MeasuredReadLimits limits;
-    limits.machine_box = machine_box(folder);
-    runs.push_back(io::read_measured_run(folder, limits));
+    runs.push_back(io::read_measured_run(folder));
   };
   for (const auto& folder : args.runs) read(folder);
   for (const auto& folder : args.test_runs) read(folder);
@@ -243,8 +195,9 @@ int fit_data_command(const FitDataArgs& args) {
           ": every run must have the same inputs; hint: drop the speed column from all runs, or "
           "give it in all");
   }
-  const std::optional<Published> published =
-      args.test_runs.empty() ? published_for(runs.back()) : std::nullopt;
+  // A published figure for the data (meta.json `published`) sets the default test window.
+  const std::optional<io::PublishedFigure> published =
+      args.test_runs.empty() ? runs.back().published : std::nullopt;
   double from = -std::numeric_limits<double>::infinity(),
          to = std::numeric_limits<double>::infinity();
   int window_run = static_cast<int>(training_runs) - 1;
@@ -503,7 +456,7 @@ int fit_data_command(const FitDataArgs& args) {
                           {"source", published->source},
                           {"note", published->note},
                           {"mae_um", published->mae_um},
-                          {"others_mae_um", published->others_um}};
+                          {"others_mae_um", published->others_mae_um}};
     }
     io::write_json(dir / "fit.json", doc);
     for (const auto& [channel, n] : networks)

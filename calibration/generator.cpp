@@ -271,6 +271,9 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
   const solvers::ThermalHistory th = solvers::thermal_history(m, truth, ops);
   io::MeasuredRun run;
   run.machine = truth.machine;
+  // The mesh's extent: readers check every position against it (meta.json machine_box_m).
+  run.machine_box = Eigen::AlignedBox3d(m.nodes.colwise().minCoeff().transpose(),
+                                        m.nodes.colwise().maxCoeff().transpose());
   run.run = name;
   run.inputs = {"speed_rpm"};
   run.initial_temperature_c = truth.thermal.initial_temperature_c;

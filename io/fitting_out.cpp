@@ -1,6 +1,9 @@
 #include "io/fitting_out.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 
@@ -9,6 +12,21 @@
 #include "io/atomic_dir.hpp"
 
 namespace tt::io {
+
+std::string modelling_date_today() {
+  using namespace std::chrono;
+  sys_seconds now = time_point_cast<seconds>(system_clock::now());
+  if (const char* epoch = std::getenv("SOURCE_DATE_EPOCH")) {
+    char* end = nullptr;
+    const long long s = std::strtoll(epoch, &end, 10);
+    if (end != epoch && *end == '\0' && s >= 0) now = sys_seconds(seconds(s));
+  }
+  const year_month_day day{floor<days>(now)};
+  char text[16];
+  std::snprintf(text, sizeof text, "%04d-%02u-%02u", static_cast<int>(day.year()),
+                static_cast<unsigned>(day.month()), static_cast<unsigned>(day.day()));
+  return text;
+}
 
 namespace {
 

@@ -49,6 +49,11 @@ struct ModellingConditions {
   std::optional<CuttingConditions> cutting;
 };
 
+/// Today's date in UTC, ISO 8601 ("2026-11-26"): the modelling date of a record written now. With
+/// SOURCE_DATE_EPOCH set (seconds since 1970, the reproducible-builds convention) that instant's
+/// date, so that a rerun writes the same record.
+std::string modelling_date_today();
+
 /// A fitted model's coefficients: intercept and named terms [µm, µm/K] for linear models, the
 /// ridge functions for PPR; with the sensors and the operating inputs (e.g. "speed_rpm") it reads,
 /// so that io/fit_model_in.hpp can evaluate it again.

@@ -102,6 +102,20 @@ std::optional<Eigen::Vector3d> optional_vector(const fs::path& file, const json&
   return v;
 }
 
+/// {"min": [x, y, z], "max": [x, y, z]} in metres with min <= max, or nothing when absent or null.
+std::optional<Eigen::AlignedBox3d> optional_box(const fs::path& file, const json& meta,
+                                                const std::string& key) {
+  const auto it = meta.find(key);
+  if (it == meta.end() || it->is_null()) return std::nullopt;
+  if (!it->is_object() || !it->contains("min") || !it->contains("max"))
+    meta_error(file, key, json_text(*it) + ": expected {\"min\": [x, y, z], \"max\": [x, y, z]}");
+  const auto lo = optional_vector(file, *it, "min", key + ".min");
+  const auto hi = optional_vector(file, *it, "max", key + ".max");
+  if (!lo || !hi || !(lo->array() <= hi->array()).all())
+    meta_error(file, key, json_text(*it) + ": min must be at most max in every coordinate");
+  return Eigen::AlignedBox3d(*lo, *hi);
+}
+
 void require_inside(const fs::path& file, const std::optional<Eigen::AlignedBox3d>& box,
                     const std::optional<Eigen::Vector3d>& p, const std::string& path,
                     const std::string& machine) {
@@ -142,6 +156,54 @@ std::string item_id(const fs::path& file, const json& item, const std::string& p
   return id;
 }
 
+/// An object of finite numbers keyed by displacement ids [um].
+std::map<std::string, double> mae_table(const fs::path& file, const json& object,
+                                        const std::string& path, const MeasuredRun& run) {
+  if (!object.is_object())
+    meta_error(file, path, json_text(object) + ": expected {\"<displacement id>\": MAE in um}");
+  std::map<std::string, double> table;
+  for (const auto& [id, value] : object.items()) {
+    bool known = false;
+    for (const auto& p : run.displacements) known = known || p.id == id;
+    if (!known) meta_error(file, path + "." + id, "'" + id + "' is not the id of a displacement");
+    if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0)
+      meta_error(file, path + "." + id, json_text(value) + ": expected a number >= 0 [um]");
+    table[id] = value.get<double>();
+  }
+  return table;
+}
+
+/// meta.json's `published`, or nothing when absent or null.
+std::optional<PublishedFigure> published_figure(const fs::path& file, const json& meta,
+                                                const MeasuredRun& run) {
+  const auto it = meta.find("published");
+  if (it == meta.end() || it->is_null()) return std::nullopt;
+  if (!it->is_object()) meta_error(file, "published", json_text(*it) + ": expected an object");
+  const json& p = *it;
+  PublishedFigure f;
+  f.model = string_value(file, required_key(file, p, "model", "published.model"), "published.model");
+  f.source =
+      string_value(file, required_key(file, p, "source", "published.source"), "published.source");
+  if (p.contains("note")) f.note = string_value(file, p["note"], "published.note");
+  const json& window = required_key(file, p, "test_window_s", "published.test_window_s");
+  if (!window.is_array() || window.size() != 2 || !window[0].is_number() ||
+      !window[1].is_number() || !(window[0].get<double>() < window[1].get<double>()))
+    meta_error(file, "published.test_window_s",
+               json_text(window) + ": expected [from, to] in seconds with from < to");
+  f.from_s = window[0].get<double>();
+  f.to_s = window[1].get<double>();
+  f.mae_um = mae_table(file, required_key(file, p, "mae_um", "published.mae_um"),
+                       "published.mae_um", run);
+  if (const auto o = p.find("others_mae_um"); o != p.end()) {
+    if (!o->is_object())
+      meta_error(file, "published.others_mae_um",
+                 json_text(*o) + ": expected {\"<model>\": {\"<displacement id>\": MAE}}");
+    for (const auto& [model, table] : o->items())
+      f.others_mae_um[model] = mae_table(file, table, "published.others_mae_um." + model, run);
+  }
+  return f;
+}
+
 /// meta.json as a run with no samples yet.
 MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
   std::ifstream in(file, std::ios::binary);
@@ -165,6 +227,10 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   if (format != kFormat)
     meta_error(file, "format", "unknown format '" + format + "': expected '" + kFormat + "'");
   run.machine = string_value(file, required_key(file, meta, "machine", "machine"), "machine");
+  // The machine's bounding box, when the data carry it; the caller's box checks in its place.
+  run.machine_box = optional_box(file, meta, "machine_box_m");
+  const std::optional<Eigen::AlignedBox3d> box = limits.machine_box ? limits.machine_box
+                                                                    : run.machine_box;
   if (meta.contains("run")) run.run = string_value(file, meta["run"], "run");
   require_unit(file, meta, "time_unit", "s");
   require_unit(file, meta, "temperature_unit", "degC");
@@ -195,7 +261,7 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
     s.id = item_id(file, sensors[i], path);
     unique(s.id, path + ".id");
     s.position = optional_vector(file, sensors[i], "position", path + ".position");
-    require_inside(file, limits.machine_box, s.position, path + ".position", run.machine);
+    require_inside(file, box, s.position, path + ".position", run.machine);
     run.sensors.push_back(std::move(s));
   }
   const json& probes = id_list(file, meta, "displacements", true);
@@ -205,7 +271,7 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
     p.id = item_id(file, probes[i], path);
     unique(p.id, path + ".id");
     p.point = optional_vector(file, probes[i], "point", path + ".point");
-    require_inside(file, limits.machine_box, p.point, path + ".point", run.machine);
+    require_inside(file, box, p.point, path + ".point", run.machine);
     p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
     if (p.direction) {
       const double norm = p.direction->norm();
@@ -221,6 +287,7 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
     if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
     run.ambient_sensor = id;
   }
+  run.published = published_figure(file, meta, run);
   run.meta = std::move(meta);
   return run;
 }
@@ -550,6 +617,11 @@ void write_measured_run(const fs::path& folder, const MeasuredRun& run) {
         {{"id", p.id}, {"point", vector_json(p.point)}, {"direction", vector_json(p.direction)}});
   meta["inputs"] = json::array();
   for (const auto& id : run.inputs) meta["inputs"].push_back({{"id", id}, {"unit", "rpm"}});
+  if (run.machine_box)
+    meta["machine_box_m"] = {{"min", vector_json(run.machine_box->min())},
+                             {"max", vector_json(run.machine_box->max())}};
+  else
+    meta.erase("machine_box_m");
   if (run.ambient_sensor)
     meta["ambient_sensor"] = *run.ambient_sensor;
   else

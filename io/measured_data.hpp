@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -24,6 +25,15 @@ struct MeasuredProbe {
   std::optional<Eigen::Vector3d> direction;  /// unit vector
 };
 
+/// A figure published for the data set (meta.json `published`): the model that reached it and
+/// where it is published, the held-out window, the MAE per displacement channel, other models'.
+struct PublishedFigure {
+  std::string model, source, note;
+  double from_s = 0, to_s = 0;                  /// held-out window [s]
+  std::map<std::string, double> mae_um;         /// per displacement id [um]
+  std::map<std::string, std::map<std::string, double>> others_mae_um;  /// model -> id -> [um]
+};
+
 struct MeasuredRun {
   std::filesystem::path folder;
   std::string machine;  /// "SB-1" means docs/SB-1-spindle-box.md
@@ -33,6 +43,9 @@ struct MeasuredRun {
   std::vector<std::string> inputs;           /// e.g. "speed_rpm"
   std::optional<std::string> ambient_sensor; /// id of one of `sensors`
   std::optional<double> initial_temperature_c, nominal_ambient_c;  /// [degC]
+  /// meta.json's machine_box_m: every sensor and probe position lies inside [m].
+  std::optional<Eigen::AlignedBox3d> machine_box;
+  std::optional<PublishedFigure> published;  /// meta.json's published
   Eigen::VectorXd time;           /// #samples [s], strictly increasing
   Eigen::MatrixXd input_values;   /// #samples x #inputs (speeds in rpm)
   Eigen::MatrixXd temperature;    /// #samples x #sensors [K]; NaN where the reading is missing
@@ -41,7 +54,8 @@ struct MeasuredRun {
 };
 
 struct MeasuredReadLimits {
-  std::optional<Eigen::AlignedBox3d> machine_box;  /// positions must lie inside (known machine)
+  /// Positions must lie inside (a known machine); meta.json's machine_box_m when not given.
+  std::optional<Eigen::AlignedBox3d> machine_box;
   std::size_t max_bytes = std::size_t(2) << 30;    /// data.csv larger than this is rejected
   std::size_t max_rows = 50'000'000;               /// more rows than this are rejected
 };

@@ -1,6 +1,7 @@
 // fit.json, the section 8 record and the compensation CSV, read back.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -107,6 +108,16 @@ TEST(FittingOut, ModellingRecordStatesSection8) {
   EXPECT_NE(md.find("| machine model | SB-1 virtual |"), std::string::npos);
   EXPECT_NE(md.find("## Target z"), std::string::npos);
   EXPECT_NE(md.find("S_M ="), std::string::npos);
+}
+
+TEST(FittingOut, ModellingDateIsTodayOrTheSourceDateEpoch) {
+  ::setenv("SOURCE_DATE_EPOCH", "1795651200", 1);  // 2026-11-26 00:00:00 UTC
+  EXPECT_EQ(tt::io::modelling_date_today(), "2026-11-26");
+  ::unsetenv("SOURCE_DATE_EPOCH");
+  const std::string today = tt::io::modelling_date_today();
+  ASSERT_EQ(today.size(), 10u);
+  EXPECT_EQ(today[4], '-');
+  EXPECT_GE(today, std::string("2026-11-26"));
 }
 
 TEST(FittingOut, CompensationCsvIsMinusThePrediction) {

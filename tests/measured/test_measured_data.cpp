@@ -192,6 +192,58 @@ TEST_F(Measured, RejectsPositionOutsideTheMachineBox) {
   EXPECT_NO_THROW(read_measured_run(dir_));
 }
 
+TEST_F(Measured, TheMachineBoxCanComeWithTheData) {
+  // meta.json's machine_box_m checks the positions as a caller's box does, and is written back.
+  const std::string boxed = replaced(
+      kMeta, "\"run\": \"unit test\",",
+      "\"run\": \"unit test\", \"machine_box_m\": {\"min\": [-0.16, 0.0, -0.04], "
+      "\"max\": [0.16, 0.30, 0.58]},");
+  auto m = rejection(replaced(boxed, "[-0.08, 0.30, 0.20]", "[-0.08, 0.31, 0.20]"), kCsv, {});
+  EXPECT_NE(m.find("key sensors[0].position:"), std::string::npos) << m;
+  EXPECT_NE(m.find("outside machine SB-1's bounding box"), std::string::npos) << m;
+  write_text(dir_ / "meta.json", boxed);
+  write_text(dir_ / "data.csv", kCsv);
+  const auto run = read_measured_run(dir_);
+  ASSERT_TRUE(run.machine_box.has_value());
+  EXPECT_DOUBLE_EQ(run.machine_box->max()(2), 0.58);
+  const fs::path copy = dir_ / "copy";
+  tt::io::write_measured_run(copy, run);
+  const auto again = read_measured_run(copy);
+  ASSERT_TRUE(again.machine_box.has_value());
+  EXPECT_TRUE(again.machine_box->isApprox(*run.machine_box));
+  // A box that is not one is refused, naming the key.
+  m = rejection(replaced(boxed, "\"max\": [0.16, 0.30, 0.58]", "\"max\": [0.16, -0.30, 0.58]"),
+                kCsv, {});
+  EXPECT_NE(m.find("key machine_box_m:"), std::string::npos) << m;
+  m = rejection(replaced(boxed, "\"min\": [-0.16, 0.0, -0.04]", "\"low\": 1"), kCsv, {});
+  EXPECT_NE(m.find("key machine_box_m:"), std::string::npos) << m;
+}
+
+TEST_F(Measured, PublishedFigureIsReadAndChecked) {
+  const std::string published = replaced(
+      kMeta, "\"run\": \"unit test\",",
+      "\"run\": \"unit test\", \"published\": {\"model\": \"GRU\", \"source\": \"paper\", "
+      "\"test_window_s\": [60, 120], \"mae_um\": {\"dy\": 3.5}, "
+      "\"others_mae_um\": {\"forest\": {\"dy\": 6.0}}},");
+  write_text(dir_ / "meta.json", published);
+  write_text(dir_ / "data.csv", kCsv);
+  const auto run = read_measured_run(dir_);
+  ASSERT_TRUE(run.published.has_value());
+  EXPECT_EQ(run.published->model, "GRU");
+  EXPECT_DOUBLE_EQ(run.published->from_s, 60.0);
+  EXPECT_DOUBLE_EQ(run.published->to_s, 120.0);
+  EXPECT_DOUBLE_EQ(run.published->mae_um.at("dy"), 3.5);
+  EXPECT_DOUBLE_EQ(run.published->others_mae_um.at("forest").at("dy"), 6.0);
+  auto m = rejection(replaced(published, "{\"dy\": 3.5}", "{\"dz\": 3.5}"), kCsv);
+  EXPECT_NE(m.find("key published.mae_um.dz: 'dz' is not the id of a displacement"),
+            std::string::npos)
+      << m;
+  m = rejection(replaced(published, "[60, 120]", "[120, 60]"), kCsv);
+  EXPECT_NE(m.find("key published.test_window_s:"), std::string::npos) << m;
+  m = rejection(replaced(published, "\"model\": \"GRU\", ", ""), kCsv);
+  EXPECT_NE(m.find("published.model"), std::string::npos) << m;
+}
+
 TEST_F(Measured, RejectsUnknownUnits) {
   auto m = rejection(replaced(kMeta, R"("temperature_unit": "degC")", R"("temperature_unit": "K")"),
                      kCsv);
@@ -277,6 +329,8 @@ TEST(MeasuredShipped, ReadsFlThermalMeasured) {
   EXPECT_DOUBLE_EQ(run.time(run.time.size() - 1), 166710.0);
   EXPECT_FALSE(run.initial_temperature_c.has_value());
   EXPECT_TRUE(run.meta.contains("source"));
+  ASSERT_TRUE(run.published.has_value());  // the published figure lives with the data
+  EXPECT_DOUBLE_EQ(run.published->mae_um.at("ch5"), 4.284);
   EXPECT_GT(run.temperature.minCoeff(), 273.15 + 15.0);
   EXPECT_LT(run.temperature.maxCoeff(), 273.15 + 50.0);
   EXPECT_LT(run.displacement.cwiseAbs().maxCoeff(), 200e-6);

@@ -130,7 +130,11 @@ TEST(NoShell, ChannelIdOfAMeasuredRunRunsNothingAndItsFigureIsMade) {
   fs::create_directories(runs);
   const std::string channel = payload("PWNED_ch");
   std::string meta = read_text(kMeasuredRun / "meta.json");
-  replace_once(meta, "\"id\": \"ch1\"", "\"id\": \"" + channel + "\"");
+  // Every "ch1" of meta.json: the channel's id and the keys of its published figure.
+  const std::string quoted = "\"" + channel + "\"";
+  for (auto at = meta.find("\"ch1\""); at != std::string::npos;
+       at = meta.find("\"ch1\"", at + quoted.size()))
+    meta.replace(at, 5, quoted);
   put(runs / "meta.json", meta);
   std::string data = read_text(kMeasuredRun / "data.csv");
   replace_once(data, ",ch1,", "," + channel + ",");
