@@ -118,8 +118,8 @@ int export_command(const ExportArgs& args) {
       "# CNC export: what each controller's law leaves of the model\n\n"
       "Compensation value = minus the model's predicted error. |law - model| over " +
       std::to_string(args.grid) +
-      " positions along the travel; states: `per unit` is each basis function alone at one unit "
-      "(1 K), the error per unit, with the constant term; `samples` are the rows of " +
+      " positions along the travel; states: `per unit` is the constant alone and each basis "
+      "function alone at one unit (1 K): the error per unit; `samples` are the rows of " +
       (args.states.empty() ? std::string("--states (not given)") : args.states.string()) +
       ".\n\n| format | states | direction | max [um] | RMS [um] | model max [um] |\n"
       "|---|---|---|---|---|---|\n";

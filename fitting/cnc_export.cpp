@@ -211,9 +211,7 @@ LawError law_error(const CncModel& model, const ControllerLaw& law, const Eigen:
 
 Eigen::MatrixXd unit_states(const CncModel& model) {
   const auto nb = static_cast<Eigen::Index>(model.basis.size());
-  Eigen::MatrixXd s = Eigen::MatrixXd::Identity(nb, nb);
-  s.col(0).setOnes();  // the constant is always there
-  return s;
+  return Eigen::MatrixXd::Identity(nb, nb);
 }
 
 Eigen::MatrixXd basis_states(const CncModel& model, const std::vector<std::string>& columns,
@@ -231,6 +229,15 @@ Eigen::MatrixXd basis_states(const CncModel& model, const std::vector<std::strin
   }
   Eigen::MatrixXd states = Eigen::MatrixXd::Ones(times.size(), nf + 1);
   if (nf == 0) return states;
+  std::vector<std::string> needed = model.features.sensor_names;
+  needed.insert(needed.end(), model.features.input_names.begin(), model.features.input_names.end());
+  for (const std::string& name : needed)
+    if (std::find(columns.begin(), columns.end(), name) == columns.end()) {
+      std::string listed;
+      for (const std::string& c : columns) listed += (listed.empty() ? "" : ", ") + c;
+      throw core::DataError("column '" + name + "' is missing: the exported models read '" + name +
+                            "'; the samples have " + (listed.empty() ? "none" : listed));
+    }
   Compensator stepper(unit, columns);
   for (Eigen::Index t = 0; t < times.size(); ++t) {
     const LiveStep& step = stepper.next(times(t), values.row(t).transpose());

@@ -107,13 +107,14 @@ struct LawError {
 };
 
 /// law − model on `grid` >= 2 equidistant positions over the travel (one when it has none) and
-/// each row of `states` (#states x #basis basis values, column 0 equal to 1). Throws DataError on
+/// each row of `states` (#states x #basis basis values; column 0 is 1 for a machine's state, and
+/// any value for a basis function's share, e.g. unit_states). Throws DataError on
 /// a states matrix whose columns do not match the basis.
 LawError law_error(const CncModel& model, const ControllerLaw& law, const Eigen::MatrixXd& states,
                    int grid);
 
-/// #basis x #basis identity: each basis function alone at one unit (1 K, 1 rpm), the constant
-/// included; law_error over it gives the law's error per unit of each basis function.
+/// #basis x #basis identity: the constant alone, then each basis function alone at one unit
+/// (1 K, 1 rpm); law_error over it gives the law's error per unit of each basis function.
 Eigen::MatrixXd unit_states(const CncModel& model);
 
 /// The basis states of sensor samples: #samples x #basis, [1, regressors] as FeatureStream forms

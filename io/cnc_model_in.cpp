@@ -40,6 +40,10 @@ AxisSection axis_section(const json& axis, const std::string& origin,
                          std::vector<fitting::FittedModel>& models,
                          std::vector<std::string>& targets) {
   const Place p{origin, ""};
+  if (axis.is_object() && !axis.contains("feed_axis"))
+    throw core::DataError(p.at("axis.feed_axis") +
+                          " is missing: this fit.json was written before fit kept the feed axis "
+                          "and its models' coefficients; hint: run `thermotwin fit` again");
   AxisSection a;
   a.points = names_at(axis, "points", p, "axis.");
   a.positions = vector_at(axis, "positions_m", p, "axis.");

@@ -124,7 +124,8 @@ std::vector<CncFile> sinumerik_files(const fitting::CncModel& m, const fitting::
        "directions.\n\n";
   const double ref_mm = law.reference * kMm;
   for (int d : dirs)
-    o << "$SA_TEMP_COMP_REF_POSITION[" << kAxisLetters[d] << "1]=" << num(ref_mm) << "\n";
+    if (law.slope[static_cast<std::size_t>(d)].cwiseAbs().maxCoeff() > 0.0)
+      o << "$SA_TEMP_COMP_REF_POSITION[" << kAxisLetters[d] << "1]=" << num(ref_mm) << "\n";
   o << "\n; Every interpolation cycle, modal and static (IDS) so it runs beside every program:\n";
   int id = 1;
   for (int d : dirs) {
