@@ -195,7 +195,10 @@ std::vector<CncFile> twincat_files(const fitting::CncModel& m, const fitting::Ta
     << "  TT_MIN_POSITION : LREAL := " << num(t.positions(0) * kMm) << ";  (* mm *)\n"
     << "  TT_MAX_POSITION : LREAL := " << num(t.positions(n - 1) * kMm) << ";  (* mm *)\n"
     << "  TT_NO_OF_TABLE_ELEMENTS : UDINT := " << n << ";\n"
-    << "  TT_NO_OF_BASIS : UDINT := " << nb << ";\n";
+    << "  TT_NO_OF_BASIS : UDINT := " << nb << ";\n"
+    << "END_VAR\n"
+    << "(* Not CONSTANT: F_TtFormTable takes them by reference (VAR_IN_OUT). *)\n"
+    << "VAR_GLOBAL\n";
   for (int d : acting_directions(m)) {
     o << "  (* " << kAxisLetters[d] << ": compensation [mm per basis unit], basis-major *)\n"
       << "  TT_COMP_" << kAxisLetters[d] << " : ARRAY[0.." << nb - 1 << ", 0.." << n - 1
@@ -216,8 +219,8 @@ std::vector<CncFile> twincat_files(const fitting::CncModel& m, const fitting::Ta
     << "VAR_INPUT\n  aBasis : ARRAY[0.." << nb - 1 << "] OF LREAL;  (* b[0] = 1 *)\nEND_VAR\n"
     << "VAR\n  i, j : UDINT;\nEND_VAR\n"
     << "FOR i := 0 TO " << n - 1 << " DO\n"
-    << "  aTable[i].Position := TT_MIN_POSITION + (TT_MAX_POSITION - TT_MIN_POSITION) * i / "
-    << std::max<Eigen::Index>(n - 1, 1) << ";\n"
+    << "  aTable[i].Position := TT_MIN_POSITION + (TT_MAX_POSITION - TT_MIN_POSITION) * "
+    << "UDINT_TO_LREAL(i) / " << std::max<Eigen::Index>(n - 1, 1) << ".0;\n"
     << "  aTable[i].Compensation := 0;\n"
     << "  FOR j := 0 TO " << nb - 1 << " DO\n"
     << "    aTable[i].Compensation := aTable[i].Compensation + aBasis[j] * aComp[j, i];\n"
