@@ -5,10 +5,10 @@
 
 #include <cmath>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 
+#include "cnc_fixture.hpp"
 #include "core/errors.hpp"
 #include "fitting/cnc_export.hpp"
 #include "io/cnc_model_in.hpp"
@@ -19,6 +19,8 @@ namespace {
 
 using namespace tt::fitting;
 using nlohmann::json;
+using tt::test::fit_document;
+using tt::test::linear_model;
 constexpr double um = 1e-6;
 constexpr double L = 1.25;  // half travel [m], as GM-1's X axis
 
@@ -108,22 +110,6 @@ TEST(CncLaw, PolynomialIsExactToItsCount) {
   EXPECT_THROW(law_error(m, law, Eigen::MatrixXd::Ones(1, 2), 11), tt::core::DataError);
 }
 
-FittedModel linear_model(const std::string& target, const std::vector<std::string>& sensors,
-                         double intercept, const std::vector<double>& coefficients) {
-  FittedModel m;
-  m.target_name = target;
-  m.spec.kind = ModelKind::least_squares;
-  m.features.sensor_names = sensors;
-  for (std::size_t k = 0; k < sensors.size(); ++k)
-    m.features.sensors.push_back(static_cast<int>(k));
-  LinearFit fit;
-  fit.intercept = intercept;
-  fit.coefficients = Eigen::Map<const Eigen::VectorXd>(
-      coefficients.data(), static_cast<Eigen::Index>(coefficients.size()));
-  m.body = fit;
-  return m;
-}
-
 TEST(CncBasis, UnionOfTheModelsRegressors) {
   const LinearBasis b = linear_basis({linear_model("dz", {"a", "b"}, 1 * um, {2 * um, 3 * um}),
                                       linear_model("dy", {"c", "a"}, 0.0, {4 * um, 5 * um})});
@@ -136,34 +122,6 @@ TEST(CncBasis, UnionOfTheModelsRegressors) {
   ppr.spec.kind = ModelKind::projection_pursuit;
   ppr.body = PprModel{};
   EXPECT_THROW(linear_basis({ppr}), tt::core::DataError);
-}
-
-/// A fit.json with a TCP dz model and an X axis of 5 points whose models give dx = p^3 per K of
-/// a and dy = 2 µm per K of b, dz = 0.
-json fit_document() {
-  const std::vector<double> positions{-1.0, -0.5, 0.0, 0.5, 1.0};
-  json axis_targets = json::object();
-  std::vector<std::string> points;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    const std::string id = "A0" + std::to_string(i + 1);
-    points.push_back(id);
-    const double p = positions[i];
-    axis_targets[id + "_dx"]["coefficients"] =
-        tt::io::model_json(linear_model(id + "_dx", {"a"}, 0.0, {p * p * p * um}));
-    axis_targets[id + "_dy"]["coefficients"] =
-        tt::io::model_json(linear_model(id + "_dy", {"b"}, 0.0, {2 * um}));
-    axis_targets[id + "_dz"]["coefficients"] =
-        tt::io::model_json(linear_model(id + "_dz", {"a"}, 0.0, {0.0}));
-  }
-  json chosen{{"coefficients", tt::io::model_json(linear_model("dz", {"b"}, 0.0, {-4 * um}))},
-              {"test", {{"S_um", {{"g", 0.5}}}}}};
-  return json{{"targets", json::array({{{"target", "dz"}, {"chosen", chosen}}})},
-              {"axis",
-               {{"feed_axis", {{"name", "X"}, {"direction", "x"}}},
-                {"points", points},
-                {"positions_m", positions},
-                {"degree", 3},
-                {"targets", axis_targets}}}};
 }
 
 TEST(CncModelIn, AxisPolynomialFromTheAxisModels) {
