@@ -106,9 +106,10 @@ struct ObserveArgs {
 struct ExportArgs {
   std::filesystem::path model, out;
   std::vector<std::string> formats;  /// sinumerik, twincat, heidenhain, linuxcnc; empty: all
-  std::filesystem::path states;      /// CSV of sensor samples (time_s, ids): the states to judge on
-  int table_points = 51;             /// TwinCAT and Heidenhain table entries over the travel
-  int grid = 1001;                   /// positions over the travel where the laws are judged
+  /// CSVs of sensor samples (time_s, ids), each from its own first sample: the states to judge on
+  std::vector<std::filesystem::path> states;
+  int table_points = 51;  /// TwinCAT and Heidenhain table entries over the travel
+  int grid = 1001;        /// positions over the travel where the laws are judged
 };
 
 int export_command(const ExportArgs& args);

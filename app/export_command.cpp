@@ -1,6 +1,6 @@
 // thermotwin export: the fitted compensation in the controllers' own formats (issue 20, item 5),
 // with what each controller's law leaves of the model along the axis travel.
-//   thermotwin export --model FIT.json --out DIR [--format F]... [--states CSV]
+//   thermotwin export --model FIT.json --out DIR [--format F]... [--states CSV]...
 //                     [--table-points N] [--grid N]
 // Writes into DIR (all or nothing): per format a folder (sinumerik/, twincat/, heidenhain/,
 // linuxcnc/) with the controller's files, and export.json / export.md with the laws' errors.
@@ -8,7 +8,8 @@
 // 1. The model: the TCP's and the feed axis's models of fit.json on one temperature basis
 //    (io::read_cnc_model).
 // 2. The temperature states the laws are judged on: every basis function alone at one unit, and
-//    with --states the samples of a CSV (time_s, sensor ids; a "_degC" suffix is dropped).
+//    with --states the samples of CSVs (time_s, sensor ids; a "_degC" suffix is dropped), each
+//    from its own first sample (fit writes its held-out groups' as held_out/*_temperatures.csv).
 // 3. Per format: the law (io::controller_law), its error against the model on the grid of positions
 //    and the states (fitting::law_error), and its files (io::cnc_files).
 #include <cmath>
@@ -94,7 +95,7 @@ int export_command(const ExportArgs& args) {
     formats = {io::CncFormat::sinumerik, io::CncFormat::twincat, io::CncFormat::heidenhain,
                io::CncFormat::linuxcnc};
   std::vector<std::filesystem::path> inputs{args.model};
-  if (!args.states.empty()) inputs.push_back(args.states);
+  inputs.insert(inputs.end(), args.states.begin(), args.states.end());
   io::OutputDir out(args.out, inputs);
 
   // 1. The model.
@@ -103,8 +104,14 @@ int export_command(const ExportArgs& args) {
 
   // 2. The states.
   const Eigen::MatrixXd unit = fitting::unit_states(model);
-  Eigen::MatrixXd sampled;
-  if (!args.states.empty()) sampled = states_of_csv(model, args.states);
+  Eigen::MatrixXd sampled(0, unit.cols());
+  nlohmann::json state_files = nlohmann::json::array();
+  for (const std::filesystem::path& path : args.states) {
+    const Eigen::MatrixXd s = states_of_csv(model, path);
+    sampled.conservativeResize(sampled.rows() + s.rows(), Eigen::NoChange);
+    sampled.bottomRows(s.rows()) = s;
+    state_files.push_back({{"file", path.string()}, {"samples", s.rows()}});
+  }
 
   // 3. Per format: law, error, files.
   nlohmann::json report{
@@ -112,15 +119,15 @@ int export_command(const ExportArgs& args) {
       {"targets", file.targets},           {"ignored_targets", file.ignored_targets},
       {"feed_axis", model.feed_axis},      {"travel_m", {model.travel_min, model.travel_max}},
       {"table_points", args.table_points}, {"formats", nlohmann::json::object()}};
-  if (!args.states.empty())
-    report["states"] = {{"file", args.states.string()}, {"samples", sampled.rows()}};
+  if (!args.states.empty()) report["states"] = state_files;
   std::string md =
       "# CNC export: what each controller's law leaves of the model\n\n"
       "Compensation value = minus the model's predicted error. |law - model| over " +
       std::to_string(args.grid) +
       " positions along the travel; states: `per unit` is the constant alone and each basis "
-      "function alone at one unit (1 K): the error per unit; `samples` are the rows of " +
-      (args.states.empty() ? std::string("--states (not given)") : args.states.string()) +
+      "function alone at one unit (1 K): the error per unit; `samples` are the " +
+      std::to_string(sampled.rows()) + " samples of the --states files" +
+      (args.states.empty() ? std::string(" (none given)") : std::string()) +
       ".\n\n| format | states | direction | max [um] | RMS [um] | model max [um] |\n"
       "|---|---|---|---|---|---|\n";
   for (io::CncFormat format : formats) {

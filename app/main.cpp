@@ -249,7 +249,7 @@ int main(int argc, char** argv) {
   exporter
       ->add_option("--states", export_args.states,
                    "CSV of sensor samples (time_s, sensor ids): temperature states the laws "
-                   "are judged on")
+                   "are judged on (repeatable, e.g. fit's held_out/*_temperatures.csv)")
       ->check(CLI::ExistingFile);
   exporter
       ->add_option("--table-points", export_args.table_points,

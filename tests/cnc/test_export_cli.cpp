@@ -46,10 +46,13 @@ TEST(ExportCli, WritesEveryFormatAndRefusesBadInput) {
   fs::create_directories(dir);
   write(dir / "fit.json", tt::test::fit_document().dump());
   write(dir / "states.csv", "time_s,a_degC,b_degC\n0,20,20\n60,21,20.5\n120,23,21.5\n");
+  // A second run from its own reference: its 1 K on a counts from 30 °C.
+  write(dir / "states2.csv", "time_s,b,a\n0,25,30\n60,25,31\n");
 
   const ExportRun ok =
       export_run(dir, {"--model", (dir / "fit.json").string(), "--out", (dir / "out").string(),
-                       "--states", (dir / "states.csv").string(), "--table-points", "41"});
+                       "--states", (dir / "states.csv").string(), "--states",
+                       (dir / "states2.csv").string(), "--table-points", "41"});
   ASSERT_EQ(ok.status, 0) << ok.output;
   for (const char* f :
        {"sinumerik/THERMOTWIN_TEMP_COMP.SPF", "twincat/thermotwin_compensation.st",
@@ -57,7 +60,9 @@ TEST(ExportCli, WritesEveryFormatAndRefusesBadInput) {
         "linuxcnc/thermotwin_eoffset.hal", "linuxcnc/thermotwin_eoffset.ini", "export.md"})
     EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
   const json report = json::parse(std::ifstream(dir / "out" / "export.json"));
-  EXPECT_EQ(report["states"]["samples"], 3);
+  ASSERT_EQ(report["states"].size(), 2u);
+  EXPECT_EQ(report["states"][0]["samples"], 3);
+  EXPECT_EQ(report["states"][1]["samples"], 2);
   // dx is p^3 per K of a: the line leaves 0.4 L^3 = 0.4 µm per K at the ends (L = 1 m); with
   // 3 K on a in the last state, 1.2 µm. The polynomial is exact to its count.
   const json& f = report["formats"];
