@@ -72,13 +72,12 @@ std::string header_lines(const std::string& comment, const std::string& title,
 
 /// R-parameter numbers: readings from 100, reference readings from 200, PLC-formed basis values
 /// (low-pass filtered increments) from 300.
-std::string sinumerik_term(const std::vector<BasisTerm>& terms, std::size_t j, bool sync) {
-  const BasisTerm& t = terms[j];
-  const std::string r = sync ? "$R" : "R";
-  if (t.tau > 0.0) return r + std::to_string(300 + j);
-  std::size_t source = 0;
-  while (terms[source].source != t.source || terms[source].tau != 0.0) ++source;
-  return "(" + r + std::to_string(100 + source) + "-" + r + std::to_string(200 + source) + ")";
+/// In a synchronized action: an increment is (reading - reference), R100+k and R200+k for source
+/// k (the unfiltered terms come first, one per source, in basis_terms' order); a filtered one is
+/// R300+j, formed by the PLC.
+std::string sinumerik_term(const std::vector<BasisTerm>& terms, std::size_t j) {
+  if (terms[j].tau > 0.0) return "$R" + std::to_string(300 + j);
+  return "($R" + std::to_string(100 + j) + "-$R" + std::to_string(200 + j) + ")";
 }
 
 std::string sinumerik_expression(const Eigen::VectorXd& c, const std::vector<BasisTerm>& terms,
@@ -87,7 +86,7 @@ std::string sinumerik_expression(const Eigen::VectorXd& c, const std::vector<Bas
   for (std::size_t j = 0; j < terms.size(); ++j) {
     const double v = c(static_cast<Eigen::Index>(j + 1)) * factor;
     if (v == 0.0) continue;
-    e += (v < 0 ? "-" : "+") + num(std::abs(v)) + "*" + sinumerik_term(terms, j, true);
+    e += (v < 0 ? "-" : "+") + num(std::abs(v)) + "*" + sinumerik_term(terms, j);
   }
   return e;
 }
