@@ -5,6 +5,7 @@
 
 #include "core/errors.hpp"
 #include "fitting/metrics.hpp"
+#include "io/fitting_out.hpp"
 #include "solvers/axis_error.hpp"
 
 namespace tt::app {
@@ -12,6 +13,7 @@ namespace tt::app {
 namespace {
 
 constexpr const char* kDirections[3] = {"dx", "dy", "dz"};
+constexpr const char* kAxes[3] = {"x", "y", "z"};
 
 /// The axis points' error on one group, as the CNC's polynomial sees it: columns of `values`
 /// (#samples x 3 #points [m]).
@@ -110,6 +112,8 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
       spec, Eigen::MatrixXd::Zero(1, 3 * static_cast<Eigen::Index>(n)));
   fit.points = first.points;
   fit.positions = first.positions;
+  fit.feed_axis = spec.feed_axis.name;
+  fit.direction = spec.feed_axis.direction;
   Tally none, measured, linear, net;
   for (const fitting::Group& g : test) {
     const solvers::AxisError truth = axis_values(fit, g.error.rightCols(3 * n));
@@ -143,6 +147,7 @@ nlohmann::json axis_fit_json(const AxisFit& fit) {
     nlohmann::json t{{"method", chosen.method},
                      {"sensors", e.model.features.sensor_names},
                      {"model", fitting::model_label(e.model.spec)},
+                     {"coefficients", io::model_json(e.model)},
                      {"test_sm_um", um(e.test.sm)},
                      {"uncompensated_std_um", um(fit.uncompensated_std[k])}};
     if (!fit.network.empty())
@@ -156,6 +161,7 @@ nlohmann::json axis_fit_json(const AxisFit& fit) {
                                               {"max_um", um(c.max_m[static_cast<std::size_t>(d)])}};
     }
   nlohmann::json j{
+      {"feed_axis", {{"name", fit.feed_axis}, {"direction", kAxes[fit.direction]}}},
       {"points", fit.points},
       {"positions_m",
        std::vector<double>(fit.positions.data(), fit.positions.data() + fit.positions.size())},

@@ -39,6 +39,8 @@ struct AxisCompensation {
 struct AxisFit {
   std::vector<std::string> points;  /// axis point ids
   Eigen::VectorXd positions;        /// #points along the feed axis [m]
+  std::string feed_axis;            /// the feed axis's name, e.g. "X"
+  int direction = 0;                /// the coordinate it moves along: 0 x, 1 y, 2 z
   int degree = 0;                   /// of the axis polynomial
   std::vector<int> targets;         /// the groups' error columns: 3 per point (dx, dy, dz)
   /// per target: the candidate chosen on validation, refitted and tested
@@ -63,7 +65,8 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
                  const std::optional<fitting::ModelSpec>& network,
                  const std::vector<int>& network_sensors);
 
-/// For fit.json: per target the chosen model, its and the network's test S_M [µm], and the
+/// For fit.json: the feed axis, per target the chosen model (its coefficients as io::model_json
+/// writes them, for `thermotwin export`), its and the network's test S_M [µm], and the
 /// polynomials' residuals per source and direction [µm].
 nlohmann::json axis_fit_json(const AxisFit& fit);
 

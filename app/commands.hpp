@@ -15,12 +15,12 @@ struct MeshArgs {
 struct RunArgs {
   std::filesystem::path case_file, out;
   bool quiet = false;
-  bool resume = false;            /// continue from OUT.checkpoint when there is one
+  bool resume = false;              /// continue from OUT.checkpoint when there is one
   double checkpoint_every_s = 600;  /// wall time between checkpoints; < 0: none
-  int stop_after_steps = 0;       /// tests: save a checkpoint after this many steps and exit 3
-  std::filesystem::path dump;     /// tests: temperatures and displacements as raw doubles
-  std::filesystem::path rom;      /// a reduced model (reduce --out DIR): thermal transient from it
-  bool verify = false;            /// with rom: recompute the output times in full and compare
+  int stop_after_steps = 0;         /// tests: save a checkpoint after this many steps and exit 3
+  std::filesystem::path dump;       /// tests: temperatures and displacements as raw doubles
+  std::filesystem::path rom;  /// a reduced model (reduce --out DIR): thermal transient from it
+  bool verify = false;        /// with rom: recompute the output times in full and compare
   std::filesystem::path duty_cycle;  /// another duty cycle: CSV "time_s,speed_rpm"
   std::optional<double> end_s;       /// with duty_cycle: the run's end [s] (default: the case's)
 };
@@ -94,13 +94,25 @@ struct ObserveArgs {
   std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
   /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
   std::vector<double> sensor_sigma_k{0.05};
-  double heat_walk_w = 4.0;          /// random walk of each unknown heat input [W/sqrt(h)]
-  double air_walk_k = 0.5;           /// random walk of the air offset [K/sqrt(h)]
+  double heat_walk_w = 4.0;            /// random walk of each unknown heat input [W/sqrt(h)]
+  double air_walk_k = 0.5;             /// random walk of the air offset [K/sqrt(h)]
   double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
   bool quiet = false;
 };
 
+/// export --model FIT.json --out DIR: the compensation in the controllers' formats
+/// (app/export_command.cpp, docs/cnc-export.md).
+struct ExportArgs {
+  std::filesystem::path model, out;
+  std::vector<std::string> formats;  /// sinumerik, twincat, heidenhain, linuxcnc; empty: all
+  /// CSVs of sensor samples (time_s, ids), each from its own first sample: the states to judge on
+  std::vector<std::filesystem::path> states;
+  int table_points = 51;  /// TwinCAT and Heidenhain table entries over the travel
+  int grid = 1001;        /// positions over the travel where the laws are judged
+};
+
+int export_command(const ExportArgs& args);
 int mesh_command(const MeshArgs& args);
 int observe_command(const ObserveArgs& args);
 int compensate_command(const CompensateArgs& args);

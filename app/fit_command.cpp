@@ -2,7 +2,8 @@
 // cycles it was not fitted on (DB3401/T 326-2024 metrics S, S_M, S_sigma).
 //   thermotwin fit CASE --out DIR [--hours 5] [--required-sm-um 1] [--quick]
 // Writes fit.json, modelling_record.{json,md}, compensation.csv, sensor_count_<target>.csv and
-// sensor_count_<target>.png, campaign.csv (what each group was). A case with feed-axis points
+// sensor_count_<target>.png, campaign.csv (what each group was), held_out/<group>_temperatures.csv
+// (the test groups' sensor readings). A case with feed-axis points
 // (GM-1) also gets models of the error at those points and the axis polynomial fitted from their
 // predictions (fit.json "axis", axis_fit.md); with --network, the patent's one network for every
 // output, network_all_outputs.pt.
@@ -271,6 +272,17 @@ int fit_command(const FitArgs& args) {
   std::vector<fitting::FittedModel> models;
   for (const auto& e : evals) models.push_back(e.model);
   io::write_compensation_csv(dir / "compensation.csv", models, groups);
+  // The held-out groups' sensor readings: the temperature states on which `thermotwin export
+  // --states` judges the controllers' laws (docs/cnc-export.md).
+  std::filesystem::create_directories(dir / "held_out");
+  for (int i : split.test) {
+    const fitting::Group& g = groups[static_cast<std::size_t>(i)];
+    std::vector<std::string> header{"time_s"};
+    header.insert(header.end(), g.sensor_names.begin(), g.sensor_names.end());
+    Eigen::MatrixXd rows(g.time.size(), g.temperature.cols() + 1);
+    rows << g.time, g.temperature.array() - core::kCelsiusOffset;  // °C, as measured data
+    io::write_csv(dir / "held_out" / (g.name + "_temperatures.csv"), header, rows);
+  }
   for (const auto& t : tables) {
     std::set<std::string> methods;
     for (const auto& row : t.rows) methods.insert(row.method);

@@ -12,18 +12,21 @@
 //                                  without --case, from the data alone
 //   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
 //   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file)
+//   export --model FIT.json --out DIR
+//                                  the compensation in SINUMERIK, TwinCAT, Heidenhain, LinuxCNC
+//                                  form
 //   observe CASE --rom DIR --data RUN --out DIR
 //                                  the physics observer: drift with its sigma, recalibrate status
 //   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <string>
-
-#include <unistd.h>
 
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
@@ -135,8 +138,9 @@ int main(int argc, char** argv) {
                   "place on readings as real sensors give them: the campaign's noise (0.05 K, "
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
-  place->add_option("--rom", place_args.rom,
-                    "a reduced model (thermotwin reduce CASE --out DIR) to simulate the case on")
+  place
+      ->add_option("--rom", place_args.rom,
+                   "a reduced model (thermotwin reduce CASE --out DIR) to simulate the case on")
       ->check(CLI::ExistingDirectory);
   place->add_flag("--full", place_args.full,
                   "simulate in full order (default: a reduced model built on the fly)");
@@ -205,44 +209,76 @@ int main(int argc, char** argv) {
   CompensateArgs compensate_args;
   auto* compensate = cli.add_subcommand(
       "compensate", "Live compensation: drift per sample from a fitted model (docs/compensate.md)");
-  compensate->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
+  compensate
+      ->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
       ->required()
       ->check(CLI::ExistingFile);
   auto* compensate_in = compensate->add_option(
       "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
   compensate->add_option("--out", compensate_args.out, "output CSV (default: standard output)");
-  auto* until_eof = compensate->add_flag("--until-eof", compensate_args.until_eof,
-                                         "with --in: stop at the file's end, do not follow it")
-                       ->needs(compensate_in);
-  compensate->add_option("--idle-s", compensate_args.idle_s,
-                         "with --in: stop when the file has not grown for this long [s]")
+  auto* until_eof = compensate
+                        ->add_flag("--until-eof", compensate_args.until_eof,
+                                   "with --in: stop at the file's end, do not follow it")
+                        ->needs(compensate_in);
+  compensate
+      ->add_option("--idle-s", compensate_args.idle_s,
+                   "with --in: stop when the file has not grown for this long [s]")
       ->check(positive_number())
       ->excludes(until_eof)
       ->needs(compensate_in);
-  compensate->add_option("--poll-ms", compensate_args.poll_ms,
-                         "with --in: how often to look for new lines at its end [ms] (default 5)")
+  compensate
+      ->add_option("--poll-ms", compensate_args.poll_ms,
+                   "with --in: how often to look for new lines at its end [ms] (default 5)")
       ->check(CLI::Range(1, 10000))
       ->needs(compensate_in);
   compensate->add_flag("--flush", compensate_args.flush,
                        "flush after every line (default: when the input pauses; always on a "
                        "terminal)");
 
+  ExportArgs export_args;
+  auto* exporter = cli.add_subcommand(
+      "export",
+      "The compensation in the CNC's own formats, with the error of each controller's "
+      "law (docs/cnc-export.md)");
+  exporter->add_option("--model", export_args.model, "fit.json of thermotwin fit")
+      ->required()
+      ->check(CLI::ExistingFile);
+  exporter->add_option("--format", export_args.formats,
+                       "sinumerik, twincat, heidenhain or linuxcnc (repeatable; default: all)");
+  exporter->add_option("--out", export_args.out, "output directory")->required();
+  exporter
+      ->add_option("--states", export_args.states,
+                   "CSV of sensor samples (time_s, sensor ids): temperature states the laws "
+                   "are judged on (repeatable, e.g. fit's held_out/*_temperatures.csv)")
+      ->check(CLI::ExistingFile);
+  exporter
+      ->add_option("--table-points", export_args.table_points,
+                   "entries of the TwinCAT and Heidenhain tables over the travel (default 51)")
+      ->check(CLI::Range(2, 100000));
+  exporter
+      ->add_option("--grid", export_args.grid,
+                   "positions over the travel where the laws are judged (default 1001)")
+      ->check(CLI::Range(2, 1000000));
+
   ObserveArgs observe_args;
-  auto* observe = cli.add_subcommand(
-      "observe",
-      "Physics observer on a measured run: a Kalman filter on the reduced model (docs/observer.md)");
+  auto* observe = cli.add_subcommand("observe",
+                                     "Physics observer on a measured run: a Kalman filter on the "
+                                     "reduced model (docs/observer.md)");
   observe->add_option("case", observe_args.case_file, "case file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  observe->add_option("--rom", observe_args.rom, "the reduced model (thermotwin reduce CASE --out DIR)")
+  observe
+      ->add_option("--rom", observe_args.rom,
+                   "the reduced model (thermotwin reduce CASE --out DIR)")
       ->required()
       ->check(CLI::ExistingDirectory);
   observe->add_option("--data", observe_args.data, "measured run folder (meta.json, data.csv)")
       ->required()
       ->check(CLI::ExistingDirectory);
   observe->add_option("--out", observe_args.out, "output directory")->required();
-  observe->add_option("--sensors", observe_args.sensors,
-                      "sensor ids to read (default: every sensor of the run the model names)")
+  observe
+      ->add_option("--sensors", observe_args.sensors,
+                   "sensor ids to read (default: every sensor of the run the model names)")
       ->delimiter(',');
   observe
       ->add_option("--sensor-sigma-k", observe_args.sensor_sigma_k,
@@ -250,25 +286,31 @@ int main(int argc, char** argv) {
                    "comma-separated (default 0.05)")
       ->delimiter(',')
       ->check(positive_number());
-  observe->add_option("--heat-walk-w", observe_args.heat_walk_w,
-                      "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
+  observe
+      ->add_option("--heat-walk-w", observe_args.heat_walk_w,
+                   "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
       ->check(CLI::NonNegativeNumber);
-  observe->add_option("--air-walk-k", observe_args.air_walk_k,
-                      "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
+  observe
+      ->add_option("--air-walk-k", observe_args.air_walk_k,
+                   "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
       ->check(CLI::NonNegativeNumber);
-  observe->add_option("--drift-relative-sigma", observe_args.drift_relative_sigma,
-                      "error of the drift rows (elastic model) relative to the drift (default "
-                      "0.04)")
+  observe
+      ->add_option("--drift-relative-sigma", observe_args.drift_relative_sigma,
+                   "error of the drift rows (elastic model) relative to the drift (default "
+                   "0.04)")
       ->check(CLI::NonNegativeNumber);
-  observe->add_option("--window-s", observe_args.window_s,
-                      "consistency test: window of the summed NIS [s] (default 1800)")
+  observe
+      ->add_option("--window-s", observe_args.window_s,
+                   "consistency test: window of the summed NIS [s] (default 1800)")
       ->check(positive_number());
-  observe->add_option("--sustain-s", observe_args.sustain_s,
-                      "consistency test: how long an exceedance lasts before recalibrate [s] "
-                      "(default 900)")
+  observe
+      ->add_option("--sustain-s", observe_args.sustain_s,
+                   "consistency test: how long an exceedance lasts before recalibrate [s] "
+                   "(default 900)")
       ->check(CLI::NonNegativeNumber);
-  observe->add_option("--probability", observe_args.probability,
-                      "consistency test: chi-square quantile of the bound (default 0.999)")
+  observe
+      ->add_option("--probability", observe_args.probability,
+                   "consistency test: chi-square quantile of the bound (default 0.999)")
       ->check(CLI::Range(0.5, 0.999999));
   observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
 
@@ -309,16 +351,19 @@ int main(int argc, char** argv) {
     }
     if (*calibrate) {
       if (calibrate_args.case_file.empty() && calibrate_args.refit)
-        throw tt::core::CaseError("calibrate: --refit refits the claims on the model of --case; "
-                                  "without --case there is no model. Hint: give --case CASE");
+        throw tt::core::CaseError(
+            "calibrate: --refit refits the claims on the model of --case; "
+            "without --case there is no model. Hint: give --case CASE");
       if (calibrate_args.case_file.empty() && calibrate_args.full)
-        throw tt::core::CaseError("calibrate: --full chooses the model of calibrate --case; without "
-                               "--case there is no model to reduce. Hint: drop --full or give "
-                               "--case CASE");
+        throw tt::core::CaseError(
+            "calibrate: --full chooses the model of calibrate --case; without "
+            "--case there is no model to reduce. Hint: drop --full or give "
+            "--case CASE");
       return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
                                               : calibrate_command_with_case(calibrate_args);
     }
     if (*compensate) return compensate_command(compensate_args);
+    if (*exporter) return export_command(export_args);
     if (*observe) return observe_command(observe_args);
     if (*probes) {
       if (probes_args.in.empty() && probes_args.from_run.empty())

@@ -59,7 +59,8 @@ Histories with_sensor_noise(Histories h, std::uint64_t seed) {
 
 placement::PlacementInput placement_input(const Histories& h) {
   placement::PlacementInput in;
-  for (size_t c = 0; c < h.names.size(); ++c) in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
+  for (size_t c = 0; c < h.names.size(); ++c)
+    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
   in.positions_m = h.positions;
   in.times_s = h.times;
   in.temperatures_K = h.temperature;

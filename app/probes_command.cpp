@@ -55,7 +55,8 @@ int probes_command(const ProbesArgs& args) {
   // 3. Align, recover drift and tilt, compare with the other alignments; publish DIR whole.
   const probes::ProbeRunSummary summary = probes::run_probes_command(raw, out.path(), options);
   out.commit();
-  std::cerr << "thermotwin: probes: " << summary.readings << " readings -> " << args.out.string() << "\n";
+  std::cerr << "thermotwin: probes: " << summary.readings << " readings -> " << args.out.string()
+            << "\n";
   return 0;
 }
 

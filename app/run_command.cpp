@@ -75,9 +75,16 @@ void write_candidates(const CandidateSet& set, const solvers::ThermalHistory& th
 /// thermal_error.csv: the TCP and probe columns, then the feed axis's points when there are any.
 void write_thermal_error(const solvers::ThermalHistory& th, const solvers::ThermalError& e,
                          const solvers::AxisError* axis, const std::filesystem::path& path) {
-  std::vector<std::string> header{"time_s",   "dx_um",    "dy_um",    "dz_um",
-                                  "dx_z1_um", "dy_z1_um", "dx_z2_um", "dy_z2_um",
-                                  "tilt_about_x_urad", "tilt_about_y_urad"};
+  std::vector<std::string> header{"time_s",
+                                  "dx_um",
+                                  "dy_um",
+                                  "dz_um",
+                                  "dx_z1_um",
+                                  "dy_z1_um",
+                                  "dx_z2_um",
+                                  "dy_z2_um",
+                                  "tilt_about_x_urad",
+                                  "tilt_about_y_urad"};
   const Eigen::Index extra = axis ? axis->values.cols() : 0;
   Eigen::MatrixXd rows(e.values.rows(), 10 + extra);
   for (Eigen::Index t = 0; t < e.values.rows(); ++t) {
@@ -140,13 +147,14 @@ nlohmann::json model_json(const RunArgs& args, const io::ReducedModelFile* rom,
                    {"rom", std::filesystem::absolute(args.rom).string()},
                    {"built_from", rom->case_name}};
   if (check)
-    j["verify"] = {{"max_temperature_error_K", check->max_temperature_error_k},
-                   {"max_point_temperature_error_K", check->max_point_error_k},
-                   {"tcp_error_um", {check->tcp_error_m(0) * 1e6, check->tcp_error_m(1) * 1e6,
-                                     check->tcp_error_m(2) * 1e6}},
-                   {"tcp_peak_um", {check->tcp_peak_m(0) * 1e6, check->tcp_peak_m(1) * 1e6,
-                                    check->tcp_peak_m(2) * 1e6}},
-                   {"full_s", check->full_s}};
+    j["verify"] = {
+        {"max_temperature_error_K", check->max_temperature_error_k},
+        {"max_point_temperature_error_K", check->max_point_error_k},
+        {"tcp_error_um",
+         {check->tcp_error_m(0) * 1e6, check->tcp_error_m(1) * 1e6, check->tcp_error_m(2) * 1e6}},
+        {"tcp_peak_um",
+         {check->tcp_peak_m(0) * 1e6, check->tcp_peak_m(1) * 1e6, check->tcp_peak_m(2) * 1e6}},
+        {"full_s", check->full_s}};
   return j;
 }
 
@@ -304,8 +312,9 @@ int run_command(const RunArgs& args) {
                                        {"tolerance_K", indicator->tolerance_k},
                                        {"above_tolerance", indicator->above_tolerance()}};
     else
-      summary["model"]["indicator"] = "not computed for this scheme (backward Euler only): see "
-                                      "verify";
+      summary["model"]["indicator"] =
+          "not computed for this scheme (backward Euler only): see "
+          "verify";
   }
   summary["steps"] = run.thermal.timings.steps;
   summary["factorizations"] = run.thermal.timings.factorizations;

@@ -8,6 +8,8 @@
 #   4. place   sensors on the run's histories for the case's targets (placement --from the run)
 #   5. fit     models on a virtual campaign, judged on held-out duty cycles; the feed axis's
 #              points modelled too, and the axis polynomial from their predictions
+#   6. export  the compensation in the four controllers' formats, each law judged against the
+#              model along the X travel on the fit's held-out states (docs/cnc-export.md)
 #
 #   bench/gm1_study.sh --short [--thermotwin PATH] [--out DIR]   coarse mesh, 1 h campaign runs, --quick fit:
 #                                                               the CI variant (a few minutes)
@@ -125,5 +127,26 @@ for d in ("dx", "dy", "dz"):
     assert res["linear"][d]["rms_um"] >= res["measured"][d]["rms_um"] - 1e-9
 dom = max(("dx", "dy", "dz"), key=lambda d: res["uncompensated"][d]["rms_um"])
 assert res["linear"][dom]["rms_um"] < 0.5 * res["uncompensated"][dom]["rms_um"], (dom, res)
+PY
+step "6. export (SINUMERIK, TwinCAT, Heidenhain, LinuxCNC)"
+states=()
+for f in "$out"/fit/held_out/*_temperatures.csv; do states+=(--states "$f"); done
+"$exe" export --model "$out/fit/fit.json" --out "$out/export" "${states[@]}"
+/usr/bin/python3 - "$out/export/export.json" <<'PY'
+import json, sys
+doc = json.load(open(sys.argv[1]))
+assert len(doc["states"]) == 3, doc["states"]
+for name, f in doc["formats"].items():
+    e = f["error_on_states"]
+    print(f"gm1_study: export {name}: law - model max " +
+          ", ".join(f"{d} {e[d]['max_um']:.3g}" for d in ("dx", "dy", "dz")) + " um")
+    for d in ("dx", "dy", "dz"):
+        assert e[d]["max_um"] <= e[d]["model_max_um"] + 1e-9, (name, d, e[d])
+# The exact forms lose no more than their unit; the line loses the cubic's curvature, less than a
+# tenth of the axis's own growth.
+assert doc["formats"]["linuxcnc"]["error_on_states"]["dx"]["max_um"] <= 0.01 + 1e-9
+assert doc["formats"]["heidenhain"]["error_on_states"]["dx"]["max_um"] <= 0.2
+sin = doc["formats"]["sinumerik"]["error_on_states"]["dx"]
+assert sin["max_um"] < 0.1 * sin["model_max_um"], sin
 PY
 step "done -> $out"

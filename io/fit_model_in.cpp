@@ -6,80 +6,35 @@
 
 #include "core/errors.hpp"
 #include "fitting/features.hpp"
+#include "io/fit_json_keys.hpp"
 
 namespace tt::io {
 
 namespace {
 
+using fit_keys::member;
+using fit_keys::names_at;
+using fit_keys::number_at;
+using fit_keys::Place;
+using fit_keys::vector_at;
 using fitting::ModelKind;
 using nlohmann::json;
 
 constexpr double um = 1e-6;  // micrometres to metres
 
-/// Where a key sits, for messages: "fit.json: targets[0] (z): chosen.coefficients.kind".
-struct Place {
-  std::string origin, target;
-  std::string at(const std::string& key) const {
-    return origin + ": target '" + target + "': " + key;
-  }
-};
-
-const json& member(const json& j, const std::string& key, const Place& p, const std::string& path) {
-  if (!j.is_object() || !j.contains(key))
-    throw core::DataError(p.at(path + key) +
-                          " is missing; hint: give a fit.json written by "
-                          "`thermotwin fit` or `thermotwin fit --data`");
-  return j.at(key);
-}
-
-double number_at(const json& j, const std::string& key, const Place& p, const std::string& path) {
-  const json& v = member(j, key, p, path);
-  if (!v.is_number() || !std::isfinite(v.get<double>()))
-    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a finite number");
-  return v.get<double>();
-}
-
-std::vector<std::string> names_at(const json& j, const std::string& key, const Place& p,
-                                  const std::string& path) {
-  const json& v = member(j, key, p, path);
-  std::vector<std::string> names;
-  if (v.is_array())
-    for (const json& n : v)
-      if (n.is_string()) names.push_back(n.get<std::string>());
-  if (!v.is_array() || names.size() != v.size())
-    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a list of names");
-  return names;
-}
-
-Eigen::VectorXd vector_at(const json& j, const std::string& key, const Place& p,
-                          const std::string& path, double factor = 1.0) {
-  const json& v = member(j, key, p, path);
-  if (!v.is_array())
-    throw core::DataError(p.at(path + key) + " = " + v.dump() + ": expected a list of numbers");
-  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    if (!v[i].is_number() || !std::isfinite(v[i].get<double>()))
-      throw core::DataError(p.at(path + key) + "[" + std::to_string(i) + "] = " + v[i].dump() +
-                            ": expected a finite number");
-    out(static_cast<Eigen::Index>(i)) = v[i].get<double>() * factor;
-  }
-  return out;
-}
-
-ModelKind kind_of(const std::string& name, const Place& p) {
+ModelKind kind_of(const std::string& name, const Place& p, const std::string& at) {
   for (ModelKind k :
        {ModelKind::no_compensation, ModelKind::least_squares, ModelKind::ridge,
         ModelKind::projection_pursuit, ModelKind::distributed_lag, ModelKind::cnn_bigru_attention})
     if (fitting::kind_name(k) == name) return k;
-  throw core::DataError(p.at("chosen.coefficients.kind") + " = '" + name +
+  throw core::DataError(p.at(at + "kind") + " = '" + name +
                         "': not a model kind thermotwin writes");
 }
 
 /// The operating inputs a model reads: the key written since compensate exists, else the names
 /// of its "d[...]" terms (fit.json files written before it).
-std::vector<std::string> operating_inputs(const json& c, const Place& p) {
-  if (c.contains("operating_inputs"))
-    return names_at(c, "operating_inputs", p, "chosen.coefficients.");
+std::vector<std::string> operating_inputs(const json& c, const Place& p, const std::string& at) {
+  if (c.contains("operating_inputs")) return names_at(c, "operating_inputs", p, at);
   std::vector<std::string> inputs;
   if (!c.contains("terms") || !c["settings"].value("inputs", false)) return inputs;
   for (const json& t : c["terms"]) {
@@ -90,8 +45,7 @@ std::vector<std::string> operating_inputs(const json& c, const Place& p) {
   return inputs;
 }
 
-fitting::PprModel ppr_of(const json& c, const Place& p) {
-  const std::string at = "chosen.coefficients.";
+fitting::PprModel ppr_of(const json& c, const Place& p, const std::string& at) {
   fitting::PprModel m;
   m.center = vector_at(c, "input_center_K", p, at);
   m.scale = vector_at(c, "input_scale_K", p, at);
@@ -113,21 +67,18 @@ fitting::PprModel ppr_of(const json& c, const Place& p) {
   return m;
 }
 
-DeployedModel deployed_model(const json& target, const Place& p) {
-  const json& chosen = member(target, "chosen", p, "");
-  const json& c = member(chosen, "coefficients", p, "chosen.");
-  const std::string at = "chosen.coefficients.";
+/// The model `c` (a model_json object) describes; `at` is its key path in messages.
+fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::string& at) {
   const json& kind_json = member(c, "kind", p, at);
   const ModelKind kind =
-      kind_of(kind_json.is_string() ? kind_json.get<std::string>() : kind_json.dump(), p);
+      kind_of(kind_json.is_string() ? kind_json.get<std::string>() : kind_json.dump(), p, at);
   if (kind == ModelKind::cnn_bigru_attention)
     throw core::DataError(p.at(at + "kind") +
                           " = 'cnn_bigru_attention': compensate does not evaluate the network "
                           "(its weights are in network_<target>.pt, not in fit.json); hint: refit "
                           "without --network, or use the linear, ridge, distributed_lag or "
                           "projection_pursuit kinds");
-  DeployedModel d;
-  fitting::FittedModel& m = d.model;
+  fitting::FittedModel m;
   m.target_name = p.target;
   m.spec.kind = kind;
   const json& settings = member(c, "settings", p, at);
@@ -143,7 +94,7 @@ DeployedModel deployed_model(const json& target, const Place& p) {
                               std::to_string(tau) + ": every time constant must be > 0");
   }
   m.features.sensor_names = names_at(c, "sensors", p, at);
-  m.features.input_names = operating_inputs(c, p);
+  m.features.input_names = operating_inputs(c, p, at);
   m.features.time_constants = m.spec.time_constants;
   for (std::size_t k = 0; k < m.features.sensor_names.size(); ++k)
     m.features.sensors.push_back(static_cast<int>(k));
@@ -155,7 +106,7 @@ DeployedModel deployed_model(const json& target, const Place& p) {
     if (inputs != expected)
       throw core::DataError(p.at(at + "inputs") + " = " + json(inputs).dump() +
                             "; the model's sensors and inputs give " + json(expected).dump());
-    m.body = ppr_of(c, p);
+    m.body = ppr_of(c, p, at);
     if (std::get<fitting::PprModel>(m.body).center.size() !=
         static_cast<Eigen::Index>(expected.size()))
       throw core::DataError(p.at(at + "input_center_K") + " has " +
@@ -181,6 +132,14 @@ DeployedModel deployed_model(const json& target, const Place& p) {
     }
     m.body = fit;
   }
+  return m;
+}
+
+DeployedModel deployed_model(const json& target, const Place& p) {
+  const json& chosen = member(target, "chosen", p, "");
+  DeployedModel d;
+  d.model =
+      fitted_model_of(member(chosen, "coefficients", p, "chosen."), p, "chosen.coefficients.");
   // The uncertainty: held-out residuals, test groups first.
   for (const char* groups : {"test", "validation"}) {
     if (!chosen.contains(groups) || !chosen[groups].contains("S_um")) continue;
@@ -223,7 +182,14 @@ std::vector<DeployedModel> deployed_models(const json& fit, const std::string& o
   return models;
 }
 
-std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path) {
+fitting::FittedModel fitted_model_from_json(const json& coefficients, const std::string& origin,
+                                            const std::string& target, const std::string& key) {
+  fitting::FittedModel m = fitted_model_of(coefficients, Place{origin, target}, key + ".");
+  m.target_name = target;
+  return m;
+}
+
+json read_fit_json(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in || std::filesystem::is_directory(path))
     throw core::IoError(path.string() + ": cannot read (expected a fit.json file)");
@@ -235,7 +201,11 @@ std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& pat
   } catch (const json::parse_error& e) {
     throw core::DataError(path.string() + ": not JSON: " + e.what());
   }
-  return deployed_models(fit, path.string());
+  return fit;
+}
+
+std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path) {
+  return deployed_models(read_fit_json(path), path.string());
 }
 
 }  // namespace tt::io

@@ -32,6 +32,16 @@ struct DeployedModel {
 /// match the model's sensors, inputs and time constants.
 std::vector<DeployedModel> deployed_models(const nlohmann::json& fit, const std::string& origin);
 
+/// The model one model_json object describes (e.g. fit.json's axis.targets.<name>.coefficients),
+/// as deployed_models reads a target's chosen.coefficients; `origin`, `target` and `key` (the
+/// object's key path) name it in messages. Throws DataError as deployed_models does.
+fitting::FittedModel fitted_model_from_json(const nlohmann::json& coefficients,
+                                            const std::string& origin, const std::string& target,
+                                            const std::string& key);
+
+/// The parsed fit.json at `path`: IoError when it cannot be read, DataError when it is not JSON.
+nlohmann::json read_fit_json(const std::filesystem::path& path);
+
 /// deployed_models of the file at `path`; IoError when it cannot be read, DataError when it is
 /// not JSON.
 std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path);

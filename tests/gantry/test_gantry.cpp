@@ -13,7 +13,10 @@
 #include "app/axis_fit.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
+#include "fitting/cnc_export.hpp"
 #include "io/case_reader.hpp"
+#include "io/cnc_model_in.hpp"
+#include "io/fitting_out.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/axis_error.hpp"
 #include "solvers/campaign.hpp"
@@ -404,6 +407,33 @@ TEST(AxisFit, LinearModelsAtThePointsGiveThePolynomialOfTheMeasuredError) {
   EXPECT_LT(j["polynomial_residual"]["linear"]["dx"]["rms_um"].get<double>(),
             j["polynomial_residual"]["uncompensated"]["dx"]["rms_um"].get<double>());
   EXPECT_NE(app::axis_fit_markdown(fit).find("| linear |"), std::string::npos);
+  // `thermotwin export` reads the axis models back from fit.json and rebuilds, state by state,
+  // the polynomial of the linear models' predictions that was judged above.
+  const nlohmann::json tcp{{"target", "dy"},
+                           {"chosen",
+                            {{"coefficients", io::model_json(fit.linear[1].model)},
+                             {"test", {{"S_um", {{"g", 1.0}}}}}}}};
+  const io::CncModelFile exported = io::cnc_model(
+      nlohmann::json{{"targets", nlohmann::json::array({tcp})}, {"axis", j}}, "fit.json");
+  EXPECT_EQ(exported.model.feed_axis, spec.feed_axis.name);
+  const fitting::Group& g = groups[5];
+  const Eigen::MatrixXd states =
+      fitting::basis_states(exported.model, g.sensor_names, g.time, g.temperature);
+  Eigen::MatrixXd predicted(g.time.size(), 33);
+  for (Eigen::Index k = 0; k < 33; ++k)
+    predicted.col(k) = fitting::predicted_error(fit.linear[static_cast<std::size_t>(k)].model, g);
+  const solvers::AxisPolynomial poly = solvers::axis_polynomial(
+      solvers::AxisError{fit.points, fit.positions, predicted}, fit.degree);
+  for (Eigen::Index t = 0; t < g.time.size(); t += 7)
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd b = states.row(t).transpose();
+      const Eigen::VectorXd want = solvers::axis_polynomial_value(poly, d, t, fit.positions);
+      for (Eigen::Index i = 0; i < fit.positions.size(); ++i)
+        EXPECT_NEAR(-fitting::model_compensation(exported.model, d, fit.positions(i), b) -
+                        exported.model.tcp[static_cast<std::size_t>(d)].dot(b),
+                    want(i), 1e-12)
+            << "t " << t << " direction " << d << " point " << i;
+    }
   // The axis columns must be the groups' last ones.
   EXPECT_THROW(app::axis_fit(spec, groups, split, 1, {}, {fitting::ModelSpec{}}, std::nullopt, {}),
                core::DataError);
