@@ -198,7 +198,7 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   for (const auto& e : res.runners_up)
     air_reported |= e["kind"] == "ambient_temperature" && e.contains("unphysical");
   EXPECT_TRUE(air_reported) << res.runners_up.dump(1);
-  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, {}).dump(1);
+  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, s.train.readout, {}).dump(1);
   EXPECT_EQ(res.effects[0]["kind"], "speed_dependent_convection");
 }
 
@@ -256,7 +256,7 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   CalibrationOptions refit = s.copt;
   refit.refit_max_iterations = 8;  // off by default (effects.hpp says why)
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, refit);
-  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, {}).dump(1);
+  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, s.train.readout, {}).dump(1);
   const nlohmann::json& claim = res.effects[0];
   ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
   EXPECT_EQ(claim["location"]["source"], "front_bearing_friction");
@@ -336,7 +336,7 @@ TEST(Pairs, DISABLED_TwoEffectsAreClaimedTogether) {
   std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
               res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
               a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
-  ASSERT_EQ(res.effects.size(), 2u) << calibration_json(res, {}).dump(1);
+  ASSERT_EQ(res.effects.size(), 2u) << calibration_json(res, s.train.readout, {}).dump(1);
   std::set<std::string> kinds{res.effects[0]["kind"], res.effects[1]["kind"]};
   EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
