@@ -2,7 +2,8 @@
 """Checks a thermotwin output folder against the documented schemas (docs/schemas/).
 
 Usage: validate_output.py COMMAND DIR
-  COMMAND: the command that wrote DIR (mesh, run, reduce, place, fit, calibrate, probes, observe).
+  COMMAND: the command that wrote DIR (mesh, run, reduce, place, fit, calibrate, probes, observe,
+  export).
 Every JSON file that COMMAND always writes must be in DIR and match its schema; a file that it
 writes only in some modes (modelling_record.json, sensor_corrections.json) is checked when there.
 Exit 0 when all match; 1 with one line per problem (file, JSON path, message) otherwise; 2 on a
@@ -25,6 +26,7 @@ OUTPUTS = {
                   ("sensor_corrections.json", "sensor_corrections", False)],
     "probes": [("summary.json", "probes_summary", True)],
     "observe": [("observer.json", "observer", True)],
+    "export": [("export.json", "export", True)],
 }
 
 
