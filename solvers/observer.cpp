@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/parallel.hpp"
 #include "core/units.hpp"
 
 namespace tt::solvers {
@@ -347,6 +348,69 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
     }
   }
   return run;
+}
+
+Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
+                                    const std::vector<core::CaseSpec>& runs,
+                                    const ObserverSetup& setup, double sample_s) {
+  if (!(sample_s > 0)) throw core::SolverError("observer: sample_s = " + number(sample_s));
+  ObserverSetup s = setup;
+  s.noise.drift_relative_sigma = 0;
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(s.target_rows.rows());
+  double n = 0;
+  for (const auto& spec : runs) {
+    KalmanObserver observer(system, spec, s);
+    // Any values do: the covariance does not see them. The initial temperature keeps the
+    // innovations, and so the states, of the order of a real run's.
+    const Eigen::VectorXd readings =
+        Eigen::VectorXd::Constant(s.sensor_rows.rows(),
+                                  spec.thermal.initial_temperature_c + core::kCelsiusOffset);
+    for (double t = sample_s; t <= spec.duty_cycle.end + 1e-9; t += sample_s) {
+      sum += observer.assimilate(t, readings).drift_sigma.array().square().matrix();
+      n += 1;
+    }
+  }
+  return n > 0 ? Eigen::VectorXd(sum / n) : sum;
+}
+
+EstimationPlacement estimation_placement(const Twin& twin, const std::vector<core::CaseSpec>& runs,
+                                         const std::vector<std::string>& candidates,
+                                         const std::vector<int>& targets, int m,
+                                         double sensor_sigma_k, const ObserverNoise& noise,
+                                         double sample_s) {
+  if (m < 1 || m > static_cast<int>(candidates.size()))
+    throw core::SolverError("estimation placement: m = " + std::to_string(m) + " of " +
+                            std::to_string(candidates.size()) + " candidates");
+  if (runs.empty()) throw core::SolverError("estimation placement: no run to place on");
+  const auto criterion = [&](const std::vector<std::string>& sensors) {
+    ObserverNoise with = noise;
+    with.sensor_sigma_k =
+        Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), sensor_sigma_k);
+    const ObserverSetup setup = twin_observer_setup(twin, runs.front(), sensors, with);
+    for (int t : targets)
+      if (t < 0 || t >= setup.target_rows.rows())
+        throw core::SolverError("estimation placement: target index " + std::to_string(t) +
+                                " of " + std::to_string(setup.target_rows.rows()));
+    const Eigen::VectorXd v = mean_drift_variance(twin.model.system, runs, setup, sample_s);
+    double sum = 0;
+    for (int t : targets) sum += v(t);
+    return sum;
+  };
+  EstimationPlacement out;
+  std::vector<std::string> left = candidates;
+  for (int k = 0; k < m; ++k) {
+    std::vector<double> score(left.size());
+    core::parallel_for(static_cast<std::ptrdiff_t>(left.size()), [&](std::ptrdiff_t c) {
+      std::vector<std::string> trial = out.sensors;
+      trial.push_back(left[static_cast<std::size_t>(c)]);
+      score[static_cast<std::size_t>(c)] = criterion(trial);
+    });
+    const auto best = std::min_element(score.begin(), score.end()) - score.begin();
+    out.sensors.push_back(left[static_cast<std::size_t>(best)]);
+    out.variance_m2.push_back(score[static_cast<std::size_t>(best)]);
+    left.erase(left.begin() + best);
+  }
+  return out;
 }
 
 }  // namespace tt::solvers

@@ -179,4 +179,31 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
                     const ObserverSetup& setup, const Eigen::VectorXd& times,
                     const Eigen::MatrixXd& readings);
 
+/// The observer's posterior variance of each target's drift [m^2], averaged over readings every
+/// `sample_s` on each of `runs` (their duty cycles) and over the runs. The Kalman covariance does
+/// not depend on the readings' values, only on which sensors read and their noise, so this is
+/// known before any sensor is placed. setup.noise.drift_relative_sigma, which scales with the
+/// predicted drift, is left out. #targets.
+Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
+                                    const std::vector<core::CaseSpec>& runs,
+                                    const ObserverSetup& setup, double sample_s);
+
+/// Sensors placed for estimation: added one at a time, each the candidate that lowers the
+/// observer's mean posterior variance of the chosen targets' drift (summed over `targets`, indices
+/// into the setup's target names, see twin_observer_setup) the most.
+struct EstimationPlacement {
+  std::vector<std::string> sensors;  /// in the order chosen
+  std::vector<double> variance_m2;   /// after each addition: the criterion [m^2]
+};
+
+/// Greedy placement of m sensors among `candidates` (named points of the twin), each read with
+/// white noise `sensor_sigma_k` [K], under `noise`'s random walks, over `runs`' duty cycles read
+/// every `sample_s`. Candidates are scored side by side (core::parallel_for). Throws SolverError
+/// for m outside 1..#candidates or an unknown candidate or target.
+EstimationPlacement estimation_placement(const Twin& twin, const std::vector<core::CaseSpec>& runs,
+                                         const std::vector<std::string>& candidates,
+                                         const std::vector<int>& targets, int m,
+                                         double sensor_sigma_k, const ObserverNoise& noise,
+                                         double sample_s);
+
 }  // namespace tt::solvers

@@ -5,11 +5,13 @@
 // raises `recalibrate` on a run with an undeclared heat input and stays quiet on a clean run.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <random>
 
 #include "calibration/generator.hpp"
+#include "core/errors.hpp"
 #include "core/rng.hpp"
 #include "core/units.hpp"
 #include "io/case_reader.hpp"
@@ -197,6 +199,56 @@ TEST_F(Observer, MissingReadingsAreLeftOutOfTheUpdate) {
   EXPECT_GE(cov(1), 0.85);
   EXPECT_GE(cov(2), 0.85);
   EXPECT_FALSE(run.recalibrate);
+}
+
+TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) {
+  // The covariance does not see the readings' values: two runs far apart report the same sigma,
+  // so the criterion of a sensor set can be computed before any sensor reads.
+  core::CaseSpec c = run_spec();
+  c.duty_cycle.end = 3600;
+  const solvers::ObserverSetup set = setup(default_noise());
+  Eigen::VectorXd times = Eigen::VectorXd::LinSpaced(6, 600, 3600);
+  const auto k = static_cast<Eigen::Index>(kSensors.size());
+  const solvers::ObserverRun cool = solvers::observe(s_->twin.model.system, c, set, times,
+                                                     Eigen::MatrixXd::Constant(6, k, 293.0));
+  const solvers::ObserverRun hot = solvers::observe(s_->twin.model.system, c, set, times,
+                                                    Eigen::MatrixXd::Constant(6, k, 320.0));
+  EXPECT_LE((cool.drift_sigma - hot.drift_sigma).cwiseAbs().maxCoeff(),
+            1e-9 * cool.drift_sigma.maxCoeff());
+  const Eigen::VectorXd v = solvers::mean_drift_variance(s_->twin.model.system, {c}, set, 600);
+  EXPECT_NEAR(v(1), cool.drift_sigma.col(1).array().square().mean(), 1e-9 * v(1));
+
+  // Greedy placement for estimation of dy and dz among every named T point: each sensor added
+  // lowers the posterior variance, the reported figure is the set's criterion, and three placed
+  // sensors estimate better than the first three of the hand-picked set.
+  std::vector<std::string> candidates;
+  for (int i = 0; i < s_->twin.outputs.temperatures; ++i)
+    if (const std::string& n = s_->twin.outputs.names[static_cast<std::size_t>(i)];
+        n.size() == 3 && n[0] == 'T' && std::isdigit(static_cast<unsigned char>(n[1])))
+      candidates.push_back(n);  // T01..T54, not the TCP
+  ASSERT_GE(candidates.size(), 20u);
+  solvers::ObserverNoise noise = default_noise();
+  const solvers::EstimationPlacement placed =
+      solvers::estimation_placement(s_->twin, {c}, candidates, {1, 2}, 3, 0.04, noise, 600);
+  ASSERT_EQ(placed.sensors.size(), 3u);
+  EXPECT_LT(placed.variance_m2[1], placed.variance_m2[0]);
+  EXPECT_LT(placed.variance_m2[2], placed.variance_m2[1]);
+  const auto criterion = [&](const std::vector<std::string>& sensors) {
+    noise.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.04);
+    const Eigen::VectorXd var = solvers::mean_drift_variance(
+        s_->twin.model.system, {c}, solvers::twin_observer_setup(s_->twin, c, sensors, noise), 600);
+    return var(1) + var(2);
+  };
+  EXPECT_NEAR(criterion(placed.sensors), placed.variance_m2[2], 1e-9 * placed.variance_m2[2]);
+  const double hand = criterion({kSensors[0], kSensors[1], kSensors[2]});
+  EXPECT_LT(placed.variance_m2[2], hand);
+  std::printf("[observer] placed for estimation: %s %s %s, sigma(dy+dz) %.3g um (hand-picked %s "
+              "%s %s: %.3g um)\n",
+              placed.sensors[0].c_str(), placed.sensors[1].c_str(), placed.sensors[2].c_str(),
+              std::sqrt(placed.variance_m2[2]) * 1e6, kSensors[0].c_str(), kSensors[1].c_str(),
+              kSensors[2].c_str(), std::sqrt(hand) * 1e6);
+  EXPECT_THROW(solvers::estimation_placement(s_->twin, {c}, candidates, {1}, 0, 0.04, noise, 600),
+               core::SolverError);
 }
 
 TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
