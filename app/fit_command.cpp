@@ -34,6 +34,7 @@
 #include "io/reports.hpp"
 #include "mesh/mesher.hpp"
 #include "placement/place.hpp"
+#include "studies/placement_input.hpp"
 #include "solvers/campaign.hpp"
 
 namespace tt::app {
@@ -69,39 +70,16 @@ std::vector<int> indices_of(const std::vector<fitting::Group>& groups,
   return out;
 }
 
-/// Placement for the first `targets` targets on the fitting groups laid end to end (times shifted
-/// so they increase).
+/// Placement for the first `targets` targets on the fitting groups laid end to end.
 placement::PlacementResult placement_on(const std::vector<fitting::Group>& groups,
                                         const std::vector<int>& fit,
                                         const Eigen::MatrixX3d& positions, Eigen::Index targets,
                                         std::uint64_t seed) {
-  Eigen::Index rows = 0;
-  for (int i : fit) rows += groups[i].time.size();
-  placement::PlacementInput in;
-  const auto& g0 = groups[fit[0]];
-  for (size_t c = 0; c < g0.sensor_names.size(); ++c)
-    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
-  in.positions_m = positions;
-  in.times_s.resize(rows);
-  in.temperatures_K.resize(rows, g0.temperature.cols());
-  Eigen::MatrixXd error(rows, targets);
-  Eigen::Index r = 0;
-  double offset = 0;
-  for (int i : fit) {
-    const auto& g = groups[i];
-    const Eigen::Index n = g.time.size();
-    in.times_s.segment(r, n) = g.time.array() + offset;
-    in.temperatures_K.middleRows(r, n) = g.temperature;
-    error.middleRows(r, n) = g.error.leftCols(targets);
-    offset += g.time(n - 1) + 1.0;
-    r += n;
-  }
-  for (Eigen::Index k = 0; k < targets; ++k)
-    in.targets.push_back({g0.target_names[k], error.col(k)});
   placement::PlacementOptions options;
   options.samples = 0;  // every reading of the campaign, not the patent's 100
   options.seed = seed;
-  return placement::place_all(in, options);
+  return placement::place_all(studies::groups_end_to_end(groups, fit, positions, targets),
+                              options);
 }
 
 /// Sensor sets per placement method and m for one target, as fitting takes them.

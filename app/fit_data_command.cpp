@@ -45,6 +45,7 @@
 #include "io/measured_segments.hpp"
 #include "io/reports.hpp"
 #include "placement/place.hpp"
+#include "studies/placement_input.hpp"
 
 namespace tt::app {
 namespace {
@@ -102,29 +103,12 @@ WindowPrediction continuous_prediction(const fitting::FittedModel& chosen,
 /// The candidate sensors ranked on the training groups laid end to end (for --network).
 placement::PlacementResult placed_on(const std::vector<fitting::Group>& groups,
                                      std::uint64_t seed) {
-  Eigen::Index rows = 0;
-  for (const auto& g : groups) rows += g.time.size();
-  const auto& g0 = groups.front();
-  placement::PlacementInput in;
-  for (std::size_t c = 0; c < g0.sensor_names.size(); ++c)
-    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
-  in.positions_m = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(g0.sensor_names.size()), 3);
-  in.times_s.resize(rows);
-  in.temperatures_K.resize(rows, g0.temperature.cols());
-  std::vector<Eigen::VectorXd> targets(g0.target_names.size(), Eigen::VectorXd(rows));
-  Eigen::Index r = 0;
-  double offset = 0.0;
-  for (const auto& g : groups) {
-    const Eigen::Index n = g.time.size();
-    in.times_s.segment(r, n) = g.time.array() - g.time(0) + offset;
-    in.temperatures_K.middleRows(r, n) = g.temperature;
-    for (std::size_t t = 0; t < targets.size(); ++t)
-      targets[t].segment(r, n) = g.error.col(static_cast<Eigen::Index>(t));
-    offset = in.times_s(r + n - 1) + 1.0;
-    r += n;
-  }
-  for (std::size_t t = 0; t < targets.size(); ++t)
-    in.targets.push_back({g0.target_names[t], targets[t]});
+  std::vector<int> all(groups.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  const auto sensors = static_cast<Eigen::Index>(groups.front().sensor_names.size());
+  const placement::PlacementInput in = studies::groups_end_to_end(
+      groups, all, Eigen::MatrixX3d::Zero(sensors, 3),
+      static_cast<Eigen::Index>(groups.front().target_names.size()));
   placement::PlacementOptions options;
   options.samples =
       400;  // resampled: the MI searches need no more than this, the runs have 10^4 rows
