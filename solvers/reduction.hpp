@@ -67,6 +67,9 @@ struct ReductionStats {
   int deflated_columns = 0;                      /// of those, dropped as dependent
   int factorizations = 0;
   double build_s = 0;  /// wall time of basis and projection [s]
+  double solve_s = 0;           /// of which factors and solves [s]
+  double orthogonalise_s = 0;   /// of which orthonormalisation against the basis [s]
+  double projection_s = 0;      /// of which the Galerkin projection [s]
 };
 
 struct ReducedModel {
