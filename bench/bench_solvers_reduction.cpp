@@ -6,9 +6,11 @@
 //
 // Run:   bench_solvers_reduction [case=cases/sb1_coarse.toml] [top_speed_rpm=6000]
 //                                [compression=0 (> 0: add the default basis compressed)]
-//                                [only | build | twin] [slice_fraction=0.25]
+//                                [only | build | twin] [slice_fraction=0.5]
+//                                [moving_moments=1 (2: the slices' second moment too)]
 // "only": the default basis (and its compressed variant) only; "build": the same, and stop after
 // the build (order, build time; run under /usr/bin/time -v for the peak memory against mesh size).
+// The slice fraction (ReductionOptions::moving_slice_fraction) applies to every Krylov basis.
 // "twin": the basis with the given compression tolerance and moving slice fraction only, as the
 // twin of the case (TCP and axis-point influence rows), validated against the full model on
 // solvers::validation_runs (the case's own cycle, a 6 h staircase, an 8 h irregular cycle): per
@@ -177,7 +179,10 @@ int main(int argc, char** argv) {
     const double compression = argc > 3 ? std::atof(argv[3]) : 0.0;
     const std::string mode = argc > 4 ? argv[4] : "";
     const bool only = mode == "only" || mode == "build";
-    const double slice_fraction = argc > 5 ? std::atof(argv[5]) : 0.25;
+    const s::ReductionOptions defaults;
+    const double slice_fraction = argc > 5 ? std::atof(argv[5]) : defaults.moving_slice_fraction;
+    const bool moving_second_moment =
+        argc > 6 ? std::atoi(argv[6]) == 2 : defaults.moving_second_moment;
     // 1. The case, its mesh and the full system.
     tt::core::CaseSpec spec = tt::io::read_case(case_file);
     auto t = Clock::now();
@@ -197,6 +202,7 @@ int main(int argc, char** argv) {
       s::ReductionOptions o;
       o.compression_tolerance = compression;
       o.moving_slice_fraction = slice_fraction;
+      o.moving_second_moment = moving_second_moment;
       o.speeds_rpm = {0.0, top_speed};
       const tt::solvers::ElasticModel elastic(mesh, spec);
       const s::TwinOutputs outputs = s::full_outputs(mesh, spec, &elastic);
@@ -204,9 +210,9 @@ int main(int argc, char** argv) {
       twin.model = s::reduced_model(full, spec, o);
       twin.outputs = s::projected_outputs(outputs, twin.model.basis);
       const auto& st = twin.model.stats;
-      std::printf("twin compression %g, slices %g of a window: r = %d, build %.2f s (%d input "
+      std::printf("twin compression %g, slices %g of a window, %d moments of the slices: r = %d, build %.2f s (%d input "
                   "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
-                  compression, slice_fraction, twin.model.states(), st.build_s, st.input_columns,
+                  compression, slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(), st.build_s, st.input_columns,
                   st.solve_s, st.orthogonalise_s, st.projection_s);
       const auto table =
           s::validate_twin(full, outputs, twin, s::validation_runs(spec, spec.seed));
@@ -230,6 +236,8 @@ int main(int argc, char** argv) {
                             double compress = 0) {
       s::ReductionOptions o;
       o.compression_tolerance = compress;
+      o.moving_slice_fraction = slice_fraction;
+      o.moving_second_moment = moving_second_moment;
       o.speeds_rpm = {0.0, top_speed};
       o.shifts_per_s = std::move(shifts);
       o.second_moment = second;

@@ -187,7 +187,7 @@ class CapacityOrthonormalBasis {
     for (Eigen::Index j = 0; j < x.cols(); ++j)
       x.col(j) =
           norm0(j) > 0 ? Eigen::VectorXd(x.col(j) / norm0(j)) : Eigen::VectorXd::Zero(x.rows());
-    const Eigen::MatrixXd g = x.transpose() * (c_ * x);
+    const Eigen::MatrixXd g = tall_transposed_product(x, c_ * x);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
     std::vector<Eigen::Index> keep;
     for (Eigen::Index i = g.rows() - 1; i >= 0; --i)
@@ -256,6 +256,19 @@ std::string count_mismatch(const std::string& what, size_t model, size_t now) {
          std::to_string(now);
 }
 
+bool moves(const core::CaseSpec& spec, size_t source) {
+  return source < spec.thermal.sources.size() && spec.thermal.sources[source].window > 0;
+}
+
+/// The input columns before the moving sources' slices: the uniform field, the fixed sources,
+/// the films' and the fluxes' areas.
+Eigen::Index fixed_input_columns(const FullThermalSystem& full, const core::CaseSpec& spec) {
+  Eigen::Index count = 1;
+  for (size_t i = 0; i < full.source_shape.size(); ++i)
+    if (!moves(spec, i)) ++count;
+  return count + static_cast<Eigen::Index>(full.film_area.size() + full.flux_area.size());
+}
+
 }  // namespace
 
 Eigen::MatrixXd input_columns(const FullThermalSystem& full, const core::CaseSpec& spec,
@@ -265,8 +278,7 @@ Eigen::MatrixXd input_columns(const FullThermalSystem& full, const core::CaseSpe
   std::vector<Eigen::VectorXd> cols;
   cols.push_back(Eigen::VectorXd::Ones(n));
   for (size_t i = 0; i < full.source_shape.size(); ++i)
-    if (!(i < spec.thermal.sources.size() && spec.thermal.sources[i].window > 0))
-      cols.push_back(full.source_shape[i]);
+    if (!moves(spec, i)) cols.push_back(full.source_shape[i]);
   for (const auto& a : full.film_area) cols.push_back(a);
   for (const auto& a : full.flux_area) cols.push_back(a);
   for (size_t k = 0; k < full.moving.size(); ++k) {
@@ -329,6 +341,15 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
     a.makeCompressed();
     return a;
   };
+  // The columns whose second moment is taken: all, or all but the moving sources' slices (the
+  // last input columns before the output columns).
+  const Eigen::Index slices = b.cols() - fixed_input_columns(full, spec);
+  const auto second_moment_columns = [&](const Eigen::MatrixXd& x) -> Eigen::MatrixXd {
+    if (options.moving_second_moment || slices == 0) return x;
+    Eigen::MatrixXd kept(x.rows(), x.cols() - slices);
+    kept << x.leftCols(b.cols() - slices), x.rightCols(options.output_columns.cols());
+    return kept;
+  };
   std::optional<cholmod::Analysis> analysis;
   if (!shifted.empty()) analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
   for (std::size_t first = 0; first < shifted.size(); first += kWave) {
@@ -342,7 +363,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
       const cholmod::Factor factor(*analysis, shifted_operator(at), what.str());
       auto& out = moments[static_cast<std::size_t>(i)];
       out.push_back(factor.solve(rhs));
-      if (options.second_moment) out.push_back(factor.solve(full.capacity * out.back()));
+      if (options.second_moment)
+        out.push_back(factor.solve(full.capacity * second_moment_columns(out.back())));
     });
     const auto solved = Clock::now();
     st.solve_s += std::chrono::duration<double>(solved - wave_start).count();
