@@ -6,7 +6,7 @@
 //
 // Run:   bench_solvers_reduction [case=cases/sb1_coarse.toml] [top_speed_rpm=6000]
 //                                [compression=0 (> 0: add the default basis compressed)]
-//                                [only | build | twin] [slice_fraction=0.5]
+//                                [only | build | twin] [slice_fraction=0.25]
 //                                [moving_moments=1 (2: the slices' second moment too)]
 // "only": the default basis (and its compressed variant) only; "build": the same, and stop after
 // the build (order, build time; run under /usr/bin/time -v for the peak memory against mesh size).

@@ -194,10 +194,10 @@ TEST(TwinCampaign, MatchesTheFullCampaignOnGm1CoarseWithItsFeedAxis) {
 }
 
 TEST(TwinValidation, Gm1CoarseAxisPointsFollowTheFullModelOnCyclesNotUsedToBuildIt) {
-  // The default basis (moving slices of half a window, their first moment only) on the cycles
+  // The default basis (moving slices of a quarter window, their first moment only) on the cycles
   // `reduce` validates: the case's own, a 6 h staircase and an 8 h irregular cycle, the feed axis
   // moving as the case says. Every named point within 0.01 K; the TCP's and each axis point's
-  // drift within 1 % of its peak or 0.02 um (measured: at most 0.55 of the limit, at A11 dz).
+  // drift within 1 % of its peak or 0.02 um (measured: at most 0.13 of the limit, at A11 dz).
   const core::CaseSpec spec = io::read_case(fs::path(TT_SOURCE_DIR) / "cases" / "gm1_coarse.toml");
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const solvers::FullThermalSystem full = solvers::thermal_system(mesh, spec);
