@@ -6,9 +6,16 @@
 //
 // Run:   bench_solvers_reduction [case=cases/sb1_coarse.toml] [top_speed_rpm=6000]
 //                                [compression=0 (> 0: add the default basis compressed)]
-//                                [only | build]
+//                                [only | build | twin] [slice_fraction=0.25]
+//                                [moving_moments=1 (2: the slices' second moment too)]
 // "only": the default basis (and its compressed variant) only; "build": the same, and stop after
 // the build (order, build time; run under /usr/bin/time -v for the peak memory against mesh size).
+// The slice fraction (ReductionOptions::moving_slice_fraction) applies to every Krylov basis.
+// "twin": the basis with the given compression tolerance and moving slice fraction only, as the
+// twin of the case (TCP and axis-point influence rows), validated against the full model on
+// solvers::validation_runs (the case's own cycle, a 6 h staircase, an 8 h irregular cycle): per
+// run the largest named-point temperature error and the largest drift error over its limit
+// (1 % of the full run's peak or 0.02 um), with the drift column where it is largest.
 // Prints the mesh size, then per basis and duty cycle: states r, build time, the largest
 // |reduced - full| over every node and output time and over the named points, the error
 // indicator at the output times, and the run times. The duty cycles: the case's own (P-1 for
@@ -29,6 +36,7 @@
 #include "solvers/reduction.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_stepper.hpp"
+#include "solvers/twin.hpp"
 
 namespace {
 
@@ -171,6 +179,10 @@ int main(int argc, char** argv) {
     const double compression = argc > 3 ? std::atof(argv[3]) : 0.0;
     const std::string mode = argc > 4 ? argv[4] : "";
     const bool only = mode == "only" || mode == "build";
+    const s::ReductionOptions defaults;
+    const double slice_fraction = argc > 5 ? std::atof(argv[5]) : defaults.moving_slice_fraction;
+    const bool moving_second_moment =
+        argc > 6 ? std::atoi(argv[6]) == 2 : defaults.moving_second_moment;
     // 1. The case, its mesh and the full system.
     tt::core::CaseSpec spec = tt::io::read_case(case_file);
     auto t = Clock::now();
@@ -185,12 +197,47 @@ int main(int argc, char** argv) {
     for (const auto& p : spec.points) points.push_back(tt::mesh::named_node(mesh, p.id));
     const double t0_k = spec.thermal.initial_temperature_c + tt::core::kCelsiusOffset;
 
+    if (mode == "twin") {
+      // The twin of the case under these options, validated as `thermotwin reduce` does.
+      s::ReductionOptions o;
+      o.compression_tolerance = compression;
+      o.moving_slice_fraction = slice_fraction;
+      o.moving_second_moment = moving_second_moment;
+      o.speeds_rpm = {0.0, top_speed};
+      const tt::solvers::ElasticModel elastic(mesh, spec);
+      const s::TwinOutputs outputs = s::full_outputs(mesh, spec, &elastic);
+      s::Twin twin;
+      twin.model = s::reduced_model(full, spec, o);
+      twin.outputs = s::projected_outputs(outputs, twin.model.basis);
+      const auto& st = twin.model.stats;
+      std::printf("twin compression %g, slices %g of a window, %d moments of the slices: r = %d, build %.2f s (%d input "
+                  "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
+                  compression, slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(), st.build_s, st.input_columns,
+                  st.solve_s, st.orthogonalise_s, st.projection_s);
+      const auto table =
+          s::validate_twin(full, outputs, twin, s::validation_runs(spec, spec.seed));
+      for (const auto& c : table) {
+        Eigen::Index worst = 0;
+        const Eigen::VectorXd ratio = c.drift_error_m.cwiseQuotient(c.drift_limit_m);
+        const double r = ratio.size() ? ratio.maxCoeff(&worst) : 0.0;
+        std::printf("  %-28s max|dT| named %.2e K (%s); drift error / limit %.3f at %s (%.2e of "
+                    "%.2e um)\n",
+                    c.run.c_str(), c.max_temperature_error_k, c.worst_point.c_str(), r,
+                    ratio.size() ? c.drift_names[static_cast<size_t>(worst)].c_str() : "-",
+                    ratio.size() ? c.drift_error_m(worst) * 1e6 : 0.0,
+                    ratio.size() ? c.drift_limit_m(worst) * 1e6 : 0.0);
+      }
+      return 0;
+    }
+
     // 2. The bases.
     std::vector<Variant> variants;
     const auto krylov = [&](const std::string& name, std::vector<double> shifts, bool second,
                             double compress = 0) {
       s::ReductionOptions o;
       o.compression_tolerance = compress;
+      o.moving_slice_fraction = slice_fraction;
+      o.moving_second_moment = moving_second_moment;
       o.speeds_rpm = {0.0, top_speed};
       o.shifts_per_s = std::move(shifts);
       o.second_moment = second;
@@ -224,10 +271,13 @@ int main(int argc, char** argv) {
       variants.push_back({"POD from the case's own cycle", std::move(m)});
     }
     for (const auto& v : variants)
-      std::printf("basis %-40s r = %3d, build %.2f s (%d factors, %d of %d columns deflated)\n",
-                  v.name.c_str(), v.model.states(), v.model.stats.build_s,
-                  v.model.stats.factorizations, v.model.stats.deflated_columns,
-                  v.model.stats.candidate_columns);
+      std::printf(
+          "basis %-40s r = %3d, build %.2f s (%d factors, %d of %d columns deflated; %d input "
+          "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
+          v.name.c_str(), v.model.states(), v.model.stats.build_s, v.model.stats.factorizations,
+          v.model.stats.deflated_columns, v.model.stats.candidate_columns,
+          v.model.stats.input_columns, v.model.stats.solve_s, v.model.stats.orthogonalise_s,
+          v.model.stats.projection_s);
     if (mode == "build") return 0;
 
     // 3. Per duty cycle: the full run, then every reduced one against it.

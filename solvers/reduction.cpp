@@ -13,6 +13,7 @@
 #include "core/parallel.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/loads.hpp"
+#include "solvers/tall_products.hpp"
 
 namespace tt::solvers {
 namespace {
@@ -100,46 +101,85 @@ Eigen::MatrixXd slice_weights(const MovingSourceShape& shape, double width) {
   return out;
 }
 
-/// Orthonormal basis under construction, in the capacity inner product.
+/// Orthonormal basis under construction, in the capacity inner product. The columns live in
+/// one matrix whose capacity grows geometrically, so that a new column does not copy the basis.
 class CapacityOrthonormalBasis {
  public:
   CapacityOrthonormalBasis(const Sparse& capacity, double tolerance, double compression)
       : c_(capacity), tol_(tolerance), compression_(compression), v_(capacity.rows(), 0) {}
 
   /// Appends what each column adds to the span (block Gram-Schmidt against the basis twice, then
-  /// column by column twice: "twice is enough"); returns the number of columns dropped.
+  /// against the block's earlier columns: "twice is enough"); returns the number of columns
+  /// dropped.
   int append(Eigen::MatrixXd x) {
     Eigen::VectorXd norm0 = c_norms(x);
-    for (int pass = 0; pass < 2 && v_.cols() > 0; ++pass) {
+    for (int pass = 0; pass < 2 && r_ > 0; ++pass) {
       const Eigen::MatrixXd cx = c_ * x;
-      x -= v_ * (v_.transpose() * cx);
+      subtract_tall_product(x, basis_view(), tall_transposed_product(basis_view(), cx));
     }
     const Eigen::Index offered = x.cols();
     if (compression_ > 0) {
       x = compressed(std::move(x), norm0);
       norm0 = Eigen::VectorXd::Ones(x.cols());
     }
-    const Eigen::Index first = v_.cols();
-    int dropped = static_cast<int>(offered - x.cols());
-    for (Eigen::Index j = 0; j < x.cols(); ++j) {
-      Eigen::VectorXd col = x.col(j);
-      for (int pass = 0; pass < 2 && v_.cols() > first; ++pass) {
-        const auto fresh = v_.rightCols(v_.cols() - first);
-        col -= fresh * (fresh.transpose() * (c_ * col));
-      }
-      const double norm = std::sqrt(std::max(0.0, col.dot(c_ * col)));
-      if (!(norm0(j) > 0) || !(norm > tol_ * norm0(j))) {
-        ++dropped;
-        continue;
-      }
-      v_.conservativeResize(Eigen::NoChange, v_.cols() + 1);
-      v_.col(v_.cols() - 1) = col / norm;
-    }
-    return dropped;
+    Eigen::MatrixXd q(x.rows(), x.cols()), cq(x.rows(), x.cols());
+    const Eigen::Index kept = orthonormalised_block(x, norm0, q, cq);
+    reserve(r_ + kept);
+    v_.middleCols(r_, kept) = q.leftCols(kept);
+    r_ += kept;
+    return static_cast<int>(offered - kept);
   }
-  const Eigen::MatrixXd& basis() const { return v_; }
+  /// The basis, #nodes x r; the object is left empty.
+  Eigen::MatrixXd take() {
+    v_.conservativeResize(Eigen::NoChange, r_);
+    r_ = 0;
+    return std::move(v_);
+  }
 
  private:
+  static constexpr Eigen::Index kPanel = 16;  /// columns orthogonalised one by one at a time
+
+  Eigen::Block<const Eigen::MatrixXd, Eigen::Dynamic, Eigen::Dynamic, true> basis_view() const {
+    return v_.leftCols(r_);
+  }
+
+  void reserve(Eigen::Index columns) {
+    if (columns <= v_.cols()) return;
+    v_.conservativeResize(Eigen::NoChange, std::max(columns, v_.cols() + v_.cols() / 2));
+  }
+
+  /// The block x (already orthogonal to the basis) made C-orthonormal in q (cq = C q), column by
+  /// column in its order, in panels: each panel against the block's kept columns twice (BLAS3),
+  /// then each column against the panel's kept ones twice. A column is dropped when less than
+  /// tol_ of its norm before orthogonalisation (norm0) is left. Returns the number kept.
+  Eigen::Index orthonormalised_block(Eigen::MatrixXd& x, const Eigen::VectorXd& norm0,
+                                     Eigen::MatrixXd& q, Eigen::MatrixXd& cq) const {
+    Eigen::Index kept = 0;
+    for (Eigen::Index p0 = 0; p0 < x.cols(); p0 += kPanel) {
+      auto panel = x.middleCols(p0, std::min(kPanel, x.cols() - p0));
+      for (int pass = 0; pass < 2 && kept > 0; ++pass)
+        subtract_tall_product(panel, q.leftCols(kept),
+                              tall_transposed_product(cq.leftCols(kept), panel));
+      const Eigen::Index panel_start = kept;
+      for (Eigen::Index j = 0; j < panel.cols(); ++j) {
+        auto col = panel.col(j);
+        for (int pass = 0; pass < 2 && kept > panel_start; ++pass) {
+          const auto fresh = q.middleCols(panel_start, kept - panel_start);
+          const auto c_fresh = cq.middleCols(panel_start, kept - panel_start);
+          col -= fresh * (c_fresh.transpose() * col);  // a few columns: one thread
+
+        }
+        const Eigen::VectorXd ccol = c_ * col;
+        const double norm = std::sqrt(std::max(0.0, col.dot(ccol)));
+        if (!(norm0(p0 + j) > 0) || !(norm > tol_ * norm0(p0 + j))) continue;
+        q.col(kept) = col / norm;
+        cq.col(kept) = ccol / norm;
+        ++kept;
+      }
+    }
+    return kept;
+  }
+
   /// The block's principal directions in the C inner product, each column scaled by its norm
   /// before orthogonalisation (every input counts alike): those whose singular value exceeds
   /// the compression tolerance, C-orthonormal.
@@ -147,7 +187,7 @@ class CapacityOrthonormalBasis {
     for (Eigen::Index j = 0; j < x.cols(); ++j)
       x.col(j) =
           norm0(j) > 0 ? Eigen::VectorXd(x.col(j) / norm0(j)) : Eigen::VectorXd::Zero(x.rows());
-    const Eigen::MatrixXd g = x.transpose() * (c_ * x);
+    const Eigen::MatrixXd g = tall_transposed_product(x, c_ * x);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(g);
     std::vector<Eigen::Index> keep;
     for (Eigen::Index i = g.rows() - 1; i >= 0; --i)
@@ -164,18 +204,69 @@ class CapacityOrthonormalBasis {
   }
   const Sparse& c_;
   double tol_, compression_;
-  Eigen::MatrixXd v_;
+  Eigen::MatrixXd v_;   /// columns [0, r_) are the basis
+  Eigen::Index r_ = 0;
 };
 
+/// The rows of a sparse matrix that hold a nonzero, ascending.
+std::vector<int> nonzero_rows(const Sparse& a) {
+  std::vector<char> used(static_cast<size_t>(a.rows()), 0);
+  for (Eigen::Index c = 0; c < a.outerSize(); ++c)
+    for (Sparse::InnerIterator it(a, c); it; ++it) used[static_cast<size_t>(it.row())] = 1;
+  std::vector<int> rows;
+  for (size_t i = 0; i < used.size(); ++i)
+    if (used[i]) rows.push_back(static_cast<int>(i));
+  return rows;
+}
+
+/// a restricted to `rows` (ascending, holding every nonzero of a), renumbered: #rows x a.cols().
+Sparse rows_of(const Sparse& a, const std::vector<int>& rows) {
+  std::vector<int> position(static_cast<size_t>(a.rows()), -1);
+  for (size_t i = 0; i < rows.size(); ++i) position[static_cast<size_t>(rows[i])] = static_cast<int>(i);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index c = 0; c < a.outerSize(); ++c)
+    for (Sparse::InnerIterator it(a, c); it; ++it)
+      entries.emplace_back(position[static_cast<size_t>(it.row())], static_cast<int>(c), it.value());
+  Sparse out(static_cast<Eigen::Index>(rows.size()), a.cols());
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
+}
+
+/// V^T A V for a symmetric sparse A. A film acts on a few surface nodes only: when A has nonzero
+/// rows on fewer than half the nodes, the product is formed on those rows of V alone (the other
+/// rows add exact zeros).
 Eigen::MatrixXd symmetric_projection(const Sparse& a, const Eigen::MatrixXd& v) {
-  const Eigen::MatrixXd av = a * v;
-  const Eigen::MatrixXd r = v.transpose() * av;
-  return 0.5 * (r + r.transpose());
+  const std::vector<int> rows = nonzero_rows(a);
+  if (2 * rows.size() >= static_cast<size_t>(a.rows())) return symmetric_tall_product(v, a * v);
+  const Sparse sub = rows_of(a, rows);  // #rows x #nodes; its columns outside `rows` are empty
+  const Eigen::MatrixXd vs = v(rows, Eigen::placeholders::all);
+  return symmetric_tall_product(vs, rows_of(Sparse(sub.transpose()), rows) * vs);
+}
+
+/// V^T P for a sparse P whose columns touch few nodes (a moving source's pieces): V's rows that
+/// P touches, transposed once, so that each column of the product reads contiguous memory.
+Eigen::MatrixXd projected_columns(const Eigen::MatrixXd& v, const Sparse& p) {
+  const std::vector<int> rows = nonzero_rows(p);
+  const Eigen::MatrixXd vt = v(rows, Eigen::placeholders::all).transpose();
+  return vt * rows_of(p, rows);
 }
 
 std::string count_mismatch(const std::string& what, size_t model, size_t now) {
   return what + ": the reduced model was built with " + std::to_string(model) + ", the case has " +
          std::to_string(now);
+}
+
+bool moves(const core::CaseSpec& spec, size_t source) {
+  return source < spec.thermal.sources.size() && spec.thermal.sources[source].window > 0;
+}
+
+/// The input columns before the moving sources' slices: the uniform field, the fixed sources,
+/// the films' and the fluxes' areas.
+Eigen::Index fixed_input_columns(const FullThermalSystem& full, const core::CaseSpec& spec) {
+  Eigen::Index count = 1;
+  for (size_t i = 0; i < full.source_shape.size(); ++i)
+    if (!moves(spec, i)) ++count;
+  return count + static_cast<Eigen::Index>(full.film_area.size() + full.flux_area.size());
 }
 
 }  // namespace
@@ -187,8 +278,7 @@ Eigen::MatrixXd input_columns(const FullThermalSystem& full, const core::CaseSpe
   std::vector<Eigen::VectorXd> cols;
   cols.push_back(Eigen::VectorXd::Ones(n));
   for (size_t i = 0; i < full.source_shape.size(); ++i)
-    if (!(i < spec.thermal.sources.size() && spec.thermal.sources[i].window > 0))
-      cols.push_back(full.source_shape[i]);
+    if (!moves(spec, i)) cols.push_back(full.source_shape[i]);
   for (const auto& a : full.film_area) cols.push_back(a);
   for (const auto& a : full.flux_area) cols.push_back(a);
   for (size_t k = 0; k < full.moving.size(); ++k) {
@@ -251,9 +341,19 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
     a.makeCompressed();
     return a;
   };
+  // The columns whose second moment is taken: all, or all but the moving sources' slices (the
+  // last input columns before the output columns).
+  const Eigen::Index slices = b.cols() - fixed_input_columns(full, spec);
+  const auto second_moment_columns = [&](const Eigen::MatrixXd& x) -> Eigen::MatrixXd {
+    if (options.moving_second_moment || slices == 0) return x;
+    Eigen::MatrixXd kept(x.rows(), x.cols() - slices);
+    kept << x.leftCols(b.cols() - slices), x.rightCols(options.output_columns.cols());
+    return kept;
+  };
   std::optional<cholmod::Analysis> analysis;
   if (!shifted.empty()) analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
   for (std::size_t first = 0; first < shifted.size(); first += kWave) {
+    const auto wave_start = Clock::now();
     const std::size_t count = std::min(kWave, shifted.size() - first);
     std::vector<std::vector<Eigen::MatrixXd>> moments(count);
     core::parallel_for(static_cast<std::ptrdiff_t>(count), [&](std::ptrdiff_t i) {
@@ -263,18 +363,22 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
       const cholmod::Factor factor(*analysis, shifted_operator(at), what.str());
       auto& out = moments[static_cast<std::size_t>(i)];
       out.push_back(factor.solve(rhs));
-      if (options.second_moment) out.push_back(factor.solve(full.capacity * out.back()));
+      if (options.second_moment)
+        out.push_back(factor.solve(full.capacity * second_moment_columns(out.back())));
     });
+    const auto solved = Clock::now();
+    st.solve_s += std::chrono::duration<double>(solved - wave_start).count();
     for (auto& block : moments)
       for (auto& x : block) {
         st.candidate_columns += static_cast<int>(x.cols());
         st.deflated_columns += v.append(x);
       }
     st.factorizations += static_cast<int>(count);
+    st.orthogonalise_s += std::chrono::duration<double>(Clock::now() - solved).count();
   }
   st.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (stats) *stats = st;
-  return v.basis();
+  return v.take();
 }
 
 ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis) {
@@ -293,7 +397,7 @@ ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen
   r.film_area = project(full.film_area);
   r.source_shape = project(full.source_shape);
   r.flux_area = project(full.flux_area);
-  for (const auto& p : full.moving) r.moving.push_back(basis.transpose() * p);
+  for (const auto& p : full.moving) r.moving.push_back(projected_columns(basis, p));
   r.moving_source = full.moving_source;
   r.moving_pieces = full.moving_pieces;
   // The uniform field's coordinates: its capacity-weighted projection on the basis,
@@ -309,7 +413,9 @@ ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& 
   const auto t0 = Clock::now();
   ReducedModel m;
   m.basis = reduction_basis(full, spec, options, &m.stats);
+  const auto projection_start = Clock::now();
   m.system = projected_system(full, m.basis);
+  m.stats.projection_s = std::chrono::duration<double>(Clock::now() - projection_start).count();
   m.stats.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return m;
 }
