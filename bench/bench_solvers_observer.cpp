@@ -4,8 +4,14 @@
 // undeclared effect).
 // Usage: bench_solvers_observer [CASE=cases/sb1_coarse.toml] [HOURS=5] [GEN_HOURS=4]
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
-//                               [DRIFT_RELATIVE_SIGMA=0]
+//                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation]
+//   GEN_HOURS = 0 skips the generator's runs (5.).
 //   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
+//   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
+//     correlation     the four best by the standard's correlation for dy and for dz, together
+//     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
+//     estimation      greedy on the observer's posterior variance of dy + dz over the fitting
+//                     runs' duty cycles (solvers::estimation_placement, issue 20 item 4)
 // 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
 // 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
 //    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
@@ -40,6 +46,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/twin.hpp"
+#include "studies/placement_input.hpp"
 
 namespace {
 
@@ -179,6 +186,11 @@ int main(int argc, char** argv) {
     if (argc > 6) campaign_noise.heat_walk_w = std::stod(argv[6]);
     if (argc > 7) campaign_noise.air_walk_k = std::stod(argv[7]);
     if (argc > 8) campaign_noise.drift_relative_sigma = std::stod(argv[8]);
+    const std::string sensor_choice = argc > 9 ? argv[9] : "correlation";
+    if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
+        sensor_choice != "estimation")
+      throw std::runtime_error("SENSORS '" + sensor_choice +
+                               "': expected correlation, mutual_info or estimation");
     const auto t_all = Clock::now();
 
     // 1. Case, mesh, twin.
@@ -221,9 +233,39 @@ int main(int argc, char** argv) {
       for (int c :
            fitting::sensors_by_correlation(fitting::group_subset(noisy, split.fitting), d, 4))
         if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
+    const auto t_place = Clock::now();
+    if (sensor_choice == "mutual_info") {
+      placement::PlacementOptions options;
+      options.samples = 400;
+      options.m_max = 4;
+      options.seed = spec.seed;
+      const placement::PlacementResult placed = placement::place_all(
+          studies::groups_end_to_end(
+              noisy, split.fitting,
+              Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(cand.size()), 3), 2),
+          options);
+      chosen.clear();
+      for (const auto& t : placed.targets)
+        for (const auto& s : t.selections)
+          if (s.method == placement::Method::kGaussianGreedy && s.m == 4)
+            for (int c : s.columns)
+              if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
+    } else if (sensor_choice == "estimation") {
+      std::vector<core::CaseSpec> fitting_runs;
+      for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);
+      const solvers::EstimationPlacement placed = solvers::estimation_placement(
+          twin, fitting_runs, cand, {1, 2}, static_cast<int>(chosen.size()),
+          fitting::SensorNoise{}.temperature_sigma, campaign_noise, 300);
+      chosen.clear();
+      for (const auto& s : placed.sensors)
+        chosen.push_back(static_cast<int>(std::find(cand.begin(), cand.end(), s) - cand.begin()));
+      std::cout << "estimation placement: posterior sigma of dy + dz after each sensor [um]:";
+      for (double v : placed.variance_m2) std::cout << " " << fmt(std::sqrt(v) * 1e6);
+      std::cout << "\n";
+    }
     std::vector<std::string> sensors;
     for (int c : chosen) sensors.push_back(cand[static_cast<std::size_t>(c)]);
-    std::cout << "sensors:";
+    std::cout << "sensors (" << sensor_choice << ", " << fmt(seconds_since(t_place)) << " s):";
     for (const auto& s : sensors) std::cout << " " << s;
     std::cout << "\n";
     std::vector<fitting::Group> noisy_s;
@@ -295,66 +337,70 @@ int main(int argc, char** argv) {
       line(r.name, "campaign, held out", o, rr, run);
     }
 
-    // 5. The generator's runs.
-    const auto t_gen = Clock::now();
-    calibration::GeneratorOptions gopt;
-    const core::CaseSpec gen = calibration::generator_case(spec, gopt);
-    const mesh::TetMesh gmesh = mesh::mesh_case(gen);
-    calibration::Instrumentation inst;
-    inst.sensor_points = sensors;
-    std::mt19937_64 rng = core::generator(seed, 0);
-    solvers::ObserverNoise gen_noise = campaign_noise;
-    // The generator's sensors: 0.03 K white, 0.01 K drifting (600 s), 0.01 K steps.
-    gen_noise.sensor_sigma_k.setConstant(std::sqrt(0.03 * 0.03 + 0.01 * 0.01 + 0.01 * 0.01 / 12));
+    // 5. The generator's runs (GEN_HOURS = 0: none).
     Method gclean, geffect;
-    std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
-    for (int k = 0; k < clean_runs; ++k) plan.emplace_back("none", calibration::InjectedEffect{});
-    for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
-      const auto kind = static_cast<calibration::EffectKind>(k);
-      plan.emplace_back(calibration::kind_name(kind),
-                        calibration::random_effect(kind, spec, gmesh, sensors, rng));
+    std::size_t effect_runs = 0;
+    if (gen_hours > 0) {
+      const auto t_gen = Clock::now();
+      calibration::GeneratorOptions gopt;
+      const core::CaseSpec gen = calibration::generator_case(spec, gopt);
+      const mesh::TetMesh gmesh = mesh::mesh_case(gen);
+      calibration::Instrumentation inst;
+      inst.sensor_points = sensors;
+      std::mt19937_64 rng = core::generator(seed, 0);
+      solvers::ObserverNoise gen_noise = campaign_noise;
+      // The generator's sensors: 0.03 K white, 0.01 K drifting (600 s), 0.01 K steps.
+      gen_noise.sensor_sigma_k.setConstant(std::sqrt(0.03 * 0.03 + 0.01 * 0.01 + 0.01 * 0.01 / 12));
+      std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
+      for (int k = 0; k < clean_runs; ++k) plan.emplace_back("none", calibration::InjectedEffect{});
+      for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
+        const auto kind = static_cast<calibration::EffectKind>(k);
+        plan.emplace_back(calibration::kind_name(kind),
+                          calibration::random_effect(kind, spec, gmesh, sensors, rng));
+      }
+      for (std::size_t k = 0; k < plan.size(); ++k) {
+        const auto& [kind, effect] = plan[k];
+        const core::DutyCycle duty = calibration::random_duty_cycle(gen_hours, rng);
+        const core::CaseSpec truth_spec =
+            calibration::truth_case(gen, effect, duty, static_cast<int>(k));
+        const std::string name = "gen_" + std::to_string(k);
+        const io::MeasuredRun truth =
+            calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
+        const io::MeasuredRun measured = calibration::with_noise(truth, gopt, rng);
+        const core::CaseSpec declared = calibration::case_for_run(spec, measured);
+        const solvers::ObserverSetup setup =
+            solvers::twin_observer_setup(twin, declared, sensors, gen_noise);
+        const auto t_obs = Clock::now();
+        const solvers::ObserverRun run =
+            solvers::observe(twin.model.system, declared, setup, measured.time, measured.temperature);
+        observer_s += seconds_since(t_obs);
+        observed_h += duty.end / 3600;
+        const Eigen::MatrixXd true_drift = truth.displacement.middleCols(1, 2);
+        fitting::Group g;
+        g.name = name;
+        g.time = measured.time;
+        g.temperature = measured.temperature;
+        g.error = true_drift;
+        g.sensor_names = sensors;
+        g.target_names = {"dy", "dz"};
+        Score o, rr;
+        const auto [po, so] = dy_dz(run);
+        o.add(po, so, true_drift);
+        const auto [pr, sr] = regression_on(reg, g);
+        rr.add(pr, sr, true_drift);
+        Method& m = effect.present ? geffect : gclean;
+        m.observer.add(po, so, true_drift);
+        m.regression.add(pr, sr, true_drift);
+        add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
+        std::string what = kind;
+        if (effect.present)
+          what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
+        line(name, "generator, " + what, o, rr, run);
+      }
+      std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
+                << fmt(seconds_since(t_gen)) << " s)\n\n";
+      effect_runs = plan.size() - static_cast<std::size_t>(clean_runs);
     }
-    for (std::size_t k = 0; k < plan.size(); ++k) {
-      const auto& [kind, effect] = plan[k];
-      const core::DutyCycle duty = calibration::random_duty_cycle(gen_hours, rng);
-      const core::CaseSpec truth_spec =
-          calibration::truth_case(gen, effect, duty, static_cast<int>(k));
-      const std::string name = "gen_" + std::to_string(k);
-      const io::MeasuredRun truth =
-          calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
-      const io::MeasuredRun measured = calibration::with_noise(truth, gopt, rng);
-      const core::CaseSpec declared = calibration::case_for_run(spec, measured);
-      const solvers::ObserverSetup setup =
-          solvers::twin_observer_setup(twin, declared, sensors, gen_noise);
-      const auto t_obs = Clock::now();
-      const solvers::ObserverRun run =
-          solvers::observe(twin.model.system, declared, setup, measured.time, measured.temperature);
-      observer_s += seconds_since(t_obs);
-      observed_h += duty.end / 3600;
-      const Eigen::MatrixXd true_drift = truth.displacement.middleCols(1, 2);
-      fitting::Group g;
-      g.name = name;
-      g.time = measured.time;
-      g.temperature = measured.temperature;
-      g.error = true_drift;
-      g.sensor_names = sensors;
-      g.target_names = {"dy", "dz"};
-      Score o, rr;
-      const auto [po, so] = dy_dz(run);
-      o.add(po, so, true_drift);
-      const auto [pr, sr] = regression_on(reg, g);
-      rr.add(pr, sr, true_drift);
-      Method& m = effect.present ? geffect : gclean;
-      m.observer.add(po, so, true_drift);
-      m.regression.add(pr, sr, true_drift);
-      add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
-      std::string what = kind;
-      if (effect.present)
-        what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
-      line(name, "generator, " + what, o, rr, run);
-    }
-    std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
-              << fmt(seconds_since(t_gen)) << " s)\n\n";
 
     const auto total = [&](const std::string& what, const Method& m) {
       std::cout << what << ": observer RMS dy " << fmt(m.observer.rms_um()(0)) << " um, dz "
@@ -371,7 +417,7 @@ int main(int argc, char** argv) {
     std::cout << "alarms on clean runs: " << clean_alarms.raised << " in " << clean_alarms.hours
               << " h (" << fmt(clean_alarms.raised / clean_alarms.hours) << " per hour)\n";
     std::cout << "alarms on effect runs: " << effect_alarms.raised << " of "
-              << plan.size() - clean_runs << "; delays [s]:";
+              << effect_runs << "; delays [s]:";
     for (double d : effect_alarms.delays_s) std::cout << " " << d;
     std::cout << "\nobserver: " << fmt(observer_s) << " s for " << fmt(observed_h) << " h of runs ("
               << fmt(observer_s / observed_h * 1e3) << " ms per hour of run); total "
