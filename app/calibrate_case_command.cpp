@@ -72,7 +72,7 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   const mesh::TetMesh mesh = mesh::mesh_case(declared);
   calibration::CalibrationOptions options;
   options.seed = declared.seed;
-  if (args.refit) options.refit_max_iterations = 8;
+  if (args.no_refit) options.refit_max_iterations = 0;
   say(std::to_string(mesh.nodes.rows()) +
       " nodes; locating the channels (probes: elastic "
       "influence rows)");
@@ -208,7 +208,12 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
            << e["refit"]["iterations"].get<int>() << " Gauss–Newton step(s)"
            << (e["refit"]["converged"].get<bool>() ? "" : " (iteration cap reached)")
            << ": linearised `" << e["refit"]["linearised"].dump() << "`, refitted `"
-           << e["refit"]["refitted"].dump() << "`\n";
+           << e["refit"]["refitted"].dump() << "`"
+           << (e["refit"].value("kept", true)
+                   ? ""
+                   : " (not kept: on the runs left out of the fit it predicted worse than the "
+                     "claim as chosen, which is written)")
+           << "\n";
   }
   for (const auto& e : res.refit_rejected)
     md << "- not claimed: " << e["name"].get<std::string>() << ", whose size refitted about "

@@ -65,7 +65,7 @@ struct CalibrateArgs {
   std::vector<std::filesystem::path> train, test;
   std::optional<double> split_s;  /// a run given as --train and --test: train before, test from
   bool full = false;              /// with --case: march the full model, not the reduced one
-  bool refit = false;             /// with --case: refit the claims about the updated model
+  bool no_refit = false;          /// with --case: keep the claims' linearised sizes
   bool quiet = false;
 };
 

@@ -201,9 +201,10 @@ int main(int argc, char** argv) {
   calibrate->add_flag("--full", calibrate_args.full,
                       "with --case: march the full-order model (default: a reduced model built on "
                       "the runs' channels)");
-  calibrate->add_flag("--refit", calibrate_args.refit,
-                      "with --case: refit the claims about the updated model (Gauss-Newton; off by "
-                      "default until it has a held-out check: docs/calibration.md)");
+  calibrate->add_flag("--no-refit", calibrate_args.no_refit,
+                      "with --case: keep the claims' linearised sizes (default: refitted about the "
+                      "updated model by Gauss-Newton where that predicts held-out runs better: "
+                      "docs/calibration.md)");
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
 
   CompensateArgs compensate_args;
@@ -350,10 +351,10 @@ int main(int argc, char** argv) {
       return fit_command(fit_args);
     }
     if (*calibrate) {
-      if (calibrate_args.case_file.empty() && calibrate_args.refit)
-        throw tt::core::CaseError(
-            "calibrate: --refit refits the claims on the model of --case; "
-            "without --case there is no model. Hint: give --case CASE");
+      if (calibrate_args.case_file.empty() && calibrate_args.no_refit)
+        throw tt::core::CaseError("calibrate: --no-refit concerns the claims on the model of "
+                                  "--case; "
+                                  "without --case there is no model. Hint: give --case CASE");
       if (calibrate_args.case_file.empty() && calibrate_args.full)
         throw tt::core::CaseError(
             "calibrate: --full chooses the model of calibrate --case; without "

@@ -68,7 +68,7 @@ nlohmann::json parameters_json(const Candidate& c, const std::vector<double>& p)
     case EffectKind::speed_dependent_convection:
       j["h_speed_gain_W_m2K"] = spread(p.at(0));
       j["speed_ref_rpm"] = c.ref_speed_rpm;
-      j["speed_exponent"] = 1.0;
+      j["speed_exponent"] = c.speed_exponent;
       break;
     case EffectKind::temperature_dependent_heat:
       j["temperature_coefficient_per_K"] = spread(p.at(0));
@@ -209,7 +209,7 @@ AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
         auto& cv = conv.at(static_cast<size_t>(c.entries[k]));
         cv.h_speed_gain = std::max(0.0, cv.h_speed_gain + p.at(0) * c.weights.at(k));
         cv.speed_ref_rpm = c.ref_speed_rpm;
-        cv.speed_exponent = 1.0;
+        cv.speed_exponent = c.speed_exponent;
       }
       break;
     case EffectKind::temperature_dependent_heat:
@@ -306,6 +306,8 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
       refined = with_refined_heat_inputs(model, train, o);
     else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
       refined = with_refined_lag(train, first.sensor, first.time_constant, o);
+    else if (first.kind == EffectKind::speed_dependent_convection && !o.speed_exponent_grid.empty())
+      refined = with_speed_exponents(model, train, res.selection.claimed.front().candidate, o);
     if (refined) res.selection = select_effects(*refined, o, resizer(*refined));
   }
   const Catalogue& cat = refined ? *refined : train;
@@ -450,11 +452,20 @@ nlohmann::json effect_json(const Catalogue& cat, const EffectFit& f, bool claime
                             {"converged", f.refit_converged},
                             {"whitened_ss_at_linearised", f.refit_ss_linearised},
                             {"whitened_ss_at_refitted", f.refit_ss}};
+    if (f.refit_heldout_checked)
+      refit["heldout_check"] = {
+          {"whitened_ss_linearised", f.refit_heldout_ss_linearised},
+          {"whitened_ss_refitted", f.refit_heldout_ss_refitted},
+          {"accepted", f.refit_accepted},
+          {"rule",
+           "per training run, the claims fitted on the other runs (linearised, and refitted about "
+           "the updated model) and judged on it; the refit is kept only when it lowers the sum"}};
     if (f.linearised.empty()) {
       refit["held_as_fitted"] = true;
     } else {
       refit["linearised"] = parameters_json(c, f.linearised);
-      refit["refitted"] = parameters_json(c, f.parameters);
+      refit["refitted"] = parameters_json(c, f.refitted.empty() ? f.parameters : f.refitted);
+      refit["kept"] = f.refit_accepted;
     }
     j["refit"] = refit;
   }
@@ -567,7 +578,9 @@ nlohmann::json calibration_json(const CalibrationResult& res, const Readout& r,
        "pair of the first round's best candidates, scored jointly, replaces the claims made one "
        "after the other when it scores above them by more than that spread and each member adds "
        "more than the noise threshold and its floor to the other (`pairs`, `claimed_by`); the "
-       "claims' sizes are then refitted about the updated model by Gauss-Newton (`refit`)"},
+       "claims' sizes are then refitted about the updated model by Gauss-Newton (`refit`), and the "
+       "refitted sizes kept only when, fitted on all training runs but one, they predict the one "
+       "left out better than the linearised fit does (`refit.heldout_check`)"},
       {"null_score", res.selection.null_score},
       {"training_residual_whitened_ss", res.selection.residual_ss},
       {"noise_sigma_per_channel", sigma}};

@@ -255,8 +255,10 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
                  number(cv.h_speed_gain + change) + " W/m2K at " + number(c.ref_speed_rpm) +
                  " rpm): the gain must be >= 0";
         for (double n : speeds_used(runs)) {
-          const double h = solvers::film_coefficient(cv, n) +
-                           change * (speed_law ? (n > 0 ? n / c.ref_speed_rpm : 0.0) : 1.0);
+          const double h =
+              solvers::film_coefficient(cv, n) +
+              change * (speed_law ? (n > 0 ? std::pow(n / c.ref_speed_rpm, c.speed_exponent) : 0.0)
+                                  : 1.0);
           if (h <= 0)
             return "film coefficient after the change" + where + " " + number(h) + " W/m2K at " +
                    number(n) + " rpm: must be > 0";
@@ -1170,6 +1172,41 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
     }
     for (auto& c : added) out.candidates.push_back(std::move(c));
   }
+  return out;
+}
+
+Catalogue with_speed_exponents(const MarchModel& model, const Catalogue& cat, int candidate,
+                               const CalibrationOptions& o) {
+  Catalogue out = cat;
+  const Candidate& parent = cat.candidates.at(static_cast<size_t>(candidate));
+  if (parent.kind != EffectKind::speed_dependent_convection) return out;
+  std::vector<Candidate> added;
+  std::vector<LoadColumn> loads;
+  for (double x : o.speed_exponent_grid) {
+    if (std::abs(x - parent.speed_exponent) < 1e-9) continue;
+    Candidate c = parent;
+    c.speed_exponent = x;
+    c.name = parent.name + " (speed^" + number(x) + ")";
+    c.columns.clear();
+    for (auto& lc : c.unit_loads) {
+      std::get<FilmChange>(lc.form).speed_exponent = x;
+      lc.name = c.name;
+      loads.push_back(lc);
+    }
+    added.push_back(std::move(c));
+  }
+  if (added.empty()) return out;
+  // One march per run with every copy's loads as columns; a copy's column sums its loads'.
+  for (const auto& rm : out.runs) {
+    const Responses rs = march(model, rm.spec, out.readout, rm.times, {}, loads);
+    size_t j = 0;
+    for (auto& c : added) {
+      Eigen::MatrixXd col = Eigen::MatrixXd::Zero(rs.base.rows(), rs.base.cols());
+      for (double w : c.unit_weights) col += w * rs.columns[j++];
+      c.columns.push_back(Eigen::Map<const Eigen::VectorXd>(col.data(), col.size()));
+    }
+  }
+  for (auto& c : added) out.candidates.push_back(std::move(c));
   return out;
 }
 

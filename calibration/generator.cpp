@@ -37,6 +37,23 @@ int point_node(const mesh::TetMesh& m, const std::string& id) {
                         "' is not in the mesh; expected one of the case's points");
 }
 
+/// A smooth random air signal [K, change from the run's start]: a drift plus two slow waves,
+/// every 300 s up to `end`.
+core::TimeTable waves_air(double magnitude, std::uint64_t seed, int run_index, double end) {
+  std::mt19937_64 rng = core::generator(seed, static_cast<std::uint64_t>(run_index));
+  const double drift = uniform(rng, -1, 1), ph1 = uniform(rng, 0, 6.3), ph2 = uniform(rng, 0, 6.3);
+  const double p1 = uniform(rng, 7200, 14400), p2 = uniform(rng, 2400, 5400);
+  core::TimeTable t;
+  for (double x = 0; x <= end + 1e-9; x += 300) {
+    const double v = drift * x / std::max(end, 1.0) + 0.7 * std::sin(6.2832 * x / p1 + ph1) +
+                     0.3 * std::sin(6.2832 * x / p2 + ph2) -
+                     (0.7 * std::sin(ph1) + 0.3 * std::sin(ph2));
+    t.time.push_back(x);
+    t.value.push_back(v * magnitude);
+  }
+  return t;
+}
+
 }  // namespace
 
 core::CaseSpec generator_case(const core::CaseSpec& declared, const GeneratorOptions& o) {
@@ -183,22 +200,16 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
   };
   switch (e.kind) {
     case EffectKind::ambient_temperature: {
-      // A smooth random air signal: a drift plus two slow waves, on every unfixed sink.
-      std::mt19937_64 rng = core::generator(e.seed, static_cast<std::uint64_t>(run_index));
-      const double drift = uniform(rng, -1, 1), ph1 = uniform(rng, 0, 6.3),
-                   ph2 = uniform(rng, 0, 6.3);
-      const double p1 = uniform(rng, 7200, 14400), p2 = uniform(rng, 2400, 5400);
-      core::TimeTable t;
-      for (double x = 0; x <= duty.end + 1e-9; x += 300) {
-        const double v =
-            drift * x / std::max(duty.end, 1.0) + 0.7 * std::sin(6.2832 * x / p1 + ph1) +
-            0.3 * std::sin(6.2832 * x / p2 + ph2) - (0.7 * std::sin(ph1) + 0.3 * std::sin(ph2));
-        t.time.push_back(x);
-        t.value.push_back(v * e.magnitude);
-      }
-      for (auto& c : conv) {
+      auto on = [&](const core::Convection& c) {
+        if (!e.target.empty()) return s.groups[c.group].name == e.target;
         const auto& f = s.mechanical.fixed_groups;
-        if (std::find(f.begin(), f.end(), c.group) != f.end()) continue;
+        return std::find(f.begin(), f.end(), c.group) == f.end();
+      };
+      const core::TimeTable t = e.air == InjectedEffect::Air::shop_day
+                                    ? shop_day_air(e.magnitude, e.seed, run_index, duty.end)
+                                    : waves_air(e.magnitude, e.seed, run_index, duty.end);
+      for (auto& c : conv) {
+        if (!on(c)) continue;
         core::TimeTable own = t;
         for (size_t k = 0; k < own.time.size(); ++k)
           own.value[k] += solvers::table_value(c.sink, own.time[k]);
@@ -225,7 +236,7 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
       auto& c = entry_of(e.target);
       c.h_speed_gain = e.magnitude;
       c.speed_ref_rpm = 3000;
-      c.speed_exponent = 0.8;
+      c.speed_exponent = e.speed_exponent;
       break;
     }
     case EffectKind::temperature_dependent_heat:
@@ -256,8 +267,109 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
   return s;
 }
 
+core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffects& effects,
+                          const core::DutyCycle& duty, int run_index) {
+  core::CaseSpec s = truth_case(gen, InjectedEffect{}, duty, run_index);
+  for (const auto& e : effects) s = truth_case(s, e, duty, run_index);
+  return s;
+}
+
+core::TimeTable shop_day_air(double magnitude, std::uint64_t seed, int run_index, double end) {
+  std::mt19937_64 rng = core::generator(seed, static_cast<std::uint64_t>(run_index));
+  const double start_h = uniform(rng, 6, 12);
+  const double hvac_period = uniform(rng, 1200, 2400), hvac_amp = uniform(rng, 0.05, 0.2),
+               hvac_phase = uniform(rng, 0, 1);
+  struct Door {
+    double at, drop, tau;
+  };
+  std::vector<Door> doors;
+  for (double t = 0; t < end;) {
+    t += std::exponential_distribution<double>(1.0 / 7200)(rng);
+    if (t < end) doors.push_back({t, uniform(rng, 0.2, 0.6), uniform(rng, 600, 1200)});
+  }
+  auto air = [&](double t) {
+    const double h = start_h + t / 3600;
+    // Coolest at 4, warmest at 15 o'clock: a day warms faster than it cools.
+    const double phase = std::fmod(h - 4 + 24, 24);
+    const double daily =
+        phase < 11 ? -std::cos(3.14159265 * phase / 11) : std::cos(3.14159265 * (phase - 11) / 13);
+    const double saw = std::fmod(t / hvac_period + hvac_phase, 1.0);
+    double v = magnitude * daily + hvac_amp * (4 * std::abs(saw - 0.5) - 1);
+    for (const auto& d : doors)
+      if (t >= d.at) v -= d.drop * std::exp(-(t - d.at) / d.tau);
+    return v;
+  };
+  core::TimeTable out;
+  const double v0 = air(0);
+  for (double t = 0; t <= end + 1e-9; t += 60) {
+    out.time.push_back(t);
+    out.value.push_back(air(t) - v0);
+  }
+  return out;
+}
+
+InjectedEffects random_effects_in_several_places(EffectKind kind, const core::CaseSpec& declared,
+                                                 const mesh::TetMesh& m,
+                                                 const std::vector<std::string>& sensors,
+                                                 std::mt19937_64& rng) {
+  InjectedEffects out;
+  const int want =
+      kind == EffectKind::sensor_offset || kind == EffectKind::speed_dependent_convection
+          ? 2 + pick(rng, 2)
+          : 2;
+  // A part that acts where another already does is drawn again.
+  auto overlaps = [](const InjectedEffect& a, const InjectedEffect& b) {
+    if (a.kind == EffectKind::heat_input)
+      return !((a.box_max.array() < b.box_min.array()).any() ||
+               (b.box_max.array() < a.box_min.array()).any());
+    return a.target == b.target;
+  };
+  switch (kind) {
+    case EffectKind::ambient_temperature: {
+      // One shop's day, felt by each unfixed group's air with its own amplitude.
+      InjectedEffect e = random_effect(kind, declared, m, sensors, rng);
+      e.air = InjectedEffect::Air::shop_day;
+      e.magnitude = uniform(rng, 1, 3);
+      const auto& fixed = declared.mechanical.fixed_groups;
+      for (const auto& c : declared.thermal.convection) {
+        if (std::find(fixed.begin(), fixed.end(), c.group) != fixed.end()) continue;
+        InjectedEffect part = e;
+        part.target = declared.groups[c.group].name;
+        if (!out.empty()) part.magnitude *= uniform(rng, 0.5, 1.2);
+        out.push_back(part);
+      }
+      return out;
+    }
+    case EffectKind::temperature_dependent_heat:
+      for (const auto& src : declared.thermal.sources) {
+        InjectedEffect e = random_effect(kind, declared, m, sensors, rng);
+        e.target = src.name;
+        out.push_back(e);
+      }
+      return out;
+    default:
+      break;
+  }
+  for (int tries = 0; static_cast<int>(out.size()) < want && tries < 50; ++tries) {
+    InjectedEffect e = random_effect(kind, declared, m, sensors, rng);
+    if (std::any_of(out.begin(), out.end(), [&](const auto& o) { return overlaps(o, e); }))
+      continue;
+    if (kind == EffectKind::speed_dependent_convection) e.speed_exponent = uniform(rng, 0.5, 0.9);
+    if (kind == EffectKind::heat_input && !out.empty())
+      e.follows_speed = !out.front().follows_speed;  // one of each law
+    out.push_back(e);
+  }
+  return out;
+}
+
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffect& e, const Instrumentation& inst,
+                          const GeneratorOptions& o, const std::string& name) {
+  return clean_run(mesh_in, truth, InjectedEffects{e}, inst, o, name);
+}
+
+io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
+                          const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {
   // A heat input adds boundary groups: the faces must carry the truth's own group labels, or its
   // flux and convection land on whatever group had that index before (same nodes: groups do not
@@ -302,18 +414,20 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
     for (const auto& p : m.points)
       if (p.id == inst.sensor_points[s]) run.sensors.back().position = p.position;
     Eigen::VectorXd x = th.temperature.row(node).transpose();
-    if (e.present && e.kind == EffectKind::sensor_lag && e.target == inst.sensor_points[s]) {
-      // The sensor's own first-order lag, integrated on the truth's fine time grid.
-      Eigen::VectorXd y(nt);
-      y(0) = x(0);
-      for (Eigen::Index k = 1; k < nt; ++k) {
-        const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
-        y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
+    for (const InjectedEffect& e : effects) {
+      if (!e.present || e.target != inst.sensor_points[s]) continue;
+      if (e.kind == EffectKind::sensor_lag) {
+        // The sensor's own first-order lag, integrated on the truth's fine time grid.
+        Eigen::VectorXd y(nt);
+        y(0) = x(0);
+        for (Eigen::Index k = 1; k < nt; ++k) {
+          const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
+          y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
+        }
+        x = y;
       }
-      x = y;
+      if (e.kind == EffectKind::sensor_offset) x.array() += e.magnitude;
     }
-    if (e.present && e.kind == EffectKind::sensor_offset && e.target == inst.sensor_points[s])
-      x.array() += e.magnitude;
     for (Eigen::Index i = 0; i < ns; ++i)
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
   }

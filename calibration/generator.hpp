@@ -2,8 +2,11 @@
 // simulated on its own (finer) mesh and time step, read by noisy sensors, written in the
 // measured-data format. It shares none of the calibrator's choices: heat enters through a box of
 // random size and position (not a calibrator patch), the air temperature is a random smooth
-// signal (not hat functions), the convection gain follows speed with exponent 0.8, magnitudes
-// are drawn from ranges that reach down to the detection limit.
+// signal or a shop's day (not hat functions), the convection gain follows speed with exponent
+// 0.8 (0.5-0.9 in several places), magnitudes are drawn from ranges that reach down to the
+// detection limit, and a mechanism may act in several places at once with its own size and law
+// in each, or two mechanisms at once. Heat that grows with temperature is simulated as such:
+// the stepper takes each source's power at its mean temperature of the step before.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,7 +36,15 @@ struct InjectedEffect {
   double area = 0;  /// heat input: area of the faces in the box on the generator's mesh [m^2]
   bool follows_speed = false;
   std::uint64_t seed = 0;  /// for the run-specific parts (the air signal)
+  /// speed_dependent_convection: the gain grows with (speed / 3000 rpm)^speed_exponent.
+  double speed_exponent = 0.8;
+  /// ambient_temperature: a drift plus two slow waves, or a shop's day (shop_day_air); on every
+  /// unfixed sink, or on `target`'s only when it names a group.
+  enum class Air { waves, shop_day } air = Air::waves;
 };
+
+/// Every effect a truth has switched on (several places of one kind, or two kinds at once).
+using InjectedEffects = std::vector<InjectedEffect>;
 
 struct GeneratorOptions {
   double mesh_scale = 0.8;                /// bodies' max_edge times this (finer than the case)
@@ -51,12 +62,35 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
                              const mesh::TetMesh& mesh, const std::vector<std::string>& sensor_ids,
                              std::mt19937_64& rng);
 
+/// One mechanism in several places at once, each with its own size and law, in forms the
+/// calibrator's candidates (one place, or every place by one share of its h) cannot match one to
+/// one: heat inputs on two patches of the housing, one constant and one following speed; two or
+/// three unfixed films growing with speed with their own gains and exponents (0.5-0.9); every
+/// heat source's heat growing with temperature by its own coefficient; two films' conductances
+/// changed by their own factors; two material values; offsets or lags of two or three sensors;
+/// a shop's day (shop_day_air) on each unfixed sink with its own amplitude. The first element
+/// is the largest or the one random_effect would draw.
+InjectedEffects random_effects_in_several_places(EffectKind kind, const core::CaseSpec& declared,
+                                                 const mesh::TetMesh& mesh,
+                                                 const std::vector<std::string>& sensor_ids,
+                                                 std::mt19937_64& rng);
+
+/// An air that follows a shop's day [K, change from the run's start], sampled every 60 s up to
+/// `end_s`: the run starts between 6 and 12 o'clock (seeded by seed + run_index); a daily swing
+/// of `magnitude` K either side (coolest at 4, warmest at 15 o'clock), the air conditioning's
+/// cycle (20-40 min, 0.05-0.2 K) and doors opened now and then (about once in two hours: 0.2-0.6 K
+/// cooler, recovering in 10-20 min).
+core::TimeTable shop_day_air(double magnitude, std::uint64_t seed, int run_index, double end_s);
+
 /// The generator's own case: the declared case meshed finer, with its own time step.
 core::CaseSpec generator_case(const core::CaseSpec& declared, const GeneratorOptions& options);
 
 /// `gen_case` (from generator_case) with `effect` switched on, under `duty` (run-specific air
 /// signal seeded by effect.seed + run_index).
 core::CaseSpec truth_case(const core::CaseSpec& gen_case, const InjectedEffect& effect,
+                          const core::DutyCycle& duty, int run_index);
+/// The same with every effect of `effects` switched on, in order.
+core::CaseSpec truth_case(const core::CaseSpec& gen_case, const InjectedEffects& effects,
                           const core::DutyCycle& duty, int run_index);
 
 /// Sensors at named points of the case (by id) and displacement probes at the TCP in x, y, z.
@@ -80,6 +114,10 @@ io::MeasuredRun synthetic_run(const mesh::TetMesh& mesh, const core::CaseSpec& t
 /// share one simulation).
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
                           const InjectedEffect& effect, const Instrumentation& inst,
+                          const GeneratorOptions& options, const std::string& name);
+/// The same with the sensor effects of every element of `effects`.
+io::MeasuredRun clean_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
+                          const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& options, const std::string& name);
 io::MeasuredRun with_noise(const io::MeasuredRun& clean, const GeneratorOptions& options,
                            std::mt19937_64& rng);

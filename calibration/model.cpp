@@ -324,7 +324,10 @@ solvers::LoadCallback load_callback(const solvers::LinearThermalSystem<Matrix>& 
           [&](const FilmChange& f) -> solvers::LoadCallback {
             return [&ops, &conv, f](const solvers::StepView& step) {
               const double scale =
-                  f.follows_speed ? (step.speed > 0 ? step.speed / f.ref_speed_rpm : 0.0) : 1.0;
+                  f.follows_speed
+                      ? (step.speed > 0 ? std::pow(step.speed / f.ref_speed_rpm, f.speed_exponent)
+                                        : 0.0)
+                      : 1.0;
               if (scale == 0) return Eigen::VectorXd::Zero(ops.states()).eval();
               const auto& c = conv[f.entry];
               return at_step_ends(step, [&](const Eigen::VectorXd& temp, double t) {

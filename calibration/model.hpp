@@ -116,12 +116,13 @@ struct SinkHat {
   std::vector<int> entries;
   double knot_s = 0, width_s = 1;
 };
-/// A change of convection entry `entry`'s film coefficient, constant or growing in proportion to
-/// speed / ref_speed_rpm: -(F_e T - T_sink a_e) [W per W/(m^2 K)].
+/// A change of convection entry `entry`'s film coefficient, constant or growing with
+/// (speed / ref_speed_rpm)^speed_exponent: -(F_e T - T_sink a_e) [W per W/(m^2 K)].
 struct FilmChange {
   int entry = -1;
   bool follows_speed = false;
   double ref_speed_rpm = 1;
+  double speed_exponent = 1;
 };
 /// Heat of source `source` growing with its mean temperature: q(t, speed) (s^T T - T0) s, s the
 /// source's unit shape, T0 = reference_k [W per 1/K].
@@ -137,7 +138,8 @@ struct OperatorChange {
   std::shared_ptr<const Eigen::MatrixXd> reduced;           /// V^T dA V, when marched reduced
 };
 /// Or any step load on the full system (full order only).
-using LoadForm = std::variant<SinkHat, FilmChange, SourceGrowth, OperatorChange, solvers::LoadCallback>;
+using LoadForm =
+    std::variant<SinkHat, FilmChange, SourceGrowth, OperatorChange, solvers::LoadCallback>;
 
 /// A load added to the declared model, whose channel response the march computes.
 struct LoadColumn {

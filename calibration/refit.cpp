@@ -132,13 +132,25 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
   return {w.y, whitened_rows(jac, w, sigma), prediction};
 }
 
-/// Gauss–Newton on the claims' shared parameters from their linearised values.
-void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claims& cl,
-                  const Eigen::VectorXd& sigma, const CalibrationOptions& o) {
+/// The updated model at `theta` (its operators assembled again when a claim changes them).
+std::optional<MarchModel> updated_operators(const MarchModel& model, const core::CaseSpec& declared,
+                                            const Claims& cl, const Eigen::VectorXd& theta) {
+  if (!cl.changes_operators()) return std::nullopt;
+  return model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec);
+}
+
+Eigen::VectorXd shared_theta(const Claims& cl) {
   Eigen::VectorXd theta(static_cast<Eigen::Index>(
       std::count_if(cl.slot.begin(), cl.slot.end(), [](int s) { return s >= 0; })));
   for (size_t k = 0; k < cl.fits.size(); ++k)
     if (cl.slot[k] >= 0) theta(cl.slot[k]) = cl.fits[k].parameters.at(0);
+  return theta;
+}
+
+/// Gauss–Newton on the claims' shared parameters from their linearised values.
+void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claims& cl,
+                  const Eigen::VectorXd& sigma, const CalibrationOptions& o) {
+  Eigen::VectorXd theta = shared_theta(cl);
   const Eigen::Index p = theta.size();
   double ss_first = 0, ss_last = std::numeric_limits<double>::infinity();
   Eigen::VectorXd last_theta = theta, step = Eigen::VectorXd::Zero(p);
@@ -147,9 +159,7 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
   Eigen::VectorXd beyond;  /// the step that left the bounds, when one did
   for (int it = 0; it < o.refit_max_iterations; ++it) {
     // The operators of the updated model: the declared case's with the claims' materials.
-    std::optional<MarchModel> own;
-    if (cl.changes_operators())
-      own.emplace(model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec));
+    const std::optional<MarchModel> own = updated_operators(model, declared, cl, theta);
     const MarchModel& model_u = own ? *own : model;
     Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
     Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
@@ -206,6 +216,86 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
   }
 }
 
+/// The claims' shared parameters fitted linearly (the catalogue's columns about the declared
+/// model, as the choice fits them) on the training runs but `out`, the others held as fitted.
+Eigen::VectorXd linearised_without(const Claims& cl, size_t out, const Eigen::VectorXd& sigma,
+                                   const CalibrationOptions& o) {
+  const Eigen::Index p = shared_theta(cl).size();
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
+  for (size_t ri = 0; ri < cl.cat->runs.size(); ++ri) {
+    if (ri == out) continue;
+    const Whitened w = whitened(cl.cat->runs[ri], sigma);
+    Eigen::VectorXd y = w.y;
+    Eigen::MatrixXd a(y.size(), p);
+    for (size_t k = 0; k < cl.fits.size(); ++k) {
+      const Candidate& c = cl.candidate(k);
+      const Eigen::MatrixXd col = whitened_rows(c.columns.at(ri), w, sigma);
+      if (cl.slot[k] >= 0) {
+        a.col(cl.slot[k]) = col.col(0);
+      } else {
+        const std::vector<double>& q =
+            c.per_run ? cl.fits[k].run_parameters.at(ri)
+                      : (c.fixed ? std::vector<double>{1.0} : cl.fits[k].parameters);
+        y -= col * Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size()));
+      }
+    }
+    g += a.transpose() * a;
+    b += a.transpose() * y;
+  }
+  return solve_ridge(g, b, o.ridge);
+}
+
+/// `cl` on the training runs but `out` (per-run parameters with them).
+struct Fold {
+  Catalogue cat;
+  Claims claims;
+};
+Fold without_run(const Claims& cl, size_t out) {
+  Fold f;
+  f.cat.readout = cl.cat->readout;
+  f.cat.candidates = cl.cat->candidates;
+  for (size_t ri = 0; ri < cl.cat->runs.size(); ++ri)
+    if (ri != out) f.cat.runs.push_back(cl.cat->runs[ri]);
+  f.claims = cl;
+  for (auto& fit : f.claims.fits)
+    if (!fit.run_parameters.empty()) fit.run_parameters.erase(fit.run_parameters.begin() + out);
+  return f;
+}
+
+/// The held-out check of the refit (docs/calibration.md, "Refit"): per training run, the claims
+/// fitted on the other runs, linearised and refitted, each judged by the updated model's whitened
+/// sum of squares on the run left out; summed over the runs. `start`: the claims as chosen.
+struct HeldOutCheck {
+  double linearised = 0, refitted = 0;
+};
+HeldOutCheck heldout_check(const MarchModel& model, const core::CaseSpec& declared,
+                           const Claims& start, const Eigen::VectorXd& sigma,
+                           const CalibrationOptions& o) {
+  HeldOutCheck out;
+  const Eigen::VectorXd chosen = shared_theta(start);
+  // A claim the choice sized about its update (its linearised fit was unphysical) has no
+  // physical linearised fit on fewer runs: there both folds start from its chosen size.
+  bool resized = false;
+  for (const auto& f : start.fits) resized |= !f.linearised.empty();
+  auto ss_on = [&](const Claims& cl, const Eigen::VectorXd& theta, size_t ri) {
+    const std::optional<MarchModel> own = updated_operators(model, declared, cl, theta);
+    return linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma).y.squaredNorm();
+  };
+  for (size_t ri = 0; ri < start.cat->runs.size(); ++ri) {
+    Eigen::VectorXd lin = resized ? chosen : linearised_without(start, ri, sigma, o);
+    if (!start.physical(lin, o)) lin = chosen;
+    Fold fold = without_run(start, ri);
+    fold.claims.cat = &fold.cat;
+    for (size_t k = 0; k < fold.claims.fits.size(); ++k)
+      if (fold.claims.slot[k] >= 0) fold.claims.fits[k].parameters = {lin(fold.claims.slot[k])};
+    gauss_newton(model, declared, fold.claims, sigma, o);
+    out.linearised += ss_on(start, lin, ri);
+    out.refitted += ss_on(start, shared_theta(fold.claims), ri);
+  }
+  return out;
+}
+
 bool wants_refit(const Claims& cl) {
   int shared = 0;
   bool nonlinear = false;
@@ -236,10 +326,8 @@ Resized refit_alone(const MarchModel& model, const core::CaseSpec& declared, con
   const double size = f.parameters.at(0);
   if (size == 0 || !std::isfinite(size)) return out;
   // The secant response at the size: the updated model's channels minus the declared model's.
-  std::optional<MarchModel> own;
   const Eigen::VectorXd theta = Eigen::VectorXd::Constant(1, size);
-  if (cl.changes_operators())
-    own.emplace(model.with_case(model.mesh(), updated_case(declared, cl, theta, 0).spec));
+  const std::optional<MarchModel> own = updated_operators(model, declared, cl, theta);
   for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
     const Step s = linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma);
     out.columns.push_back(vec(s.prediction - cat.runs[ri].base) / size);
@@ -262,8 +350,27 @@ Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
                            (c.kind == EffectKind::material_parameter && c.field == "expansion"));
       cl.slot.push_back(shared ? next++ : -1);
     }
-    if (!wants_refit(cl)) return sel;
+    if (!wants_refit(cl) || o.refit_max_iterations <= 0) return sel;
+    const Claims start = cl;
     gauss_newton(model, declared, cl, sel.sigma, o);
+    // Kept only where it predicts the runs it was not fitted on better than the claims as chosen:
+    // sizing a law that is not the truth's to its in-sample optimum can cost on other runs.
+    bool checked = false;
+    HeldOutCheck check;
+    if (cat.runs.size() >= 2 && std::all_of(cl.fits.begin(), cl.fits.end(),
+                                            [](const auto& f) { return f.unphysical.empty(); })) {
+      check = heldout_check(model, declared, start, sel.sigma, o);
+      checked = true;
+    }
+    for (size_t k = 0; k < cl.fits.size(); ++k) {
+      EffectFit& f = cl.fits[k];
+      f.refit_heldout_checked = checked;
+      f.refit_heldout_ss_linearised = check.linearised;
+      f.refit_heldout_ss_refitted = check.refitted;
+      f.refit_accepted = !checked || check.refitted < check.linearised;
+      f.refitted = f.parameters;
+      if (!f.refit_accepted) f.parameters = start.fits[k].parameters;
+    }
     // A size that is unphysical once found is not claimed; the others are sized without it.
     std::vector<EffectFit> kept;
     for (auto& f : cl.fits) {

@@ -89,7 +89,7 @@ inline std::unique_ptr<Study> make_study(const Scale& sc) {
 
 /// Runs (train, train, test) of the truth with `effect`, noise from `rng`; `clean` gets the same
 /// runs without noise (the test run's is the truth the RMS figures are measured against).
-inline std::vector<io::MeasuredRun> effect_runs(const Study& s, const InjectedEffect& effect,
+inline std::vector<io::MeasuredRun> effect_runs(const Study& s, const InjectedEffects& effect,
                                                 std::mt19937_64& rng,
                                                 std::vector<io::MeasuredRun>* clean = nullptr) {
   std::vector<io::MeasuredRun> out;

@@ -251,11 +251,9 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   e.magnitude = 0.07;
   std::mt19937_64 rng = core::generator(31, 1);
   std::vector<io::MeasuredRun> clean;
-  const auto runs = testing::effect_runs(s, e, rng, &clean);
+  const auto runs = testing::effect_runs(s, {e}, rng, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
-  CalibrationOptions refit = s.copt;
-  refit.refit_max_iterations = 8;  // off by default (effects.hpp says why)
-  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, refit);
+  const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
   ASSERT_FALSE(res.effects.empty()) << calibration_json(res, s.train.readout, {}).dump(1);
   const nlohmann::json& claim = res.effects[0];
   ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
@@ -341,6 +339,37 @@ TEST(Pairs, DISABLED_TwoEffectsAreClaimedTogether) {
   EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
   EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+}
+
+// Issue 16 item 5: the generator's forms the candidates cannot match one to one. A kind acting in
+// several places at once with its own sizes and laws: the air as a shop's day on each unfixed
+// sink with its own amplitude, heat inputs on two patches under two laws, films growing with
+// speed with their own exponents, both sources' heat growing with temperature by their own
+// coefficients (the other kinds' several-places draws are in the long variant's confusion
+// matrix, for CI time); the right kind first, or ambiguous between it and another, and
+// after/before at most 0.3 where right.
+class SeveralPlaces : public ::testing::TestWithParam<int> {};
+TEST_P(SeveralPlaces, RightKindOrAmbiguousAndRms) {
+  const Study& s = study();
+  const auto kind = static_cast<EffectKind>(GetParam());
+  std::mt19937_64 rng = core::generator(41, static_cast<std::uint64_t>(GetParam()));
+  const InjectedEffects e =
+      random_effects_in_several_places(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
+  ASSERT_GE(e.size(), 2u);
+  testing::check_draw(s, e, rng);
+}
+INSTANTIATE_TEST_SUITE_P(FourKinds, SeveralPlaces, ::testing::Range(0, 4));
+
+// Two mechanisms of different kinds at once, drawn as the generator draws single ones: the first
+// claim is one of them (or the report ambiguous between one of them and another).
+TEST(TwoKinds, OneOfThemFirst) {
+  const Study& s = study();
+  std::mt19937_64 rng = core::generator(51, 1);
+  const InjectedEffects e = {
+      random_effect(EffectKind::heat_input, s.declared, s.gen_mesh, s.inst.sensor_points, rng),
+      random_effect(EffectKind::boundary_conductance, s.declared, s.gen_mesh, s.inst.sensor_points,
+                    rng)};
+  testing::check_draw(s, e, rng);
 }
 
 TEST(Clean, AtMostOneInTenGetsAnEffect) {

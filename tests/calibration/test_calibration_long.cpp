@@ -4,7 +4,14 @@
 //   three random draws per effect kind.
 // - MoreDraws: the CI scale with further draws per kind (seeds 100 and 200 above the CI tests'),
 //   for the kinds whose drawn magnitudes reach down to the detection limit.
+// - Confusion.FortyDraws: issue 16's confusion matrix at the CI scale (the coarse stand-in of
+//   SB-1, not cases/sb1.toml): 40 draws, per kind two single effects, two in several places at
+//   once and one with a second effect of another kind; plus ten clean runs. Prints the matrix of
+//   true kind against first claimed kind, the ambiguous and clean-claimed counts and after/before
+//   where right, and checks issue 16's targets.
 #include <gtest/gtest.h>
+
+#include <map>
 
 #include "calibration_checks.hpp"
 
@@ -43,6 +50,75 @@ TEST_P(MoreDraws, RightKindPlaceAndRms) {
   testing::check_kind(ci_study(), kind, seed);
 }
 INSTANTIATE_TEST_SUITE_P(CiScale, MoreDraws, ::testing::Range(0, 16));
+
+TEST(Confusion, FortyDraws) {
+  const testing::Study& s = ci_study();
+  const char* forms[] = {"single", "single", "several places", "several places", "two kinds"};
+  std::map<std::string, std::map<std::string, int>> matrix;
+  std::vector<double> ratios;
+  int right = 0, ambiguous = 0, draws = 0, right_within = 0;
+  // Kinds and forms interleaved (each kind takes each form once over the five blocks of eight), so
+  // that a run stopped early still covers every kind and form.
+  for (int d = 0; d < 40; ++d) {
+    const auto kind = static_cast<EffectKind>(d % 8);
+    const int form = (d % 8 + d / 8) % 5;
+    std::mt19937_64 rng = core::generator(3000 + static_cast<std::uint64_t>(d), 1);
+    InjectedEffects e;
+    if (form < 2) {
+      e = {random_effect(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng)};
+    } else if (form < 4) {
+      e = random_effects_in_several_places(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
+    } else {
+      const auto other = static_cast<EffectKind>((d % 8 + 1 + d % 7) % 8);
+      e = {random_effect(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng),
+           random_effect(other, s.declared, s.gen_mesh, s.inst.sensor_points, rng)};
+    }
+    std::printf("[confusion] draw %d: %s, %s\n", d, kind_name(kind).c_str(), forms[form]);
+    const testing::Outcome out = testing::calibrated(s, e, rng);
+    std::string truth = kind_name(kind);
+    if (e.size() > 1 && e[1].kind != kind) truth += " + " + kind_name(e[1].kind);
+    const std::string first = out.ambiguous ? "ambiguous" : out.first;
+    ++matrix[truth][first];
+    ++draws;
+    right += out.right;
+    ambiguous += out.ambiguous;
+    if (out.right) {
+      ratios.push_back(out.after / out.before);
+      right_within += out.after <= 0.3 * out.before;
+    }
+    std::printf("[confusion] draw %d: true %s (%s), first %s, after/before %.3f (%s)%s\n", d,
+                truth.c_str(), forms[form], first.c_str(), out.after / out.before,
+                out.units.c_str(), out.right ? " right" : "");
+  }
+  // Clean runs: ten noise draws on two clean simulations, as Clean.AtMostOneInTenGetsAnEffect.
+  std::vector<io::MeasuredRun> clean;
+  for (int k = 0; k < 2; ++k)
+    clean.push_back(clean_run(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[k], k),
+                              InjectedEffect{}, s.inst, s.gopt, "clean " + std::to_string(k)));
+  int clean_claimed = 0;
+  for (int t = 0; t < 10; ++t) {
+    std::mt19937_64 rng = core::generator(4000, static_cast<std::uint64_t>(t));
+    const Catalogue cat = testing::with_measured(
+        s.train, {with_noise(clean[0], s.gopt, rng), with_noise(clean[1], s.gopt, rng)});
+    clean_claimed += !select_effects(cat, s.copt).claimed.empty();
+  }
+  std::printf("[confusion] matrix (true kind -> first claimed kind: count)\n");
+  for (const auto& [t, row] : matrix) {
+    std::string line;
+    for (const auto& [f, n] : row) line += " " + f + ": " + std::to_string(n) + ";";
+    std::printf("[confusion]   %s ->%s\n", t.c_str(), line.c_str());
+  }
+  std::sort(ratios.begin(), ratios.end());
+  std::printf(
+      "[confusion] %d draws: right first %d, ambiguous with a true kind %d (%.1f %% together); "
+      "after/before <= 0.3 in %d of %d right (median %.3f, worst %.3f); clean claimed %d of 10\n",
+      draws, right, ambiguous, 100.0 * (right + ambiguous) / draws, right_within,
+      static_cast<int>(ratios.size()), ratios.empty() ? 0.0 : ratios[ratios.size() / 2],
+      ratios.empty() ? 0.0 : ratios.back(), clean_claimed);
+  EXPECT_GE(right + ambiguous, 0.95 * draws);
+  EXPECT_EQ(right_within, static_cast<int>(ratios.size()));
+  EXPECT_LE(clean_claimed, 1);
+}
 
 }  // namespace
 }  // namespace tt::calibration
