@@ -382,16 +382,21 @@ EstimationPlacement estimation_placement(const Twin& twin, const std::vector<cor
     throw core::SolverError("estimation placement: m = " + std::to_string(m) + " of " +
                             std::to_string(candidates.size()) + " candidates");
   if (runs.empty()) throw core::SolverError("estimation placement: no run to place on");
-  const auto criterion = [&](const std::vector<std::string>& sensors) {
+  const auto setup_for = [&](const std::vector<std::string>& sensors) {
     ObserverNoise with = noise;
     with.sensor_sigma_k =
         Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), sensor_sigma_k);
-    const ObserverSetup setup = twin_observer_setup(twin, runs.front(), sensors, with);
-    for (int t : targets)
-      if (t < 0 || t >= setup.target_rows.rows())
-        throw core::SolverError("estimation placement: target index " + std::to_string(t) +
-                                " of " + std::to_string(setup.target_rows.rows()));
-    const Eigen::VectorXd v = mean_drift_variance(twin.model.system, runs, setup, sample_s);
+    return twin_observer_setup(twin, runs.front(), sensors, with);
+  };
+  // The targets do not depend on the sensors: checked once, not per candidate set.
+  const Eigen::Index target_count = setup_for({candidates.front()}).target_rows.rows();
+  for (int t : targets)
+    if (t < 0 || t >= target_count)
+      throw core::SolverError("estimation placement: target index " + std::to_string(t) + " of " +
+                              std::to_string(target_count));
+  const auto criterion = [&](const std::vector<std::string>& sensors) {
+    const Eigen::VectorXd v =
+        mean_drift_variance(twin.model.system, runs, setup_for(sensors), sample_s);
     double sum = 0;
     for (int t : targets) sum += v(t);
     return sum;
