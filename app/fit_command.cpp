@@ -34,8 +34,8 @@
 #include "io/reports.hpp"
 #include "mesh/mesher.hpp"
 #include "placement/place.hpp"
-#include "studies/placement_input.hpp"
 #include "solvers/campaign.hpp"
+#include "studies/placement_input.hpp"
 
 namespace tt::app {
 namespace {
@@ -78,8 +78,7 @@ placement::PlacementResult placement_on(const std::vector<fitting::Group>& group
   placement::PlacementOptions options;
   options.samples = 0;  // every reading of the campaign, not the patent's 100
   options.seed = seed;
-  return placement::place_all(studies::groups_end_to_end(groups, fit, positions, targets),
-                              options);
+  return placement::place_all(studies::groups_end_to_end(groups, fit, positions, targets), options);
 }
 
 /// Sensor sets per placement method and m for one target, as fitting takes them.

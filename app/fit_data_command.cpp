@@ -106,9 +106,9 @@ placement::PlacementResult placed_on(const std::vector<fitting::Group>& groups,
   std::vector<int> all(groups.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
   const auto sensors = static_cast<Eigen::Index>(groups.front().sensor_names.size());
-  const placement::PlacementInput in = studies::groups_end_to_end(
-      groups, all, Eigen::MatrixX3d::Zero(sensors, 3),
-      static_cast<Eigen::Index>(groups.front().target_names.size()));
+  const placement::PlacementInput in =
+      studies::groups_end_to_end(groups, all, Eigen::MatrixX3d::Zero(sensors, 3),
+                                 static_cast<Eigen::Index>(groups.front().target_names.size()));
   placement::PlacementOptions options;
   options.samples =
       400;  // resampled: the MI searches need no more than this, the runs have 10^4 rows

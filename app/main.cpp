@@ -352,9 +352,10 @@ int main(int argc, char** argv) {
     }
     if (*calibrate) {
       if (calibrate_args.case_file.empty() && calibrate_args.no_refit)
-        throw tt::core::CaseError("calibrate: --no-refit concerns the claims on the model of "
-                                  "--case; "
-                                  "without --case there is no model. Hint: give --case CASE");
+        throw tt::core::CaseError(
+            "calibrate: --no-refit concerns the claims on the model of "
+            "--case; "
+            "without --case there is no model. Hint: give --case CASE");
       if (calibrate_args.case_file.empty() && calibrate_args.full)
         throw tt::core::CaseError(
             "calibrate: --full chooses the model of calibrate --case; without "

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -13,18 +14,16 @@
 #include "solvers/campaign.hpp"
 #include "solvers/reduction.hpp"
 
-#include <nlohmann/json.hpp>
-
 namespace tt::app {
 
 /// Candidate sensors with their histories and the case's targets (mechanical.targets: "dy" and
 /// "dz" unless the case says otherwise).
 struct Histories {
-  std::vector<std::string> names;   /// #candidates point ids, "v<node>" for surface vertices
-  std::vector<int> nodes;           /// #candidates mesh node, -1 when not known
-  Eigen::MatrixX3d positions;       /// #candidates x 3 [m]
-  Eigen::VectorXd times;            /// #times [s]
-  Eigen::MatrixXd temperature;      /// #times x #candidates [K]
+  std::vector<std::string> names;         /// #candidates point ids, "v<node>" for surface vertices
+  std::vector<int> nodes;                 /// #candidates mesh node, -1 when not known
+  Eigen::MatrixX3d positions;             /// #candidates x 3 [m]
+  Eigen::VectorXd times;                  /// #times [s]
+  Eigen::MatrixXd temperature;            /// #times x #candidates [K]
   std::vector<std::string> target_names;  /// #targets: "dx", "dy" or "dz"
   Eigen::MatrixXd targets;                /// #times x #targets thermal error at the TCP [m]
 };
@@ -67,7 +66,8 @@ Histories histories_from_nodes(const core::CaseSpec& spec, const CandidateSet& c
 
 /// From a simulated campaign run (point temperatures #times x #named points, error #times x 9).
 Histories histories_from_points(const core::CaseSpec& spec, const std::vector<double>& times,
-                                const Eigen::MatrixXd& point_temperature, const Eigen::MatrixXd& error);
+                                const Eigen::MatrixXd& point_temperature,
+                                const Eigen::MatrixXd& error);
 
 /// Which thermal model a study steps: a reduced model read from `rom`, the full model when
 /// `full`, else a reduced model built on the fly from the case.
@@ -80,19 +80,19 @@ struct ModelChoice {
 /// reduced, its order and where it came from).
 /// The reduced model's error indicator on `run` for summary files (`max_K`, `tolerance_K`,
 /// `above_tolerance`); above its tolerance it also warns on stderr.
-nlohmann::json indicator_report(const solvers::ErrorIndicator& indicator,
-                                const std::string& run);
+nlohmann::json indicator_report(const solvers::ErrorIndicator& indicator, const std::string& run);
 
 struct CampaignOnModel {
   std::vector<solvers::CampaignResult> results;
   nlohmann::json model;
 };
 
-/// Runs the campaign on the model `choice` names (app/model_choice.cpp), saying on stderr which one (unless quiet).
-/// Throws DataError when a reduced model given was built for another machine or mesh.
+/// Runs the campaign on the model `choice` names (app/model_choice.cpp), saying on stderr which one
+/// (unless quiet). Throws DataError when a reduced model given was built for another machine or
+/// mesh.
 CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                   const std::vector<solvers::CampaignRun>& runs,
-                                  const ModelChoice& choice,
-                                  const std::vector<int>& sampled_nodes, bool quiet);
+                                  const ModelChoice& choice, const std::vector<int>& sampled_nodes,
+                                  bool quiet);
 
 }  // namespace tt::app

@@ -14,8 +14,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "calibration/generator.hpp"
 #include "core/rng.hpp"

@@ -371,8 +371,8 @@ int main(int argc, char** argv) {
         const solvers::ObserverSetup setup =
             solvers::twin_observer_setup(twin, declared, sensors, gen_noise);
         const auto t_obs = Clock::now();
-        const solvers::ObserverRun run =
-            solvers::observe(twin.model.system, declared, setup, measured.time, measured.temperature);
+        const solvers::ObserverRun run = solvers::observe(twin.model.system, declared, setup,
+                                                          measured.time, measured.temperature);
         observer_s += seconds_since(t_obs);
         observed_h += duty.end / 3600;
         const Eigen::MatrixXd true_drift = truth.displacement.middleCols(1, 2);
@@ -416,8 +416,8 @@ int main(int argc, char** argv) {
     total("generator effect runs", geffect);
     std::cout << "alarms on clean runs: " << clean_alarms.raised << " in " << clean_alarms.hours
               << " h (" << fmt(clean_alarms.raised / clean_alarms.hours) << " per hour)\n";
-    std::cout << "alarms on effect runs: " << effect_alarms.raised << " of "
-              << effect_runs << "; delays [s]:";
+    std::cout << "alarms on effect runs: " << effect_alarms.raised << " of " << effect_runs
+              << "; delays [s]:";
     for (double d : effect_alarms.delays_s) std::cout << " " << d;
     std::cout << "\nobserver: " << fmt(observer_s) << " s for " << fmt(observed_h) << " h of runs ("
               << fmt(observer_s / observed_h * 1e3) << " ms per hour of run); total "

@@ -210,22 +210,24 @@ int main(int argc, char** argv) {
       twin.model = s::reduced_model(full, spec, o);
       twin.outputs = s::projected_outputs(outputs, twin.model.basis);
       const auto& st = twin.model.stats;
-      std::printf("twin compression %g, slices %g of a window, %d moments of the slices: r = %d, build %.2f s (%d input "
-                  "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
-                  compression, slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(), st.build_s, st.input_columns,
-                  st.solve_s, st.orthogonalise_s, st.projection_s);
-      const auto table =
-          s::validate_twin(full, outputs, twin, s::validation_runs(spec, spec.seed));
+      std::printf(
+          "twin compression %g, slices %g of a window, %d moments of the slices: r = %d, build "
+          "%.2f s (%d input "
+          "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
+          compression, slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(),
+          st.build_s, st.input_columns, st.solve_s, st.orthogonalise_s, st.projection_s);
+      const auto table = s::validate_twin(full, outputs, twin, s::validation_runs(spec, spec.seed));
       for (const auto& c : table) {
         Eigen::Index worst = 0;
         const Eigen::VectorXd ratio = c.drift_error_m.cwiseQuotient(c.drift_limit_m);
         const double r = ratio.size() ? ratio.maxCoeff(&worst) : 0.0;
-        std::printf("  %-28s max|dT| named %.2e K (%s); drift error / limit %.3f at %s (%.2e of "
-                    "%.2e um)\n",
-                    c.run.c_str(), c.max_temperature_error_k, c.worst_point.c_str(), r,
-                    ratio.size() ? c.drift_names[static_cast<size_t>(worst)].c_str() : "-",
-                    ratio.size() ? c.drift_error_m(worst) * 1e6 : 0.0,
-                    ratio.size() ? c.drift_limit_m(worst) * 1e6 : 0.0);
+        std::printf(
+            "  %-28s max|dT| named %.2e K (%s); drift error / limit %.3f at %s (%.2e of "
+            "%.2e um)\n",
+            c.run.c_str(), c.max_temperature_error_k, c.worst_point.c_str(), r,
+            ratio.size() ? c.drift_names[static_cast<size_t>(worst)].c_str() : "-",
+            ratio.size() ? c.drift_error_m(worst) * 1e6 : 0.0,
+            ratio.size() ? c.drift_limit_m(worst) * 1e6 : 0.0);
       }
       return 0;
     }

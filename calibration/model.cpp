@@ -161,8 +161,8 @@ Readout readout(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::Me
   return r;
 }
 
-Readout readout_like(const mesh::TetMesh& m, const core::CaseSpec& spec,
-                     const io::MeasuredRun& run, const Readout& like) {
+Readout readout_like(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::MeasuredRun& run,
+                     const Readout& like) {
   Readout r = located(m, spec, run);
   if (r.probe_point.empty()) return r;
   const bool same = r.probe_point == like.probe_point &&
@@ -241,7 +241,8 @@ Eigen::MatrixXd measured_channels(const io::MeasuredRun& run, const Readout& r) 
 
 MarchModel::MarchModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec)
     : mesh_(&mesh),
-      full_(std::make_shared<const solvers::FullThermalSystem>(solvers::thermal_system(mesh, spec))) {
+      full_(
+          std::make_shared<const solvers::FullThermalSystem>(solvers::thermal_system(mesh, spec))) {
 }
 
 MarchModel::MarchModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const Readout& r,
@@ -260,8 +261,8 @@ MarchModel::MarchModel(const mesh::TetMesh& mesh, const core::CaseSpec& spec, co
 MarchModel MarchModel::with_case(const mesh::TetMesh& mesh, const core::CaseSpec& other) const {
   if (mesh.nodes.rows() != mesh_->nodes.rows())
     throw core::SolverError("calibration: a case meshed with " + std::to_string(mesh.nodes.rows()) +
-                            " nodes cannot use a model of " +
-                            std::to_string(mesh_->nodes.rows()) + " nodes");
+                            " nodes cannot use a model of " + std::to_string(mesh_->nodes.rows()) +
+                            " nodes");
   MarchModel m(mesh, other);
   if (reduced_) {
     m.reduced_ = reduced_;
@@ -351,8 +352,10 @@ solvers::LoadCallback load_callback(const solvers::LinearThermalSystem<Matrix>& 
           },
           [&](const OperatorChange& f) -> solvers::LoadCallback {
             std::shared_ptr<const Matrix> a;
-            if constexpr (reduced) a = f.reduced;
-            else a = f.full;
+            if constexpr (reduced)
+              a = f.reduced;
+            else
+              a = f.full;
             if (!a)
               throw core::SolverError("calibration: an operator change without its " +
                                       std::string(reduced ? "projected" : "full") + " operator");
@@ -384,7 +387,8 @@ Responses march_on(const solvers::LinearThermalSystem<Matrix>& sys, const core::
                    const solvers::StateReadout& read, Eigen::Index channels,
                    const std::vector<Eigen::MatrixXd>& extra, const Eigen::VectorXd& times,
                    const std::vector<SeparableColumn>& separable,
-                   const std::vector<Eigen::VectorXd>& shapes, const std::vector<LoadColumn>& loads) {
+                   const std::vector<Eigen::VectorXd>& shapes,
+                   const std::vector<LoadColumn>& loads) {
   solvers::StepperRequest q;
   q.record_times = solvers::time_grid(spec, spec.thermal.step);
   q.record_states = false;
@@ -444,8 +448,8 @@ Responses march(const MarchModel& model, const core::CaseSpec& spec, const Reado
   for (const auto& e : extra_displacement) extra.push_back(e * v);
   std::vector<Eigen::VectorXd> shapes;
   for (const auto& c : separable) shapes.push_back(v.transpose() * c.shape);
-  return march_on(model.reduced_system(), spec, read, r.channels(), extra, times, separable,
-                  shapes, loads);
+  return march_on(model.reduced_system(), spec, read, r.channels(), extra, times, separable, shapes,
+                  loads);
 }
 
 Responses march(const mesh::TetMesh& m, const core::CaseSpec& spec, const Readout& r,

@@ -28,38 +28,38 @@ struct Material {
 struct Primitive {
   enum class Kind { box, cylinder, annulus, surface_file };
   Kind kind = Kind::box;
-  Eigen::Vector3d min = Eigen::Vector3d::Zero();  /// box corner [m]
-  Eigen::Vector3d max = Eigen::Vector3d::Zero();  /// box corner [m]
-  Eigen::Vector2d axis = Eigen::Vector2d::Zero(); /// (x, y) of a cylinder's axis [m]
-  double radius = 0;        /// cylinder radius, annulus outer radius [m]
-  double inner_radius = 0;  /// annulus inner radius [m]
-  double z_min = 0, z_max = 0;  /// axial extent [m]
-  std::filesystem::path file;   /// closed STL/OFF/PLY surface (flat convex polygons), case unit
-  double file_scale = 1.0;      /// factor from the file's length unit to m
-  std::string where;            /// where it was declared, for messages: "bodies[0].add[1]"
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();   /// box corner [m]
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();   /// box corner [m]
+  Eigen::Vector2d axis = Eigen::Vector2d::Zero();  /// (x, y) of a cylinder's axis [m]
+  double radius = 0;                               /// cylinder radius, annulus outer radius [m]
+  double inner_radius = 0;                         /// annulus inner radius [m]
+  double z_min = 0, z_max = 0;                     /// axial extent [m]
+  std::filesystem::path file;  /// closed STL/OFF/PLY surface (flat convex polygons), case unit
+  double file_scale = 1.0;     /// factor from the file's length unit to m
+  std::string where;           /// where it was declared, for messages: "bodies[0].add[1]"
 };
 
 /// A solid body: union of `add` minus union of `subtract`; one material region of the mesh.
 struct Body {
   std::string name;
-  int material = -1;              /// index into CaseSpec::materials
+  int material = -1;  /// index into CaseSpec::materials
   std::vector<Primitive> add;
   std::vector<Primitive> subtract;
-  double max_edge = 0;            /// target tet edge length in this body [m]
+  double max_edge = 0;  /// target tet edge length in this body [m]
 };
 
 /// One rule selecting mesh faces (all given conditions must hold).
 struct FaceSelector {
-  std::vector<int> bodies;          /// faces of tets in these bodies; empty: any body
+  std::vector<int> bodies;  /// faces of tets in these bodies; empty: any body
   enum class Side { exterior, interface, any };
-  Side side = Side::exterior;       /// exterior faces only, body interfaces only, or both
-  std::vector<int> other_bodies;    /// with interface: the body across the face
+  Side side = Side::exterior;            /// exterior faces only, body interfaces only, or both
+  std::vector<int> other_bodies;         /// with interface: the body across the face
   std::optional<Eigen::Vector4d> plane;  /// (n, d): faces in the plane n.x = d (n unit)
   struct Cylinder {
     Eigen::Vector2d axis;  /// (x, y) of the z-parallel axis [m]
     double radius;         /// [m]
   };
-  std::optional<Cylinder> on_cylinder;   /// faces on that cylinder (within faceting tolerance)
+  std::optional<Cylinder> on_cylinder;  /// faces on that cylinder (within faceting tolerance)
   std::optional<Eigen::Vector3d> within_min, within_max;  /// face centroid inside this box [m]
 };
 
@@ -79,10 +79,10 @@ struct NamedPoint {
 };
 
 struct MeshOptions {
-  int order = 2;                    /// 1: 4-node, 2: 10-node tetrahedra
-  int circle_segments = 48;         /// facets around every cylinder
-  double radius_edge_ratio = 1.5;   /// TetGen quality bound
-  double min_dihedral_deg = 12.0;   /// TetGen quality bound asked for
+  int order = 2;                   /// 1: 4-node, 2: 10-node tetrahedra
+  int circle_segments = 48;        /// facets around every cylinder
+  double radius_edge_ratio = 1.5;  /// TetGen quality bound
+  double min_dihedral_deg = 12.0;  /// TetGen quality bound asked for
   /// Bounds on meshing (core/limits.hpp has the defaults): tetrahedra estimated before TetGen
   /// starts, TetGen's wall time [s] and the memory it may add [GB, 10^9 bytes].
   double max_tets = limits::kDefaultMaxTets;
@@ -126,9 +126,9 @@ struct HeatSource {
   int body = -1;
   enum class Law { speed_power, constant, palmgren, feed_power };
   Law law = Law::speed_power;
-  double power_ref = 0;       /// [W] at ref_speed (speed_power) or always (constant)
-  double ref_speed_rpm = 0;   /// [rpm]
-  double exponent = 1.0;      /// Q = power_ref (n / ref_speed)^exponent, 0 at n = 0
+  double power_ref = 0;      /// [W] at ref_speed (speed_power) or always (constant)
+  double ref_speed_rpm = 0;  /// [rpm]
+  double exponent = 1.0;     /// Q = power_ref (n / ref_speed)^exponent, 0 at n = 0
   /// Palmgren: M = M0 + M1, M0 = 1e-7 f0 (nu n)^(2/3) dm^3 (nu n >= 2000), M1 = f1 P1 dm; Q = M w
   double palmgren_f0 = 0, palmgren_nu_cSt = 0, palmgren_dm = 0, palmgren_f1 = 0, palmgren_p1 = 0;
   double temperature_coefficient = 0;  /// [1/K]: Q multiplied by (1 + c (T_mean - T0))
@@ -140,17 +140,17 @@ struct HeatSource {
 
 struct Convection {
   int group = -1;
-  double h = 0;                  /// [W/(m^2 K)] at standstill
-  double h_speed_gain = 0;       /// [W/(m^2 K)]: h = h + gain (n / speed_ref)^speed_exponent
+  double h = 0;             /// [W/(m^2 K)] at standstill
+  double h_speed_gain = 0;  /// [W/(m^2 K)]: h = h + gain (n / speed_ref)^speed_exponent
   double speed_ref_rpm = 1;
   double speed_exponent = 1;
-  TimeTable sink;                /// sink temperature [degC] over time
+  TimeTable sink;  /// sink temperature [degC] over time
 };
 
 struct SurfaceFlux {
   int group = -1;
-  double flux = 0;               /// [W/m^2], into the body
-  bool follows_speed = false;    /// scaled by n / ref_speed (speed_power law, exponent 1)
+  double flux = 0;             /// [W/m^2], into the body
+  bool follows_speed = false;  /// scaled by n / ref_speed (speed_power law, exponent 1)
   double ref_speed_rpm = 0;
 };
 
@@ -160,8 +160,8 @@ enum class TimeScheme { backward_euler, crank_nicolson };
 struct ThermalSpec {
   double initial_temperature_c = 20;  /// [degC]
   TimeScheme scheme = TimeScheme::backward_euler;
-  double step = 12;              /// [s]
-  double output_interval = 72;   /// [s]
+  double step = 12;             /// [s]
+  double output_interval = 72;  /// [s]
   bool lumped_mass = false;
   std::vector<HeatSource> sources;
   std::vector<Convection> convection;
@@ -170,17 +170,17 @@ struct ThermalSpec {
 
 /// A named point held in some directions (e.g. 3-2-1 supports against rigid motion only).
 struct PointSupport {
-  std::string point;                      /// id of a named point
+  std::string point;                               /// id of a named point
   std::array<bool, 3> fixed = {true, true, true};  /// x, y, z
 };
 
 struct MechanicalSpec {
   bool enabled = true;
   std::vector<PointSupport> point_supports;
-  double reference_temperature_c = 20;  /// stress-free temperature [degC]
-  std::vector<int> fixed_groups;         /// boundary groups fixed in all directions
-  std::string tcp_point;                 /// id of the tool centre point
-  std::vector<std::string> probe_points; /// ids of the two axial probe points (z1, z2)
+  double reference_temperature_c = 20;    /// stress-free temperature [degC]
+  std::vector<int> fixed_groups;          /// boundary groups fixed in all directions
+  std::string tcp_point;                  /// id of the tool centre point
+  std::vector<std::string> probe_points;  /// ids of the two axial probe points (z1, z2)
   /// TCP error directions ("dx", "dy", "dz") that placement and fitting aim at, each on its own
   std::vector<std::string> targets = {"dy", "dz"};
   std::vector<std::string> axis_points;  /// ids of measurement points along the feed axis
@@ -208,9 +208,9 @@ struct PlacementSpec {
 };
 
 struct CaseSpec {
-  std::filesystem::path source;          /// the case file
+  std::filesystem::path source;  /// the case file
   std::string name;
-  std::string machine;                   /// "SB-1" when it models the spec exactly
+  std::string machine;  /// "SB-1" when it models the spec exactly
   std::uint64_t seed = 1;
   std::vector<Material> materials;
   std::vector<Body> bodies;

@@ -55,7 +55,8 @@ void parallel_invoke(First&& first, Second&& second) {
 /// chunk_body(begin, end, chunk) on each, possibly in parallel, and returns the chunk results
 /// in chunk order so that concatenation is deterministic.
 template <class Result, class ChunkBody>
-std::vector<Result> parallel_chunks(std::ptrdiff_t n, std::ptrdiff_t chunk_size, ChunkBody&& chunk_body) {
+std::vector<Result> parallel_chunks(std::ptrdiff_t n, std::ptrdiff_t chunk_size,
+                                    ChunkBody&& chunk_body) {
   const std::ptrdiff_t chunks = n == 0 ? 0 : (n + chunk_size - 1) / chunk_size;
   std::vector<Result> results(static_cast<std::size_t>(chunks));
   detail::guarded_loop(

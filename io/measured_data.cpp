@@ -181,7 +181,8 @@ std::optional<PublishedFigure> published_figure(const fs::path& file, const json
   if (!it->is_object()) meta_error(file, "published", json_text(*it) + ": expected an object");
   const json& p = *it;
   PublishedFigure f;
-  f.model = string_value(file, required_key(file, p, "model", "published.model"), "published.model");
+  f.model =
+      string_value(file, required_key(file, p, "model", "published.model"), "published.model");
   f.source =
       string_value(file, required_key(file, p, "source", "published.source"), "published.source");
   if (p.contains("note")) f.note = string_value(file, p["note"], "published.note");
@@ -192,8 +193,8 @@ std::optional<PublishedFigure> published_figure(const fs::path& file, const json
                json_text(window) + ": expected [from, to] in seconds with from < to");
   f.from_s = window[0].get<double>();
   f.to_s = window[1].get<double>();
-  f.mae_um = mae_table(file, required_key(file, p, "mae_um", "published.mae_um"),
-                       "published.mae_um", run);
+  f.mae_um =
+      mae_table(file, required_key(file, p, "mae_um", "published.mae_um"), "published.mae_um", run);
   if (const auto o = p.find("others_mae_um"); o != p.end()) {
     if (!o->is_object())
       meta_error(file, "published.others_mae_um",
@@ -229,8 +230,8 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   run.machine = string_value(file, required_key(file, meta, "machine", "machine"), "machine");
   // The machine's bounding box, when the data carry it; the caller's box checks in its place.
   run.machine_box = optional_box(file, meta, "machine_box_m");
-  const std::optional<Eigen::AlignedBox3d> box = limits.machine_box ? limits.machine_box
-                                                                    : run.machine_box;
+  const std::optional<Eigen::AlignedBox3d> box =
+      limits.machine_box ? limits.machine_box : run.machine_box;
   if (meta.contains("run")) run.run = string_value(file, meta["run"], "run");
   require_unit(file, meta, "time_unit", "s");
   require_unit(file, meta, "temperature_unit", "degC");

@@ -29,8 +29,8 @@ struct MeasuredProbe {
 /// where it is published, the held-out window, the MAE per displacement channel, other models'.
 struct PublishedFigure {
   std::string model, source, note;
-  double from_s = 0, to_s = 0;                  /// held-out window [s]
-  std::map<std::string, double> mae_um;         /// per displacement id [um]
+  double from_s = 0, to_s = 0;                                         /// held-out window [s]
+  std::map<std::string, double> mae_um;                                /// per displacement id [um]
   std::map<std::string, std::map<std::string, double>> others_mae_um;  /// model -> id -> [um]
 };
 
@@ -40,24 +40,24 @@ struct MeasuredRun {
   std::string run;
   std::vector<MeasuredSensor> sensors;
   std::vector<MeasuredProbe> displacements;
-  std::vector<std::string> inputs;           /// e.g. "speed_rpm"
-  std::optional<std::string> ambient_sensor; /// id of one of `sensors`
+  std::vector<std::string> inputs;                                 /// e.g. "speed_rpm"
+  std::optional<std::string> ambient_sensor;                       /// id of one of `sensors`
   std::optional<double> initial_temperature_c, nominal_ambient_c;  /// [degC]
   /// meta.json's machine_box_m: every sensor and probe position lies inside [m].
   std::optional<Eigen::AlignedBox3d> machine_box;
   std::optional<PublishedFigure> published;  /// meta.json's published
-  Eigen::VectorXd time;           /// #samples [s], strictly increasing
-  Eigen::MatrixXd input_values;   /// #samples x #inputs (speeds in rpm)
-  Eigen::MatrixXd temperature;    /// #samples x #sensors [K]; NaN where the reading is missing
-  Eigen::MatrixXd displacement;   /// #samples x #probes [m]; NaN where the reading is missing
-  nlohmann::json meta;            /// the whole meta.json, keys not interpreted carried along
+  Eigen::VectorXd time;                      /// #samples [s], strictly increasing
+  Eigen::MatrixXd input_values;              /// #samples x #inputs (speeds in rpm)
+  Eigen::MatrixXd temperature;   /// #samples x #sensors [K]; NaN where the reading is missing
+  Eigen::MatrixXd displacement;  /// #samples x #probes [m]; NaN where the reading is missing
+  nlohmann::json meta;           /// the whole meta.json, keys not interpreted carried along
 };
 
 struct MeasuredReadLimits {
   /// Positions must lie inside (a known machine); meta.json's machine_box_m when not given.
   std::optional<Eigen::AlignedBox3d> machine_box;
-  std::size_t max_bytes = std::size_t(2) << 30;    /// data.csv larger than this is rejected
-  std::size_t max_rows = 50'000'000;               /// more rows than this are rejected
+  std::size_t max_bytes = std::size_t(2) << 30;  /// data.csv larger than this is rejected
+  std::size_t max_rows = 50'000'000;             /// more rows than this are rejected
 };
 
 /// Reads folder/meta.json and folder/data.csv. Throws DataError naming the file, the line and the
@@ -65,7 +65,8 @@ struct MeasuredReadLimits {
 /// increase, text or a non-finite number in a number cell, a position outside the machine's box,
 /// an unknown unit or format, meta.json or data.csv that is a folder; IoError when a file cannot be
 /// read. Empty cells stay NaN.
-MeasuredRun read_measured_run(const std::filesystem::path& folder, const MeasuredReadLimits& limits = {});
+MeasuredRun read_measured_run(const std::filesystem::path& folder,
+                              const MeasuredReadLimits& limits = {});
 
 /// True when `a` and `b` name one run folder (relative paths and symbolic links resolved).
 bool same_run(const std::filesystem::path& a, const std::filesystem::path& b);

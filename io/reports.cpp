@@ -20,7 +20,8 @@ nlohmann::json mesh_report_json(const mesh::TetMesh& mesh, const mesh::MeshRepor
     j["bodies"][b.name] = body;
   }
   j["groups"] = nlohmann::json::object();
-  for (size_t g = 0; g < mesh.group_names.size(); ++g) j["groups"][mesh.group_names[g]] = {{"area_m2", r.group_areas[g]}};
+  for (size_t g = 0; g < mesh.group_names.size(); ++g)
+    j["groups"][mesh.group_names[g]] = {{"area_m2", r.group_areas[g]}};
   j["points"] = nlohmann::json::array();
   for (size_t i = 0; i < mesh.points.size(); ++i) {
     const auto& p = mesh.points[i];

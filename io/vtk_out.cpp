@@ -380,10 +380,12 @@ void write_points_vtp(const mesh::TetMesh& mesh, const fs::path& path) {
 }
 
 void write_point_cloud_vtp(const fs::path& path, const std::vector<std::string>& ids,
-                           const Eigen::MatrixX3d& positions, const std::vector<NamedField>& fields) {
+                           const Eigen::MatrixX3d& positions,
+                           const std::vector<NamedField>& fields) {
   const auto count = positions.rows();
   if (static_cast<Eigen::Index>(ids.size()) != count)
-    throw core::DataError(path.string() + ": " + str(ids.size()) + " ids for " + str(count) + " points");
+    throw core::DataError(path.string() + ": " + str(ids.size()) + " ids for " + str(count) +
+                          " points");
   mesh::NodeMatrix xyz = positions;
   mesh::IndexMatrix vertices(count, 1);
   for (Eigen::Index p = 0; p < count; ++p) vertices(p, 0) = static_cast<int>(p);

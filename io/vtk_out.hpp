@@ -40,7 +40,8 @@ struct NamedField {
 /// A cloud of labelled points (e.g. candidate sensors) with per-point fields, for ParaView:
 /// point data `id` (string) and every field (#points * components values each).
 void write_point_cloud_vtp(const std::filesystem::path& path, const std::vector<std::string>& ids,
-                           const Eigen::MatrixX3d& positions, const std::vector<NamedField>& fields);
+                           const Eigen::MatrixX3d& positions,
+                           const std::vector<NamedField>& fields);
 
 /// One written step of a series.
 struct SeriesStep {

@@ -1,10 +1,10 @@
 #include "mesh/extrusion.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
-#include <Eigen/Geometry>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -26,7 +26,9 @@ constexpr double kPi = 3.14159265358979323846;
 /// A closed ring of 2D points, counter-clockwise.
 using Ring = std::vector<Vector2d>;
 
-double cross2(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross2(const Vector2d& a, const Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 double signed_area(const Ring& ring) {
   double a = 0;
@@ -60,7 +62,9 @@ double segment_distance(const Vector2d& p, const Vector2d& a, const Vector2d& b)
 std::pair<Ring, Ring> primitive_rings(const Primitive& p, int n) {
   switch (p.kind) {
     case Primitive::Kind::box:
-      return {Ring{{p.min.x(), p.min.y()}, {p.max.x(), p.min.y()}, {p.max.x(), p.max.y()},
+      return {Ring{{p.min.x(), p.min.y()},
+                   {p.max.x(), p.min.y()},
+                   {p.max.x(), p.max.y()},
                    {p.min.x(), p.max.y()}},
               {}};
     case Primitive::Kind::cylinder:
@@ -70,8 +74,9 @@ std::pair<Ring, Ring> primitive_rings(const Primitive& p, int n) {
     case Primitive::Kind::surface_file:
       break;
   }
-  throw core::GeometryError(p.where + ": surface-file primitives cannot be combined with "
-                                      "z-extruded primitives in one body");
+  throw core::GeometryError(p.where +
+                            ": surface-file primitives cannot be combined with "
+                            "z-extruded primitives in one body");
 }
 
 std::pair<double, double> z_range(const Primitive& p) {
@@ -182,7 +187,8 @@ struct Face {
 
 struct Arrangement {
   std::vector<Face> faces;
-  std::vector<int> halfedge_face;  /// per half-edge 2e (a->b) and 2e+1 (b->a): face on its left, -1 unbounded
+  std::vector<int>
+      halfedge_face;  /// per half-edge 2e (a->b) and 2e+1 (b->a): face on its left, -1 unbounded
 };
 
 Ring ring_of(const Pslg& g, const std::vector<int>& ids) {
@@ -302,9 +308,10 @@ Vector2d point_beside(const Pslg& g, const std::vector<int>& ring, int side,
     const Vector2d p = m + side * 0.5 * clearance * left;
     if (clearance > 2 * g.tol && accept(p)) return p;
   }
-  throw core::GeometryError("could not find an interior point of a cross-section face; the "
-                            "geometry has features below the tolerance " +
-                            std::to_string(g.tol) + " m");
+  throw core::GeometryError(
+      "could not find an interior point of a cross-section face; the "
+      "geometry has features below the tolerance " +
+      std::to_string(g.tol) + " m");
 }
 
 struct ZValue {
@@ -428,11 +435,14 @@ double exact_body_volume(const Body& body) {
         .volume;
   auto volume = [](const Primitive& p) {
     switch (p.kind) {
-      case Primitive::Kind::box: return (p.max - p.min).prod();
-      case Primitive::Kind::cylinder: return kPi * p.radius * p.radius * (p.z_max - p.z_min);
+      case Primitive::Kind::box:
+        return (p.max - p.min).prod();
+      case Primitive::Kind::cylinder:
+        return kPi * p.radius * p.radius * (p.z_max - p.z_min);
       case Primitive::Kind::annulus:
         return kPi * (p.radius * p.radius - p.inner_radius * p.inner_radius) * (p.z_max - p.z_min);
-      default: return -1.0;
+      default:
+        return -1.0;
     }
   };
 
@@ -446,7 +456,8 @@ double exact_body_volume(const Body& body) {
       return -1;
     if (!outer.contains(primitive_bounds(s))) return -1;
     for (size_t j = 0; j < i; ++j)
-      if (!primitive_bounds(s).intersection(primitive_bounds(body.subtract[j])).isEmpty()) return -1;
+      if (!primitive_bounds(s).intersection(primitive_bounds(body.subtract[j])).isEmpty())
+        return -1;
     v -= volume(s);
   }
   return v;
@@ -471,7 +482,8 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
           extent.extend(Vector3d(q.x(), q.y(), z1));
         }
       }
-  if (extent.isEmpty()) throw core::GeometryError(spec.source.string() + ": the case has no bodies");
+  if (extent.isEmpty())
+    throw core::GeometryError(spec.source.string() + ": the case has no bodies");
   const double tol = 1e-9 * extent.diagonal().norm();
 
   // 2. The planar graph: named points first so that their coordinates are kept exactly.
@@ -486,7 +498,8 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         for (const Ring* r : {&outer, &inner}) {
           std::vector<int> ids;
           for (const auto& q : *r) ids.push_back(g.vertex(q));
-          for (size_t i = 0; i < ids.size(); ++i) g.edges.push_back({ids[i], ids[(i + 1) % ids.size()]});
+          for (size_t i = 0; i < ids.size(); ++i)
+            g.edges.push_back({ids[i], ids[(i + 1) % ids.size()]});
         }
       }
   resolve_pslg(g);
@@ -539,7 +552,8 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
   Plc& plc = result.plc;
   std::map<std::pair<int, int>, int> vertex3d;
   auto v3 = [&](int v2, int zi) {
-    auto [it, fresh] = vertex3d.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
+    auto [it, fresh] =
+        vertex3d.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
     if (fresh) plc.vertices.emplace_back(g.vertices[v2].x(), g.vertices[v2].y(), z[zi]);
     return it->second;
   };
@@ -570,9 +584,8 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         for (int v : hole) ring.push_back(v3(v, j));
         facet.polygons.push_back(ring);
         const Ring hole_ring = ring_of(g, hole);
-        const Vector2d h = point_beside(g, hole, -1, [&](const Vector2d& p) {
-          return ring_contains(hole_ring, p);
-        });
+        const Vector2d h = point_beside(
+            g, hole, -1, [&](const Vector2d& p) { return ring_contains(hole_ring, p); });
         facet.holes.emplace_back(h.x(), h.y(), z[j]);
       }
       for (size_t i = 0; i < spec.points.size(); ++i) {
@@ -707,7 +720,8 @@ struct Patch {
   std::vector<std::vector<int>> polygons;  /// its boundary ring, or its triangles when not one ring
 };
 
-std::vector<Patch> planar_patches(const cgal::TriangleSurface& s, double tol, std::vector<int>& patch_of) {
+std::vector<Patch> planar_patches(const cgal::TriangleSurface& s, double tol,
+                                  std::vector<int>& patch_of) {
   const auto& x = s.vertices;
   const auto& tri = s.triangles;
   const int nt = static_cast<int>(tri.size());
@@ -772,7 +786,8 @@ std::string overlap_message(const core::CaseSpec& spec, const SurfaceBody& s, in
 }
 
 /// Throws unless every surface-file body is clear of the other bodies (see overlap_message).
-void check_surface_bodies_clear(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces) {
+void check_surface_bodies_clear(const core::CaseSpec& spec,
+                                const std::vector<SurfaceBody>& surfaces) {
   const int n = spec.mesh.circle_segments;
   for (size_t i = 0; i < surfaces.size(); ++i)
     for (size_t j = i + 1; j < surfaces.size(); ++j)
@@ -788,9 +803,9 @@ void check_surface_bodies_clear(const core::CaseSpec& spec, const std::vector<Su
           continue;
         bool carved_out = false;
         for (const auto& u : spec.bodies[b].subtract)
-          carved_out = carved_out || (primitive_bounds(u).contains(s.bounds) &&
-                                      cgal::solid_strictly_inside(s.solid.surface,
-                                                                  primitive_surface(u, n)));
+          carved_out =
+              carved_out || (primitive_bounds(u).contains(s.bounds) &&
+                             cgal::solid_strictly_inside(s.solid.surface, primitive_surface(u, n)));
         if (!carved_out) throw core::GeometryError(overlap_message(spec, s, static_cast<int>(b)));
       }
     }
@@ -803,7 +818,8 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
   // 1. Surface-file bodies are read and checked; the others go to the extrusion.
   std::vector<SurfaceBody> surfaces;
   for (size_t b = 0; b < spec.bodies.size(); ++b)
-    if (is_surface_body(spec.bodies[b])) surfaces.push_back(surface_body(spec, static_cast<int>(b)));
+    if (is_surface_body(spec.bodies[b]))
+      surfaces.push_back(surface_body(spec, static_cast<int>(b)));
   if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
   check_surface_bodies_clear(spec, surfaces);
 
@@ -905,7 +921,8 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
               for (int e = 0; e < 3; ++e)
                 if (u[e] == b && u[(e + 1) % 3] == a && patch_of[f] != own) {
                   on_crease = true;
-                  insert_on_edge(plc.facets[first_facet + own], first + a, first + b, v, plc.vertices);
+                  insert_on_edge(plc.facets[first_facet + own], first + a, first + b, v,
+                                 plc.vertices);
                   insert_on_edge(plc.facets[first_facet + patch_of[f]], first + a, first + b, v,
                                  plc.vertices);
                 }
@@ -914,12 +931,16 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
           if (!on_crease) plc.facets[first_facet + own].polygons.push_back({v});
           break;
         }
-        case Kind::inside: plc.interior_points.push_back(x); break;
-        case Kind::outside: break;
+        case Kind::inside:
+          plc.interior_points.push_back(x);
+          break;
+        case Kind::outside:
+          break;
       }
     }
     const double h = spec.bodies[surfaces[s].body].max_edge;
-    plc.regions.push_back(PlcRegion{solid.inside_point, surfaces[s].body, h * h * h / (6.0 * std::sqrt(2.0))});
+    plc.regions.push_back(
+        PlcRegion{solid.inside_point, surfaces[s].body, h * h * h / (6.0 * std::sqrt(2.0))});
   }
   return result;
 }

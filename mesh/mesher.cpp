@@ -26,7 +26,8 @@ constexpr int kTetEdges[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}
 
 int edge_slot(int a, int b) {
   for (int e = 0; e < 6; ++e)
-    if ((kTetEdges[e][0] == a && kTetEdges[e][1] == b) || (kTetEdges[e][0] == b && kTetEdges[e][1] == a))
+    if ((kTetEdges[e][0] == a && kTetEdges[e][1] == b) ||
+        (kTetEdges[e][0] == b && kTetEdges[e][1] == a))
       return 4 + e;
   return -1;
 }
@@ -57,7 +58,8 @@ bool selector_matches(const core::FaceSelector& s, const TetMesh& m, int f, cons
   const int r0 = core::index_of(m.tet_region[m.face_tet[f]]);
   const int r1 = interface ? core::index_of(m.tet_region[m.face_other_tet[f]]) : -1;
   if (!s.bodies.empty()) {
-    const bool a = contains(s.bodies, r0) && (s.other_bodies.empty() || contains(s.other_bodies, r1));
+    const bool a =
+        contains(s.bodies, r0) && (s.other_bodies.empty() || contains(s.other_bodies, r1));
     const bool b = interface && contains(s.bodies, r1) &&
                    (s.other_bodies.empty() || contains(s.other_bodies, r0));
     if (!a && !b) return false;
@@ -248,7 +250,8 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
   }
   std::vector<std::array<int, 3>> picked;  // (tet, local face, other tet)
   for (const auto& [key, s] : seen) {
-    if (s.count == 1) picked.push_back({s.tet, s.local, -1});
+    if (s.count == 1)
+      picked.push_back({s.tet, s.local, -1});
     else if (m.tet_region[s.tet] != m.tet_region[s.other]) {
       // Interfaces are owned by the lower body index.
       const bool swap = core::index_of(m.tet_region[s.other]) < core::index_of(m.tet_region[s.tet]);
@@ -256,7 +259,8 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
       int local = s.local;
       if (swap) {
         for (int f = 0; f < 4; ++f) {
-          std::array<int, 3> k2 = {m.tets(owner, kFaceCorners[f][0]), m.tets(owner, kFaceCorners[f][1]),
+          std::array<int, 3> k2 = {m.tets(owner, kFaceCorners[f][0]),
+                                   m.tets(owner, kFaceCorners[f][1]),
                                    m.tets(owner, kFaceCorners[f][2])};
           std::sort(k2.begin(), k2.end());
           if (k2 == key) local = f;
@@ -358,7 +362,8 @@ std::vector<double> tet_volumes(const TetMesh& m) {
     const Vector3d a = m.nodes.row(m.tets(t, 0)).transpose();
     v[t] = (m.nodes.row(m.tets(t, 1)).transpose() - a)
                .cross(m.nodes.row(m.tets(t, 2)).transpose() - a)
-               .dot(m.nodes.row(m.tets(t, 3)).transpose() - a) / 6.0;
+               .dot(m.nodes.row(m.tets(t, 3)).transpose() - a) /
+           6.0;
   }
   return v;
 }
@@ -409,7 +414,8 @@ MeshReport mesh_report(const TetMesh& m, const core::CaseSpec& spec) {
   const auto area = face_areas(m);
   r.group_areas.assign(m.group_names.size(), 0.0);
   for (int f = 0; f < m.faces.rows(); ++f)
-    if (core::index_of(m.face_group[f]) >= 0) r.group_areas[core::index_of(m.face_group[f])] += area[f];
+    if (core::index_of(m.face_group[f]) >= 0)
+      r.group_areas[core::index_of(m.face_group[f])] += area[f];
   for (const auto& p : m.points)
     r.point_distance.push_back((m.nodes.row(p.node).transpose() - p.position).norm());
   return r;

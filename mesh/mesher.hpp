@@ -23,7 +23,7 @@ struct MeshReport {
   int order = 1;
   double min_dihedral_deg = 0;
   std::vector<BodyReport> bodies;
-  std::vector<double> group_areas;  /// per boundary group [m^2]
+  std::vector<double> group_areas;     /// per boundary group [m^2]
   std::vector<double> point_distance;  /// per named point: distance to its node [m]
 };
 

@@ -25,8 +25,8 @@ struct Plc {
   std::vector<Eigen::Vector3d> vertices;  /// [m]
   std::vector<PlcFacet> facets;
   std::vector<PlcRegion> regions;
-  std::vector<Eigen::Vector3d> holes;           /// points in enclosed empty space [m]
-  std::vector<Eigen::Vector3d> interior_points; /// points inside bodies that must be vertices [m]
+  std::vector<Eigen::Vector3d> holes;            /// points in enclosed empty space [m]
+  std::vector<Eigen::Vector3d> interior_points;  /// points inside bodies that must be vertices [m]
 };
 
 /// Typed options for the mesher; the adapter turns them into TetGen switches.
@@ -39,9 +39,9 @@ struct TetgenOptions {
 
 /// What the tetrahedraliser returns: linear tets (positively oriented) and their regions.
 struct LinearTets {
-  std::vector<Eigen::Vector3d> nodes;        /// [m]; the PLC's vertices keep their indices
+  std::vector<Eigen::Vector3d> nodes;  /// [m]; the PLC's vertices keep their indices
   std::vector<std::array<int, 4>> tets;
-  std::vector<int> region;                   /// per tet: body index
+  std::vector<int> region;  /// per tet: body index
 };
 
 }  // namespace tt::mesh

@@ -27,13 +27,13 @@ struct NamedNode {
 /// nodes on (0,1) (1,2) (2,0); their normal (right hand) points out of `face_tet`.
 struct TetMesh {
   int order = 1;
-  NodeMatrix nodes;          /// #nodes x 3 coordinates [m]; corner nodes come first
-  int corner_count = 0;      /// nodes [0, corner_count) are tet corners
-  IndexMatrix tets;          /// #tets x (4|10)
+  NodeMatrix nodes;                        /// #nodes x 3 coordinates [m]; corner nodes come first
+  int corner_count = 0;                    /// nodes [0, corner_count) are tet corners
+  IndexMatrix tets;                        /// #tets x (4|10)
   std::vector<core::RegionId> tet_region;  /// per tet: index of its body
   std::vector<std::string> region_names;   /// per region: the body's name
 
-  IndexMatrix faces;         /// #faces x (3|6): exterior faces and body interfaces
+  IndexMatrix faces;                         /// #faces x (3|6): exterior faces and body interfaces
   std::vector<int> face_tet;                 /// per face: the tet it bounds
   std::vector<int> face_other_tet;           /// per face: the tet across it, -1 on the exterior
   std::vector<core::BoundaryId> face_group;  /// per face: boundary group, -1 for none

@@ -27,7 +27,7 @@ done
 packages=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas0-pthread
   libvtk9-dev libtet1.5-dev libcgal-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev python3-minimal python3-numpy python3-matplotlib python3-jsonschema
-  libtorch-dev)
+  libtorch-dev clang-format)
 [ "$with_calculix" = 1 ] && packages+=(calculix-ccx python3-vtk9)
 [ "$with_fuzz" = 1 ] && packages+=(clang-14 libfuzzer-14-dev libclang-rt-14-dev)
 

@@ -276,9 +276,8 @@ Eigen::MatrixXd ElasticModel::adjoint_solutions(
   const Impl& impl = *impl_;
   const int ndof = static_cast<int>(impl.coupling.rows());
   if (functionals.cols() != ndof)
-    throw core::SolverError("displacement functionals have " +
-                            std::to_string(functionals.cols()) + " columns, expected 3 per node (" +
-                            std::to_string(ndof) + ")");
+    throw core::SolverError("displacement functionals have " + std::to_string(functionals.cols()) +
+                            " columns, expected 3 per node (" + std::to_string(ndof) + ")");
   // K is symmetric: f . u = f^T K^-1 G dT = (G^T K^-1 f)^T dT.
   const Eigen::MatrixXd dense = Eigen::MatrixXd(functionals.transpose());
   Eigen::MatrixXd rhs(impl.free_dofs, functionals.rows());

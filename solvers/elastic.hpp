@@ -70,7 +70,8 @@ ElasticHistory elastic_history(const mesh::TetMesh& mesh, const core::CaseSpec& 
 
 /// Von Mises stress per node [Pa] (element nodal stresses averaged at each node).
 Eigen::VectorXd von_mises_nodal(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-                                const Eigen::VectorXd& displacement, const Eigen::VectorXd& temperature);
+                                const Eigen::VectorXd& displacement,
+                                const Eigen::VectorXd& temperature);
 
 /// Displacement [m] at a point inside the mesh (interpolated in the element that contains it).
 Eigen::Vector3d displacement_at(const mesh::TetMesh& mesh, const Eigen::VectorXd& displacement,

@@ -26,7 +26,8 @@ double source_power(const core::HeatSource& s, double n) {
 double source_power(const core::HeatSource& s, double n, double feed) {
   using Law = core::HeatSource::Law;
   switch (s.law) {
-    case Law::constant: return s.power_ref;
+    case Law::constant:
+      return s.power_ref;
     case Law::feed_power:
       if (feed <= 0) return 0.0;
       return s.power_ref * std::pow(feed / s.ref_feed, s.exponent);
@@ -38,8 +39,9 @@ double source_power(const core::HeatSource& s, double n, double feed) {
       // Palmgren's bearing friction torque in N mm with dm in mm, nu in cSt, n in rpm.
       const double dm_mm = s.palmgren_dm * 1e3;
       const double nu_n = s.palmgren_nu_cSt * n;
-      const double m0 = nu_n >= 2000 ? 1e-7 * s.palmgren_f0 * std::pow(nu_n, 2.0 / 3.0) * std::pow(dm_mm, 3)
-                                     : 160e-7 * s.palmgren_f0 * std::pow(dm_mm, 3);
+      const double m0 = nu_n >= 2000
+                            ? 1e-7 * s.palmgren_f0 * std::pow(nu_n, 2.0 / 3.0) * std::pow(dm_mm, 3)
+                            : 160e-7 * s.palmgren_f0 * std::pow(dm_mm, 3);
       const double m1 = s.palmgren_f1 * s.palmgren_p1 * dm_mm;
       return (m0 + m1) * 1e-3 * 2 * kPi * n / 60.0;
     }

@@ -362,9 +362,8 @@ Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
     KalmanObserver observer(system, spec, s);
     // Any values do: the covariance does not see them. The initial temperature keeps the
     // innovations, and so the states, of the order of a real run's.
-    const Eigen::VectorXd readings =
-        Eigen::VectorXd::Constant(s.sensor_rows.rows(),
-                                  spec.thermal.initial_temperature_c + core::kCelsiusOffset);
+    const Eigen::VectorXd readings = Eigen::VectorXd::Constant(
+        s.sensor_rows.rows(), spec.thermal.initial_temperature_c + core::kCelsiusOffset);
     for (double t = sample_s; t <= spec.duty_cycle.end + 1e-9; t += sample_s) {
       sum += observer.assimilate(t, readings).drift_sigma.array().square().matrix();
       n += 1;

@@ -167,7 +167,6 @@ class CapacityOrthonormalBasis {
           const auto fresh = q.middleCols(panel_start, kept - panel_start);
           const auto c_fresh = cq.middleCols(panel_start, kept - panel_start);
           col -= fresh * (c_fresh.transpose() * col);  // a few columns: one thread
-
         }
         const Eigen::VectorXd ccol = c_ * col;
         const double norm = std::sqrt(std::max(0.0, col.dot(ccol)));
@@ -204,7 +203,7 @@ class CapacityOrthonormalBasis {
   }
   const Sparse& c_;
   double tol_, compression_;
-  Eigen::MatrixXd v_;   /// columns [0, r_) are the basis
+  Eigen::MatrixXd v_;  /// columns [0, r_) are the basis
   Eigen::Index r_ = 0;
 };
 
@@ -222,11 +221,13 @@ std::vector<int> nonzero_rows(const Sparse& a) {
 /// a restricted to `rows` (ascending, holding every nonzero of a), renumbered: #rows x a.cols().
 Sparse rows_of(const Sparse& a, const std::vector<int>& rows) {
   std::vector<int> position(static_cast<size_t>(a.rows()), -1);
-  for (size_t i = 0; i < rows.size(); ++i) position[static_cast<size_t>(rows[i])] = static_cast<int>(i);
+  for (size_t i = 0; i < rows.size(); ++i)
+    position[static_cast<size_t>(rows[i])] = static_cast<int>(i);
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index c = 0; c < a.outerSize(); ++c)
     for (Sparse::InnerIterator it(a, c); it; ++it)
-      entries.emplace_back(position[static_cast<size_t>(it.row())], static_cast<int>(c), it.value());
+      entries.emplace_back(position[static_cast<size_t>(it.row())], static_cast<int>(c),
+                           it.value());
   Sparse out(static_cast<Eigen::Index>(rows.size()), a.cols());
   out.setFromTriplets(entries.begin(), entries.end());
   return out;
@@ -318,7 +319,7 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   rhs.rightCols(options.output_columns.cols()) = options.output_columns;
   st.film_states = film_states(spec, options);
   // The shifts of each film state, in the order their Krylov vectors join the basis.
-  std::vector<Sparse> stiffness;  // K(h) per film state
+  std::vector<Sparse> stiffness;                        // K(h) per film state
   std::vector<std::pair<std::size_t, double>> shifted;  // (film state, shift)
   for (const auto& h : st.film_states) {
     const bool steady = removes_heat(full, h);
@@ -351,7 +352,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
     return kept;
   };
   std::optional<cholmod::Analysis> analysis;
-  if (!shifted.empty()) analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
+  if (!shifted.empty())
+    analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
   for (std::size_t first = 0; first < shifted.size(); first += kWave) {
     const auto wave_start = Clock::now();
     const std::size_t count = std::min(kWave, shifted.size() - first);

@@ -73,10 +73,10 @@ struct ReductionStats {
   int candidate_columns = 0;                     /// columns offered to the basis
   int deflated_columns = 0;                      /// of those, dropped as dependent
   int factorizations = 0;
-  double build_s = 0;  /// wall time of basis and projection [s]
-  double solve_s = 0;           /// of which factors and solves [s]
-  double orthogonalise_s = 0;   /// of which orthonormalisation against the basis [s]
-  double projection_s = 0;      /// of which the Galerkin projection [s]
+  double build_s = 0;          /// wall time of basis and projection [s]
+  double solve_s = 0;          /// of which factors and solves [s]
+  double orthogonalise_s = 0;  /// of which orthonormalisation against the basis [s]
+  double projection_s = 0;     /// of which the Galerkin projection [s]
 };
 
 struct ReducedModel {

@@ -27,7 +27,8 @@ Eigen::MatrixXd tall_transposed_product(const Eigen::Ref<const Eigen::MatrixXd>&
                                         const Eigen::Ref<const Eigen::MatrixXd>& b) {
   check_rows(a.rows(), b.rows(), "a^T b");
   const auto parts = core::parallel_chunks<Eigen::MatrixXd>(
-      a.rows(), chunk_rows(a.rows()), [&](std::ptrdiff_t begin, std::ptrdiff_t end, std::ptrdiff_t) {
+      a.rows(), chunk_rows(a.rows()),
+      [&](std::ptrdiff_t begin, std::ptrdiff_t end, std::ptrdiff_t) {
         Eigen::MatrixXd part(a.cols(), b.cols());
         part.noalias() =
             a.middleRows(begin, end - begin).transpose() * b.middleRows(begin, end - begin);

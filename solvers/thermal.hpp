@@ -45,12 +45,12 @@ using Progress = std::function<void(double, double)>;
 /// The time loop's whole state after `steps` steps: enough to continue and end with the same
 /// numbers as a run that was never interrupted.
 struct ThermalCheckpoint {
-  int steps = 0;                /// time steps done (index of the next step in the time grid)
-  double time = 0;              /// simulated time reached [s]
-  double speed = 0;             /// spindle speed of the last step [rpm] (CN restarts on a change)
-  Eigen::VectorXd temperature;  /// #nodes [K] at `time`
-  Eigen::MatrixXd outputs;      /// #nodes x #output times written so far [K], t = 0 first
-  double heat_in = 0, lost = 0; /// energy accumulators so far [J]
+  int steps = 0;                 /// time steps done (index of the next step in the time grid)
+  double time = 0;               /// simulated time reached [s]
+  double speed = 0;              /// spindle speed of the last step [rpm] (CN restarts on a change)
+  Eigen::VectorXd temperature;   /// #nodes [K] at `time`
+  Eigen::MatrixXd outputs;       /// #nodes x #output times written so far [K], t = 0 first
+  double heat_in = 0, lost = 0;  /// energy accumulators so far [J]
 };
 
 /// Checkpoints during the time loop: `save` gets the state after a step when `interval_s` of wall

@@ -8,7 +8,8 @@ namespace tt::solvers {
 std::array<int, 3> error_nodes(const mesh::TetMesh& m, const core::CaseSpec& spec) {
   auto node_of = [&](const std::string& id) {
     const int node = mesh::named_node(m, id);
-    if (node < 0) throw core::SolverError("mechanical point '" + id + "' is not a named point of the mesh");
+    if (node < 0)
+      throw core::SolverError("mechanical point '" + id + "' is not a named point of the mesh");
     return node;
   };
   if (spec.mechanical.probe_points.size() != 2)
@@ -38,7 +39,8 @@ ThermalError thermal_error_of(const Eigen::MatrixXd& u, double probe_distance) {
   return e;
 }
 
-ThermalError thermal_error(const mesh::TetMesh& m, const core::CaseSpec& spec, const Eigen::MatrixXd& u) {
+ThermalError thermal_error(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                           const Eigen::MatrixXd& u) {
   const auto nodes = error_nodes(m, spec);
   Eigen::MatrixXd rows(9, u.cols());
   for (int p = 0; p < 3; ++p)

@@ -11,10 +11,21 @@
 namespace tt::solvers {
 
 /// Columns of ThermalError::values, in the order of thermal_error.csv after time_s.
-enum ThermalErrorColumn { kDx, kDy, kDz, kDxZ1, kDyZ1, kDxZ2, kDyZ2, kTiltX, kTiltY, kThermalErrorColumns };
+enum ThermalErrorColumn {
+  kDx,
+  kDy,
+  kDz,
+  kDxZ1,
+  kDyZ1,
+  kDxZ2,
+  kDyZ2,
+  kTiltX,
+  kTiltY,
+  kThermalErrorColumns
+};
 
 struct ThermalError {
-  Eigen::MatrixXd values;  /// #times x 9: displacements [m], tilts [rad]
+  Eigen::MatrixXd values;     /// #times x 9: displacements [m], tilts [rad]
   double probe_distance = 0;  /// D between the two probe points [m]
 };
 

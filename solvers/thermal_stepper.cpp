@@ -554,8 +554,8 @@ template Eigen::VectorXd moving_heat_load<Sparse>(const core::CaseSpec&, const F
 template Eigen::VectorXd moving_heat_load<Dense>(const core::CaseSpec&, const ReducedThermalSystem&,
                                                  double, double);
 
-template StepLoad step_load<Sparse>(const FullThermalSystem&, const core::CaseSpec&, double,
-                                    double, const Eigen::VectorXd&);
+template StepLoad step_load<Sparse>(const FullThermalSystem&, const core::CaseSpec&, double, double,
+                                    const Eigen::VectorXd&);
 template StepLoad step_load<Dense>(const ReducedThermalSystem&, const core::CaseSpec&, double,
                                    double, const Eigen::VectorXd&);
 

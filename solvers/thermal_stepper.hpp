@@ -102,17 +102,16 @@ template <class Matrix>
 StepLoad step_load(const LinearThermalSystem<Matrix>& system, const core::CaseSpec& spec, double t0,
                    double t1, const Eigen::VectorXd& state0);
 
-
 /// One step of a reduced (dense) system as an affine map of its state, formed as step_thermal
 /// forms the step: x1 = transition x0 + input, with (C + theta dt A) transition = C - (1 - theta)
 /// dt A and (C + theta dt A) input = dt times the step's weighted load (the load's temperature-
 /// dependent part from x0). For a filter that propagates a covariance with the runs' own
 /// discretisation.
 struct AffineStep {
-  double t0 = 0, t1 = 0;      /// [s]
-  double speed = 0;           /// spindle speed over the step [rpm]
-  double theta = 1;           /// 1: backward Euler; 0.5: Crank–Nicolson
-  std::vector<double> film;   /// h per convection entry over the step [W/(m^2 K)]
+  double t0 = 0, t1 = 0;     /// [s]
+  double speed = 0;          /// spindle speed over the step [rpm]
+  double theta = 1;          /// 1: backward Euler; 0.5: Crank–Nicolson
+  std::vector<double> film;  /// h per convection entry over the step [W/(m^2 K)]
   const Eigen::MatrixXd* step_inverse = nullptr;  /// (C + theta dt A)^{-1}, r x r
   const Eigen::MatrixXd* transition = nullptr;    /// r x r
   Eigen::VectorXd input;                          /// r [state]

@@ -45,7 +45,8 @@ using FullThermalSystem = LinearThermalSystem<Eigen::SparseMatrix<double>>;
 using ReducedThermalSystem = LinearThermalSystem<Eigen::MatrixXd>;
 
 /// `reduced` with its moving_prefix filled.
-LinearThermalSystem<Eigen::MatrixXd> with_moving_prefix(LinearThermalSystem<Eigen::MatrixXd> reduced);
+LinearThermalSystem<Eigen::MatrixXd> with_moving_prefix(
+    LinearThermalSystem<Eigen::MatrixXd> reduced);
 
 /// The full system of `spec` on `mesh` (element loops in parallel, deterministic order). Throws
 /// SolverError for inverted elements and sources on empty bodies.

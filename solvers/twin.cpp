@@ -107,8 +107,8 @@ Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
   return case_twin(mesh, spec, thermal_system(mesh, spec), options);
 }
 
-Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
-               const FullThermalSystem& full, const ReductionOptions& options) {
+Twin case_twin(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const FullThermalSystem& full,
+               const ReductionOptions& options) {
   // The displacement outputs (the stiffness factor and its block adjoint solve) and the thermal
   // basis (a factor per film state and shift) are independent: they are built side by side.
   TwinOutputs outputs;

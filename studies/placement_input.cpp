@@ -15,13 +15,13 @@ placement::PlacementInput groups_end_to_end(const std::vector<fitting::Group>& g
   for (int i : which) {
     if (i < 0 || i >= static_cast<int>(groups.size()))
       throw core::DataError("placement on groups: group " + std::to_string(i) + " of " +
-                             std::to_string(groups.size()));
+                            std::to_string(groups.size()));
     if (groups[static_cast<std::size_t>(i)].sensor_names !=
         groups[static_cast<std::size_t>(which.front())].sensor_names)
       throw core::DataError("placement on groups: group '" +
-                             groups[static_cast<std::size_t>(i)].name +
-                             "' has other sensors than '" +
-                             groups[static_cast<std::size_t>(which.front())].name + "'");
+                            groups[static_cast<std::size_t>(i)].name +
+                            "' has other sensors than '" +
+                            groups[static_cast<std::size_t>(which.front())].name + "'");
     rows += groups[static_cast<std::size_t>(i)].time.size();
   }
   const fitting::Group& g0 = groups[static_cast<std::size_t>(which.front())];

@@ -20,13 +20,13 @@
 #include <CGAL/Side_of_triangle_mesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/boost/graph/helpers.h>
-#include <Eigen/Geometry>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
 #include <fstream>
-#include <iterator>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <sstream>
 
@@ -123,13 +123,15 @@ Eigen::Vector3d inside_point_of(const Mesh& m, double diagonal, const std::strin
 /// The file's polygon soup. CGAL 5.5's OFF and PLY readers trust the file (docs/reliability.md,
 /// F3 to F11): OFF is read by our own strict reader, and a PLY header is checked before CGAL reads
 /// the file. False when CGAL's reader fails; `reader_said` holds what it printed.
-bool read_soup(const std::filesystem::path& file, const std::string& prefix, std::vector<Point>& points,
-               std::vector<std::vector<std::size_t>>& polygons, std::string& reader_said) {
+bool read_soup(const std::filesystem::path& file, const std::string& prefix,
+               std::vector<Point>& points, std::vector<std::vector<std::size_t>>& polygons,
+               std::string& reader_said) {
   std::string extension = file.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const auto refuse = [&](const std::string& problem) {
-    return core::GeometryError(prefix + problem + ". Hint: export the surface again, as ASCII OFF, "
+    return core::GeometryError(prefix + problem +
+                               ". Hint: export the surface again, as ASCII OFF, "
                                "STL or a PLY with float coordinates.");
   };
   if (extension == ".off" || extension == ".ply") {
@@ -182,8 +184,9 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
     for (int k = 0; k < 3; ++k)
       if (!(std::abs(points[v][k]) <= kFarthest)) {
         std::ostringstream msg;
-        msg << prefix << "vertex " << v << " has coordinate " << "xyz"[k] << " = " << points[v][k]
-            << " m, beyond " << kFarthest << " m. Hint: check the file and its length unit.";
+        msg << prefix << "vertex " << v << " has coordinate "
+            << "xyz"[k] << " = " << points[v][k] << " m, beyond " << kFarthest
+            << " m. Hint: check the file and its length unit.";
         throw core::GeometryError(msg.str());
       }
   {
@@ -209,7 +212,8 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
   Mesh m;
   PMP::polygon_soup_to_polygon_mesh(points, polygons, m);
   if (!CGAL::is_triangle_mesh(m))  // the soup was split into triangles above
-    throw core::GeometryError(prefix + "internal: the surface is not all triangles after splitting");
+    throw core::GeometryError(prefix +
+                              "internal: the surface is not all triangles after splitting");
   m.collect_garbage();
   const CGAL::Bbox_3 box = PMP::bbox(m);
   const double diagonal =

@@ -27,7 +27,9 @@ bool is_real_type(std::string_view t) {
 std::vector<std::string_view> words_of(std::string_view line) {
   std::vector<std::string_view> words;
   std::size_t i = 0;
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; };
+  const auto blank = [](char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+  };
   while (i < line.size()) {
     while (i < line.size() && blank(line[i])) ++i;
     const std::size_t start = i;
@@ -49,9 +51,11 @@ std::vector<std::string_view> lines_of(std::string_view text) {
   return lines;
 }
 
-/// The value of a word made only of decimal digits, or nothing (other characters, or beyond 64 bits).
+/// The value of a word made only of decimal digits, or nothing (other characters, or beyond 64
+/// bits).
 std::optional<unsigned long long> plain_count(std::string_view word) {
-  if (word.empty() || !std::all_of(word.begin(), word.end(), [](char c) { return c >= '0' && c <= '9'; }))
+  if (word.empty() ||
+      !std::all_of(word.begin(), word.end(), [](char c) { return c >= '0' && c <= '9'; }))
     return std::nullopt;
   unsigned long long value = 0;
   const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
@@ -63,7 +67,8 @@ std::string quoted(std::string_view word) {
   constexpr std::size_t kShown = 40;
   std::string shown;
   for (char c : word.substr(0, kShown))
-    shown += (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
+    shown +=
+        (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
   return "'" + shown + (word.size() > kShown ? "...'" : "'");
 }
 
@@ -96,7 +101,8 @@ std::optional<std::string> ply_header_problem(std::string_view text) {
       if (w.size() != 3) return line_no(i) + ": 'element' takes a name and a count";
       const auto count = plain_count(w[2]);
       if (!count || *count > text.size())
-        return line_no(i) + ": element count " + quoted(w[2]) + " is not a count this file can hold";
+        return line_no(i) + ": element count " + quoted(w[2]) +
+               " is not a count this file can hold";
       element = w[1];
       continue;
     }
@@ -141,7 +147,9 @@ struct OffCursor {
   std::size_t at = 0;
   std::size_t line = 0;
 
-  static bool blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n'; }
+  static bool blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n';
+  }
 
   /// Skips blanks, line ends and comments; false at the end of the text.
   bool skip() {
@@ -204,18 +212,24 @@ OffReading read_off(std::string_view text) {
     if (w == "BINARY") return fail("binary OFF is not read; export ASCII OFF, STL or PLY");
     const auto c = plain_count(w);
     if (!c || *c > text.size())
-      return fail("count " + quoted(w) + " is not a count this file can hold (vertices, faces, edges)");
+      return fail("count " + quoted(w) +
+                  " is not a count this file can hold (vertices, faces, edges)");
     count = *c;
   }
-  const auto vertices = static_cast<std::size_t>(counts[0]), faces = static_cast<std::size_t>(counts[1]);
+  const auto vertices = static_cast<std::size_t>(counts[0]),
+             faces = static_cast<std::size_t>(counts[1]);
   r.soup.points.reserve(vertices);
   for (std::size_t v = 0; v < vertices; ++v) {
     const auto w = in.record();
-    if (w.size() < 3) return fail("vertex " + std::to_string(v) + " of " + std::to_string(vertices) + " lacks x, y, z");
+    if (w.size() < 3)
+      return fail("vertex " + std::to_string(v) + " of " + std::to_string(vertices) +
+                  " lacks x, y, z");
     std::array<double, 3> p{};
     for (int k = 0; k < 3; ++k) {
       const auto x = finite_number(w[k]);
-      if (!x) return fail("vertex " + std::to_string(v) + ": coordinate " + quoted(w[k]) + " is not a finite number");
+      if (!x)
+        return fail("vertex " + std::to_string(v) + ": coordinate " + quoted(w[k]) +
+                    " is not a finite number");
       p[k] = *x;
     }
     r.soup.points.push_back(p);
@@ -233,8 +247,8 @@ OffReading read_off(std::string_view text) {
     for (std::size_t i = 1; i <= *k; ++i) {
       const auto index = plain_count(w[i]);
       if (!index || *index >= vertices)
-        return fail("face " + std::to_string(f) + ": vertex index " + quoted(w[i]) + ", the file has " +
-                    std::to_string(vertices) + " vertices");
+        return fail("face " + std::to_string(f) + ": vertex index " + quoted(w[i]) +
+                    ", the file has " + std::to_string(vertices) + " vertices");
       polygon.push_back(static_cast<std::size_t>(*index));
     }
     r.soup.polygons.push_back(std::move(polygon));

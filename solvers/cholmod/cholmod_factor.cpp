@@ -98,8 +98,8 @@ cholmod_factor* analysed(const Eigen::SparseMatrix<double>& a, cholmod_common& c
   c.supernodal = CHOLMOD_SUPERNODAL;
   cholmod_factor* f = cholmod_analyze(&s, &c);
   if (!f || c.status < CHOLMOD_OK)
-    throw core::SolverError(what + ": CHOLMOD analysis failed (status " +
-                            std::to_string(c.status) + ")");
+    throw core::SolverError(what + ": CHOLMOD analysis failed (status " + std::to_string(c.status) +
+                            ")");
   return f;
 }
 
@@ -126,7 +126,8 @@ Analysis::Analysis(const Eigen::SparseMatrix<double>& a, std::string what)
 
 Analysis::~Analysis() = default;
 
-Factor::Factor(const Eigen::SparseMatrix<double>& a, std::string what) : impl_(std::make_unique<Impl>()) {
+Factor::Factor(const Eigen::SparseMatrix<double>& a, std::string what)
+    : impl_(std::make_unique<Impl>()) {
   impl_->what = std::move(what);
   check_square(a, impl_->what);
   impl_->n = static_cast<int>(a.rows());
@@ -144,9 +145,8 @@ Factor::Factor(const Analysis& analysis, const Eigen::SparseMatrix<double>& a, s
                     std::equal(p.outer.begin(), p.outer.end(), a.outerIndexPtr()) &&
                     std::equal(p.inner.begin(), p.inner.end(), a.innerIndexPtr());
   if (!same)
-    throw core::SolverError(impl_->what + ": its pattern (" + std::to_string(a.rows()) +
-                            " rows, " + std::to_string(a.nonZeros()) +
-                            " entries) is not the analysed one (" +
+    throw core::SolverError(impl_->what + ": its pattern (" + std::to_string(a.rows()) + " rows, " +
+                            std::to_string(a.nonZeros()) + " entries) is not the analysed one (" +
                             std::to_string(p.outer.size() - 1) + " rows, " +
                             std::to_string(p.inner.size()) + " entries)");
   impl_->n = static_cast<int>(a.rows());
@@ -179,10 +179,12 @@ Eigen::MatrixXd Factor::solve(const Eigen::MatrixXd& b) const {
     throw core::SolverError(impl_->what + ": right-hand side has " + std::to_string(b.rows()) +
                             " rows, expected " + std::to_string(impl_->n));
   Eigen::MatrixXd copy = b;
-  cholmod_dense bd = dense_view(copy.data(), static_cast<int>(b.rows()), static_cast<int>(b.cols()));
+  cholmod_dense bd =
+      dense_view(copy.data(), static_cast<int>(b.rows()), static_cast<int>(b.cols()));
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, impl_->factor, &bd, &impl_->common);
   if (!x) throw core::SolverError(impl_->what + ": CHOLMOD solve failed");
-  Eigen::MatrixXd result = Eigen::Map<Eigen::MatrixXd>(static_cast<double*>(x->x), b.rows(), b.cols());
+  Eigen::MatrixXd result =
+      Eigen::Map<Eigen::MatrixXd>(static_cast<double*>(x->x), b.rows(), b.cols());
   cholmod_free_dense(&x, &impl_->common);
   return result;
 }
@@ -204,6 +206,8 @@ double Factor::factor_entries() const {
   return static_cast<double>(f->nzmax);
 }
 
-int Factor::rows() const { return impl_->n; }
+int Factor::rows() const {
+  return impl_->n;
+}
 
 }  // namespace tt::solvers::cholmod

@@ -44,14 +44,14 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
   for (int k = 0; k < 3; ++k) {
     const core::DutyCycle duty = random_duty_cycle(hours[k], rng);
     const core::CaseSpec truth = truth_case(gen, effect, duty, k);
-    const io::MeasuredRun run = synthetic_run(gen_mesh, truth, effect, inst, gopt,
-                                              "run " + std::to_string(k), rng);
+    const io::MeasuredRun run =
+        synthetic_run(gen_mesh, truth, effect, inst, gopt, "run " + std::to_string(k), rng);
     runs.push_back((dir / ("run_" + std::to_string(k))).string());
     io::write_measured_run(runs.back(), run);
   }
   const fs::path out = dir / "out", log = dir / "calibrate.log";
-  ASSERT_EQ(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0],
-                     runs[1], "--test", runs[2], "--out", out.string()},
+  ASSERT_EQ(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0], runs[1],
+                     "--test", runs[2], "--out", out.string()},
                     {}, log),
             0)
       << rt::read_text(log);
@@ -70,12 +70,13 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
   EXPECT_EQ(first["kind"], "heat_input") << j.dump(1);
   const auto& c = first["location"]["centre_m"];
   const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
-  std::printf("[calibrate cli] heat input %.2f W at (%.3f, %.3f, %.3f), found %.2f W at "
-              "(%.3f, %.3f, %.3f); u RMS %.3f -> %.3f um\n",
-              effect.magnitude, effect.centre(0), effect.centre(1), effect.centre(2),
-              first["parameters"]["power_W"].get<double>(), found(0), found(1), found(2),
-              j["before"]["displacement_rms_um"].get<double>(),
-              j["after"]["displacement_rms_um"].get<double>());
+  std::printf(
+      "[calibrate cli] heat input %.2f W at (%.3f, %.3f, %.3f), found %.2f W at "
+      "(%.3f, %.3f, %.3f); u RMS %.3f -> %.3f um\n",
+      effect.magnitude, effect.centre(0), effect.centre(1), effect.centre(2),
+      first["parameters"]["power_W"].get<double>(), found(0), found(1), found(2),
+      j["before"]["displacement_rms_um"].get<double>(),
+      j["after"]["displacement_rms_um"].get<double>());
   EXPECT_LT((found - effect.centre).norm(), 0.06);
   EXPECT_LT(j["after"]["displacement_rms_um"].get<double>(),
             0.5 * j["before"]["displacement_rms_um"].get<double>());
@@ -88,8 +89,8 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
 
   // A training run as --out is refused at once, and the run is left as it was.
   const auto before = rt::snapshot(runs[0]);
-  EXPECT_NE(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0],
-                     runs[1], "--test", runs[2], "--out", runs[0]},
+  EXPECT_NE(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0], runs[1],
+                     "--test", runs[2], "--out", runs[0]},
                     {}, dir / "refused.log"),
             0);
   EXPECT_EQ(rt::snapshot(runs[0]), before);

@@ -94,7 +94,6 @@ TEST(March, ColumnsAreLinearResponses) {
   }
 }
 
-
 // On the reduced model whose basis holds the channels' Krylov vectors, the declared channels and
 // the response of every kind of candidate load (a heat patch, a film change, an air hat, heat
 // growing with a source's temperature, a conductivity change) equal the full model's at the
@@ -115,9 +114,8 @@ TEST(March, ReducedOnChannelsKeepsEveryCandidateResponse) {
   for (Eigen::Index i = 0; i < m.nodes.rows(); ++i)
     if (std::abs(m.nodes(i, 0) - 0.3) > 0.05 || m.nodes(i, 2) < 0.049) patch(i) = 0;
   ASSERT_GT(patch.sum(), 0);
-  const std::vector<SeparableColumn> sep{{"patch", patch, [](double t, double) {
-                                            return t < 300 ? 1.0 : 0.5;
-                                          }}};
+  const std::vector<SeparableColumn> sep{
+      {"patch", patch, [](double t, double) { return t < 300 ? 1.0 : 0.5; }}};
   const auto dk = std::make_shared<const Eigen::SparseMatrix<double>>(0.1 * full.full().conduction);
   OperatorChange fk;
   fk.full = dk;
@@ -168,7 +166,6 @@ TEST(March, ReducedOnChannelsKeepsEveryCandidateResponse) {
   EXPECT_THROW(march(reduced, spec, r, run.time, {}, callback), core::SolverError);
 }
 
-
 // The probes' rows split by material are exact: doubling one material's expansion coefficient
 // changes the rows by exactly that material's part (solved again with another elastic model).
 TEST(Readout, ExpansionPartsAreExactPerMaterial) {
@@ -178,7 +175,8 @@ TEST(Readout, ExpansionPartsAreExactPerMaterial) {
   io::MeasuredRun run;
   run.run = "probes";
   for (const auto& [id, dir] : std::vector<std::pair<std::string, Eigen::Vector3d>>{
-           {"tcp_dy", Eigen::Vector3d::UnitY()}, {"tcp_dz", Eigen::Vector3d::UnitZ()},
+           {"tcp_dy", Eigen::Vector3d::UnitY()},
+           {"tcp_dz", Eigen::Vector3d::UnitZ()},
            {"tcp_skew", Eigen::Vector3d(1, 1, 0).normalized()}})
     run.displacements.push_back({id, Eigen::Vector3d(0.0, 0.18, 0.58), dir});
   const Readout r = readout(m, declared, run);

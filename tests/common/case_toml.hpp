@@ -22,8 +22,9 @@ inline std::string steel() {
 inline std::string box_body(const std::string& name, const std::string& material,
                             const std::string& max_edge, const std::string& min,
                             const std::string& max) {
-  return "[[bodies]]\nname = \"" + name + "\"\nmaterial = \"" + material + "\"\nmax_edge = " +
-         max_edge + "\nadd = [ { box = { min = " + min + ", max = " + max + " } } ]\n";
+  return "[[bodies]]\nname = \"" + name + "\"\nmaterial = \"" + material +
+         "\"\nmax_edge = " + max_edge + "\nadd = [ { box = { min = " + min + ", max = " + max +
+         " } } ]\n";
 }
 
 }  // namespace tt::test_toml

@@ -20,15 +20,16 @@ inline ::testing::AssertionResult matches_output_schemas(const std::string& comm
   const std::filesystem::path source(TT_SOURCE_DIR);
   const std::filesystem::path log = dir.parent_path() / (dir.filename().string() + ".schema.log");
   std::filesystem::remove(log);
-  const int status = io::run_program(
-      {"/usr/bin/python3", (source / "scripts" / "validate_output.py").string(), command,
-       dir.string()},
-      {}, log);
+  const int status =
+      io::run_program({"/usr/bin/python3", (source / "scripts" / "validate_output.py").string(),
+                       command, dir.string()},
+                      {}, log);
   if (status == 0) return ::testing::AssertionSuccess();
   std::ostringstream text;
   text << std::ifstream(log).rdbuf();
   return ::testing::AssertionFailure() << command << " output " << dir << " against docs/schemas/"
-                                       << " (exit " << status << "):\n" << text.str();
+                                       << " (exit " << status << "):\n"
+                                       << text.str();
 }
 
 }  // namespace tt::test

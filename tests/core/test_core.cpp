@@ -1,5 +1,4 @@
 #include <gtest/gtest.h>
-
 #include <omp.h>
 
 #include <algorithm>
@@ -21,11 +20,12 @@ TEST(Errors, LocatedNamesFileAndLine) {
 TEST(Parallel, ChunksAreInOrderWhateverTheThreadCount) {
   for (int threads : {1, 2, 3}) {
     omp_set_num_threads(threads);
-    auto chunks = parallel_chunks<long>(1001, 100, [](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
-      long s = 0;
-      for (auto i = b; i < e; ++i) s += i;
-      return s;
-    });
+    auto chunks =
+        parallel_chunks<long>(1001, 100, [](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
+          long s = 0;
+          for (auto i = b; i < e; ++i) s += i;
+          return s;
+        });
     ASSERT_EQ(chunks.size(), 11u);
     EXPECT_EQ(chunks[0], 4950);
     EXPECT_EQ(chunks[10], 1000);

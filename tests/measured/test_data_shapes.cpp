@@ -97,8 +97,8 @@ void drop_inputs_key(const fs::path& folder) {
 
 /// fit.json or calibration.json, its folder checked against the command's schemas first.
 nlohmann::json json_of(const fs::path& file) {
-  EXPECT_TRUE(tt::test::matches_output_schemas(
-      file.filename() == "fit.json" ? "fit" : "calibrate", file.parent_path()));
+  EXPECT_TRUE(tt::test::matches_output_schemas(file.filename() == "fit.json" ? "fit" : "calibrate",
+                                               file.parent_path()));
   return nlohmann::json::parse(read_text(file));
 }
 

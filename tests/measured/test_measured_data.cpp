@@ -194,10 +194,10 @@ TEST_F(Measured, RejectsPositionOutsideTheMachineBox) {
 
 TEST_F(Measured, TheMachineBoxCanComeWithTheData) {
   // meta.json's machine_box_m checks the positions as a caller's box does, and is written back.
-  const std::string boxed = replaced(
-      kMeta, "\"run\": \"unit test\",",
-      "\"run\": \"unit test\", \"machine_box_m\": {\"min\": [-0.16, 0.0, -0.04], "
-      "\"max\": [0.16, 0.30, 0.58]},");
+  const std::string boxed =
+      replaced(kMeta, "\"run\": \"unit test\",",
+               "\"run\": \"unit test\", \"machine_box_m\": {\"min\": [-0.16, 0.0, -0.04], "
+               "\"max\": [0.16, 0.30, 0.58]},");
   auto m = rejection(replaced(boxed, "[-0.08, 0.30, 0.20]", "[-0.08, 0.31, 0.20]"), kCsv, {});
   EXPECT_NE(m.find("key sensors[0].position:"), std::string::npos) << m;
   EXPECT_NE(m.find("outside machine SB-1's bounding box"), std::string::npos) << m;
@@ -220,11 +220,11 @@ TEST_F(Measured, TheMachineBoxCanComeWithTheData) {
 }
 
 TEST_F(Measured, PublishedFigureIsReadAndChecked) {
-  const std::string published = replaced(
-      kMeta, "\"run\": \"unit test\",",
-      "\"run\": \"unit test\", \"published\": {\"model\": \"GRU\", \"source\": \"paper\", "
-      "\"test_window_s\": [60, 120], \"mae_um\": {\"dy\": 3.5}, "
-      "\"others_mae_um\": {\"forest\": {\"dy\": 6.0}}},");
+  const std::string published =
+      replaced(kMeta, "\"run\": \"unit test\",",
+               "\"run\": \"unit test\", \"published\": {\"model\": \"GRU\", \"source\": \"paper\", "
+               "\"test_window_s\": [60, 120], \"mae_um\": {\"dy\": 3.5}, "
+               "\"others_mae_um\": {\"forest\": {\"dy\": 6.0}}},");
   write_text(dir_ / "meta.json", published);
   write_text(dir_ / "data.csv", kCsv);
   const auto run = read_measured_run(dir_);

@@ -202,7 +202,8 @@ TEST(SurfaceBody, UnreadableFileIsRejected) {
 
 TEST(SurfaceBody, FarFlungVertexIsRejectedBeforeTheGeometryChecks) {
   const std::string msg = surface_error(
-      "far.off", "OFF\n4 4 0\n0 0 0\n10 3.3e44 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
+      "far.off",
+      "OFF\n4 4 0\n0 0 0\n10 3.3e44 0\n0 10 0\n0 0 10\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
   EXPECT_NE(msg.find("far.off"), std::string::npos) << msg;
   EXPECT_NE(msg.find("vertex 1 has coordinate y"), std::string::npos) << msg;
 }

@@ -234,7 +234,8 @@ TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) 
   EXPECT_LT(placed.variance_m2[1], placed.variance_m2[0]);
   EXPECT_LT(placed.variance_m2[2], placed.variance_m2[1]);
   const auto criterion = [&](const std::vector<std::string>& sensors) {
-    noise.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.04);
+    noise.sensor_sigma_k =
+        Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.04);
     const Eigen::VectorXd var = solvers::mean_drift_variance(
         s_->twin.model.system, {c}, solvers::twin_observer_setup(s_->twin, c, sensors, noise), 600);
     return var(1) + var(2);
@@ -242,11 +243,12 @@ TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) 
   EXPECT_NEAR(criterion(placed.sensors), placed.variance_m2[2], 1e-9 * placed.variance_m2[2]);
   const double hand = criterion({kSensors[0], kSensors[1], kSensors[2]});
   EXPECT_LT(placed.variance_m2[2], hand);
-  std::printf("[observer] placed for estimation: %s %s %s, sigma(dy+dz) %.3g um (hand-picked %s "
-              "%s %s: %.3g um)\n",
-              placed.sensors[0].c_str(), placed.sensors[1].c_str(), placed.sensors[2].c_str(),
-              std::sqrt(placed.variance_m2[2]) * 1e6, kSensors[0].c_str(), kSensors[1].c_str(),
-              kSensors[2].c_str(), std::sqrt(hand) * 1e6);
+  std::printf(
+      "[observer] placed for estimation: %s %s %s, sigma(dy+dz) %.3g um (hand-picked %s "
+      "%s %s: %.3g um)\n",
+      placed.sensors[0].c_str(), placed.sensors[1].c_str(), placed.sensors[2].c_str(),
+      std::sqrt(placed.variance_m2[2]) * 1e6, kSensors[0].c_str(), kSensors[1].c_str(),
+      kSensors[2].c_str(), std::sqrt(hand) * 1e6);
   EXPECT_THROW(solvers::estimation_placement(s_->twin, {c}, candidates, {1}, 0, 0.04, noise, 600),
                core::SolverError);
 }

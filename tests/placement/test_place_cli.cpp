@@ -112,7 +112,8 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
       const auto& a = noisy[0]["targets"][target]["methods"][method];
       const auto& b = noisy[1]["targets"][target]["methods"][method];
       ASSERT_EQ(a.size(), 6u) << target << " " << method;
-      for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ(a[k]["ids"], b[k]["ids"]) << target << " " << method;
+      for (size_t k = 0; k < a.size(); ++k)
+        EXPECT_EQ(a[k]["ids"], b[k]["ids"]) << target << " " << method;
     }
   if (!HasFailure()) fs::remove_all(dir);  // kept for a look when something failed
 }

@@ -5,10 +5,10 @@
 // is small on a good basis and large on a truncated one; a model built for another case is
 // refused.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <omp.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

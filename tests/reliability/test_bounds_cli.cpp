@@ -59,9 +59,8 @@ TEST(BoundsCli, TetGenIsRefusedMemoryBeyondTheLimit) {
   const std::string key = "min_dihedral_deg = 12.0\n";
   text.replace(text.find(key), key.size(), key + "memory_limit_GB = 0.002\n");
   std::ofstream(dir / "case.toml") << text;
-  const auto [code, log] =
-      run_logged({"mesh", (dir / "case.toml").string(), "--out", (dir / "out").string()},
-                 dir / "log");
+  const auto [code, log] = run_logged(
+      {"mesh", (dir / "case.toml").string(), "--out", (dir / "out").string()}, dir / "log");
   EXPECT_EQ(code, 1) << log;
   EXPECT_NE(log.find("mesh.memory_limit_GB = 0.002"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(dir / "out"));

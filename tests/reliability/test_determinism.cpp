@@ -13,13 +13,11 @@ namespace tt::reliability_test {
 namespace {
 
 // A heated steel bar on a fixed base: order 1, max_edge small enough for > 50 000 tets, ten steps.
-const std::string kBarCase = test_toml::header("determinism bar", "seed = 7\n") +
-                             test_toml::steel() +
-                             test_toml::box_body("bar", "steel", "0.009", "[0.0, 0.0, 0.0]",
-                                                 "[0.24, 0.1, 0.1]") +
-                             test_toml::box_body("heater", "steel", "0.009", "[0.24, 0.0, 0.0]",
-                                                 "[0.28, 0.1, 0.1]") +
-                             R"(
+const std::string kBarCase =
+    test_toml::header("determinism bar", "seed = 7\n") + test_toml::steel() +
+    test_toml::box_body("bar", "steel", "0.009", "[0.0, 0.0, 0.0]", "[0.24, 0.1, 0.1]") +
+    test_toml::box_body("heater", "steel", "0.009", "[0.24, 0.0, 0.0]", "[0.28, 0.1, 0.1]") +
+    R"(
 [mesh]
 order = 1
 

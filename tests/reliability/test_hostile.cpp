@@ -121,12 +121,11 @@ TEST(HostileCase, SchemeTheSolverCannotRunIsRefusedWhenRead) {
 TEST(HostileCase, HeatSourceOnARegionWithoutElementsIsRefused) {
   // Two boxes, the source on the second; then every tet is given to the first, as a mesh that
   // lost a thin body would be.
-  const std::string text = test_toml::header("empty region") + test_toml::steel() +
-                           test_toml::box_body("block", "steel", "0.05", "[0.0, 0.0, 0.0]",
-                                               "[0.1, 0.1, 0.1]") +
-                           test_toml::box_body("pad", "steel", "0.05", "[0.1, 0.0, 0.0]",
-                                               "[0.15, 0.1, 0.1]") +
-                           R"(
+  const std::string text =
+      test_toml::header("empty region") + test_toml::steel() +
+      test_toml::box_body("block", "steel", "0.05", "[0.0, 0.0, 0.0]", "[0.1, 0.1, 0.1]") +
+      test_toml::box_body("pad", "steel", "0.05", "[0.1, 0.0, 0.0]", "[0.15, 0.1, 0.1]") +
+      R"(
 [[boundary]]
 name = "all"
 rest = true

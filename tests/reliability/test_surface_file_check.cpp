@@ -9,8 +9,7 @@
 namespace tt::mesh::cgal {
 namespace {
 
-const std::string kPlyBody =
-    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+const std::string kPlyBody = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
 
 std::string ply(const std::string& header_middle) {
   return "ply\nformat ascii 1.0\n" + header_middle + "end_header\n" + kPlyBody;
@@ -23,9 +22,10 @@ const std::string kPlainFace = "element face 4\nproperty list uchar int vertex_i
 TEST(PlyHeader, OrdinaryHeadersPass) {
   EXPECT_EQ(ply_header_problem(ply(kPlainVertex + kPlainFace)), std::nullopt);
   // CRLF line ends, comments, extra vertex properties, doubles, a texture list of floats.
-  std::string crlf = ply("comment made by hand\nelement vertex 4\nproperty double x\n"
-                         "property double y\nproperty double z\nproperty uchar red\n" +
-                         kPlainFace + "property list uchar float texcoord\n");
+  std::string crlf =
+      ply("comment made by hand\nelement vertex 4\nproperty double x\n"
+          "property double y\nproperty double z\nproperty uchar red\n" +
+          kPlainFace + "property list uchar float texcoord\n");
   std::string with_cr;
   for (char c : crlf) with_cr += c == '\n' ? std::string("\r\n") : std::string(1, c);
   EXPECT_EQ(ply_header_problem(with_cr), std::nullopt);
@@ -38,7 +38,8 @@ TEST(PlyHeader, WhatCgalCrashesOnIsRefused) {
             std::nullopt);
   // F5: a coordinate of an integer type.
   EXPECT_NE(ply_header_problem(ply("element vertex 4\nproperty float x\nproperty float y\n"
-                                   "property uint16 z\n" + kPlainFace)),
+                                   "property uint16 z\n" +
+                                   kPlainFace)),
             std::nullopt);
   // F6: faces with no vertex element.
   EXPECT_NE(ply_header_problem(ply(kPlainFace)), std::nullopt);
@@ -46,16 +47,17 @@ TEST(PlyHeader, WhatCgalCrashesOnIsRefused) {
   EXPECT_NE(ply_header_problem(ply("elemnt vertex 4\n" + kPlainFace)), std::nullopt);
   EXPECT_NE(ply_header_problem(ply(kPlainVertex + "property flot w\n" + kPlainFace)), std::nullopt);
   EXPECT_NE(ply_header_problem(ply("element vertex 99999999999\nproperty float x\n"
-                                   "property float y\nproperty float z\n" + kPlainFace)),
+                                   "property float y\nproperty float z\n" +
+                                   kPlainFace)),
             std::nullopt);
-  EXPECT_NE(ply_header_problem(ply(kPlainVertex +
-                                   "element face 4\nproperty list uchar float vertex_indices\n")),
+  EXPECT_NE(ply_header_problem(
+                ply(kPlainVertex + "element face 4\nproperty list uchar float vertex_indices\n")),
             std::nullopt);
   EXPECT_NE(ply_header_problem("ply\nformat ascii 1.0\n" + kPlainVertex), std::nullopt);
   // A list count wider than 8 bits: CGAL would size the list by a count of up to 4e9 (found by
   // the fuzzer: a 17 GB allocation).
-  EXPECT_NE(ply_header_problem(ply(kPlainVertex +
-                                   "element face 4\nproperty list uint32 int vertex_indices\n")),
+  EXPECT_NE(ply_header_problem(
+                ply(kPlainVertex + "element face 4\nproperty list uint32 int vertex_indices\n")),
             std::nullopt);
   // A vertex coordinate declared as a list (found by the fuzzer: a null call in CGAL).
   EXPECT_NE(ply_header_problem(ply(kPlainVertex + "property list uchar float x\n" + kPlainFace)),
@@ -79,8 +81,7 @@ const std::string kOffTetrahedron =
     "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
 
 std::string off_with_face(const std::string& second_face) {
-  return "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n" + second_face +
-         "\n3 1 2 3\n3 0 3 2\n";
+  return "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n" + second_face + "\n3 1 2 3\n3 0 3 2\n";
 }
 
 TEST(OffFile, OrdinaryFilesAreRead) {

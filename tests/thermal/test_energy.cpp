@@ -7,8 +7,8 @@
 
 #include <cstdio>
 
-#include "tests/thermal/thermal_fixtures.hpp"
 #include "tests/common/case_toml.hpp"
+#include "tests/thermal/thermal_fixtures.hpp"
 
 namespace tt::thermal_test {
 namespace {

@@ -219,9 +219,10 @@ TEST(TwinValidation, Gm1CoarseAxisPointsFollowTheFullModelOnCyclesNotUsedToBuild
     }
     EXPECT_EQ(axis_columns, 3 * static_cast<int>(spec.mechanical.axis_points.size())) << c.run;
     EXPECT_TRUE(c.passes()) << c.run;
-    std::printf("[twin] gm1_coarse %s: order %d, max |dT| %.2e K, largest drift error / limit %.3f\n",
-                c.run.c_str(), twin.model.states(), c.max_temperature_error_k,
-                c.drift_error_m.cwiseQuotient(c.drift_limit_m).maxCoeff());
+    std::printf(
+        "[twin] gm1_coarse %s: order %d, max |dT| %.2e K, largest drift error / limit %.3f\n",
+        c.run.c_str(), twin.model.states(), c.max_temperature_error_k,
+        c.drift_error_m.cwiseQuotient(c.drift_limit_m).maxCoeff());
   }
 }
 
