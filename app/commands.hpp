@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "io/plot.hpp"
+
 namespace tt::app {
 
 struct MeshArgs {
@@ -127,14 +129,8 @@ int place_command(const PlaceArgs& args);
 int probes_command(const ProbesArgs& args);
 int run_command(const RunArgs& args);
 
-/// Runs `script` under /usr/bin/python3 with these arguments, from an argument vector (no shell);
-/// true when it exits 0. Its output is discarded.
-bool run_python(const std::filesystem::path& script, const std::vector<std::string>& args);
-
-/// Runs app/plot.py with these arguments; a missing matplotlib only skips the figure (a note on
-/// stderr). Values that come from the user (titles, labels, column names) are passed as
-/// "--option=value", so that one starting with '-' is not read as an option.
-void plot(const std::vector<std::string>& args);
+/// The one plotting entry point (io/plot.hpp).
+using io::plot;
 
 /// Progress on stderr, at most every 10 % of the simulated time.
 void report_progress(const std::string& stage, double done, double total);

@@ -491,18 +491,15 @@ nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& sel) {
 
 ChannelFigures channel_figures(const std::vector<Eigen::MatrixXd>& measured,
                                const std::vector<Eigen::MatrixXd>& simulated, int channel) {
-  double sum_sq = 0, sum_abs = 0, largest = 0, n = 0;
-  for (size_t r = 0; r < measured.size(); ++r)
-    for (Eigen::Index i = 0; i < measured[r].rows(); ++i) {
-      const double e = measured[r](i, channel) - simulated[r](i, channel);
-      if (!std::isfinite(e)) continue;
-      sum_sq += e * e;
-      sum_abs += std::abs(e);
-      largest = std::max(largest, std::abs(e));
-      n += 1;
-    }
-  if (n == 0) return {};
-  return {std::sqrt(sum_sq / n), largest, sum_abs / n};
+  Eigen::Index n = 0;
+  for (const auto& m : measured) n += m.rows();
+  Eigen::VectorXd residual(n);
+  Eigen::Index at = 0;
+  for (size_t r = 0; r < measured.size(); ++r) {
+    residual.segment(at, measured[r].rows()) = measured[r].col(channel) - simulated[r].col(channel);
+    at += measured[r].rows();
+  }
+  return core::error_figures(residual);
 }
 
 namespace {

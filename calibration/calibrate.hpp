@@ -9,6 +9,7 @@
 
 #include "calibration/effects.hpp"
 #include "core/case_spec.hpp"
+#include "core/error_figures.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/tet_mesh.hpp"
 
@@ -97,9 +98,7 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
 
 /// One channel's test residual, measured - simulated, over the finite samples of all runs, in
 /// the channel's unit [K | m].
-struct ChannelFigures {
-  double rms = 0, max_abs = 0, mae = 0;
-};
+using ChannelFigures = core::ErrorFigures;
 ChannelFigures channel_figures(const std::vector<Eigen::MatrixXd>& measured,
                                const std::vector<Eigen::MatrixXd>& simulated, int channel);
 

@@ -1,6 +1,7 @@
 #include "io/measured_segments.hpp"
 
 #include <cmath>
+#include <set>
 
 #include "core/errors.hpp"
 
@@ -59,6 +60,68 @@ std::vector<fitting::Segment> measured_segments(const MeasuredRun& run, const st
                                            targets, range));
   }
   return segments;
+}
+
+namespace {
+
+std::set<std::string> canonical_names(const std::vector<std::filesystem::path>& folders) {
+  std::set<std::string> names;
+  for (const auto& p : folders) names.insert(std::filesystem::weakly_canonical(p).string());
+  return names;
+}
+
+}  // namespace
+
+SplitRuns read_split_runs(const std::vector<std::filesystem::path>& train,
+                          const std::vector<std::filesystem::path>& test,
+                          std::optional<double> split_s) {
+  if (train.empty() || test.empty())
+    throw core::DataError(
+        "calibrate: give --train RUN... and --test RUN... (the same run in both splits it in "
+        "time)");
+  require_distinct_runs(train, "--train");
+  require_distinct_runs(test, "--test");
+  const std::set<std::string> train_names = canonical_names(train),
+                              test_names = canonical_names(test);
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  SplitRuns out;
+  std::filesystem::path first;
+  const auto add = [&](const std::filesystem::path& folder, bool is_train) {
+    const std::string key = std::filesystem::weakly_canonical(folder).string();
+    const bool shared = train_names.count(key) && test_names.count(key);
+    const MeasuredRun run = read_measured_run(folder);
+    const Eigen::VectorXd speed = measured_speed(run);
+    const bool has_speed = speed.size() != 0;
+    if (out.runs.empty()) {
+      first = folder;
+      out.has_speed = has_speed;
+      if (run.ambient_sensor)
+        for (std::size_t k = 0; k < run.sensors.size(); ++k)
+          if (run.sensors[k].id == *run.ambient_sensor) out.ambient_sensor = static_cast<int>(k);
+    } else if (has_speed != out.has_speed) {
+      throw core::DataError(folder.string() +
+                            (has_speed ? " has a speed input but " : " has none but ") +
+                            first.string() + (has_speed ? " has none" : " has one") +
+                            ": every run must have the same inputs; hint: drop the speed column "
+                            "from all runs, or give it in all");
+    }
+    const double split =
+        shared ? split_s.value_or(fitting::held_out_start(run.time, speed, 0.7, 0.6)) : inf;
+    const std::string name =
+        "run" + std::to_string(out.runs.size() + 1) + (is_train ? ".train" : ".test");
+    auto segments = is_train ? measured_segments(run, name, -inf, shared ? split : inf)
+                             : measured_segments(run, name, shared ? split : -inf, inf);
+    RunSplit record{folder, is_train, shared ? std::optional<double>(split) : std::nullopt, {}};
+    for (const auto& s : segments)
+      record.segments.push_back(
+          {s.group.name, s.group.time(0), s.group.time(s.group.time.size() - 1), s.dropped_rows});
+    out.runs.push_back(std::move(record));
+    auto& into = is_train ? out.training : out.testing;
+    into.insert(into.end(), segments.begin(), segments.end());
+  };
+  for (const auto& f : train) add(f, true);
+  for (const auto& f : test) add(f, false);
+  return out;
 }
 
 }  // namespace tt::io

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,5 +26,36 @@ std::vector<fitting::Segment> measured_segments(
     const MeasuredRun& run, const std::string& name,
     double from_s = -std::numeric_limits<double>::infinity(),
     double to_s = std::numeric_limits<double>::infinity());
+
+/// Where one run's rows went: its role, the time it was split at (when it is both a training
+/// and a test run) and its segments.
+struct RunSplit {
+  struct Span {
+    std::string name;
+    double from_s = 0.0, to_s = 0.0;
+    int dropped_rows = 0;
+  };
+  std::filesystem::path folder;
+  bool train = true;
+  std::optional<double> split_s;
+  std::vector<Span> segments;
+};
+
+/// Training runs and test runs read and cut into segments (measured_segments), named
+/// "run<k>.train" and "run<k>.test". A run given in both lists is split in time: training rows
+/// before `split_s`, test rows from it (default: fitting::held_out_start at 70 % of the run).
+struct SplitRuns {
+  std::vector<fitting::Segment> training, testing;
+  bool has_speed = false;
+  /// temperature column of the first run's ambient sensor, -1 when it names none
+  int ambient_sensor = -1;
+  std::vector<RunSplit> runs;
+};
+
+/// Throws core::DataError naming the folder when a list is empty or names a run twice, a run
+/// cannot be read, or the runs differ in having a speed input.
+SplitRuns read_split_runs(const std::vector<std::filesystem::path>& train,
+                          const std::vector<std::filesystem::path>& test,
+                          std::optional<double> split_s);
 
 }  // namespace tt::io

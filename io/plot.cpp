@@ -1,17 +1,16 @@
-// Figures: app/plot.py run by Debian's /usr/bin/python3 (where matplotlib imports), started from
-// an argument vector (io::run_program), never a shell string.
+#include "io/plot.hpp"
+
 #include <iostream>
 
-#include "app/commands.hpp"
 #include "io/child_process.hpp"
 
-namespace tt::app {
+namespace tt::io {
 
 bool run_python(const std::filesystem::path& script, const std::vector<std::string>& args) {
   std::vector<std::string> argv{"/usr/bin/python3", script.string()};
   argv.insert(argv.end(), args.begin(), args.end());
   // The script's own messages (a missing matplotlib) are not the command's: only the note below.
-  return io::run_program(argv, {"MPLBACKEND=Agg"}, "/dev/null") == 0;
+  return run_program(argv, {"MPLBACKEND=Agg"}, "/dev/null") == 0;
 }
 
 void plot(const std::vector<std::string>& args) {
@@ -19,4 +18,4 @@ void plot(const std::vector<std::string>& args) {
     std::cerr << "thermotwin: note: plot skipped (" << args[0] << ")\n";
 }
 
-}  // namespace tt::app
+}  // namespace tt::io
