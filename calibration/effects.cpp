@@ -291,25 +291,7 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
 }
 
 std::string kind_name(EffectKind kind) {
-  switch (kind) {
-    case EffectKind::ambient_temperature:
-      return "ambient_temperature";
-    case EffectKind::heat_input:
-      return "heat_input";
-    case EffectKind::speed_dependent_convection:
-      return "speed_dependent_convection";
-    case EffectKind::temperature_dependent_heat:
-      return "temperature_dependent_heat";
-    case EffectKind::boundary_conductance:
-      return "boundary_conductance";
-    case EffectKind::material_parameter:
-      return "material_parameter";
-    case EffectKind::sensor_offset:
-      return "sensor_offset";
-    case EffectKind::sensor_lag:
-      return "sensor_lag";
-  }
-  return "unknown";
+  return std::string(core::name_in(kEffectKindNames, kind));
 }
 
 Eigen::VectorXd lagged(const Eigen::VectorXd& times, const Eigen::VectorXd& x, double tau) {

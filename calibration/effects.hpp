@@ -12,6 +12,7 @@
 
 #include "calibration/model.hpp"
 #include "core/case_spec.hpp"
+#include "core/enum_names.hpp"
 #include "mesh/tet_mesh.hpp"
 
 namespace tt::calibration {
@@ -26,6 +27,20 @@ enum class EffectKind {
   sensor_offset,
   sensor_lag
 };
+/// The kinds' names in calibration.json and reports.
+inline constexpr std::array<core::Named<EffectKind>, 8> kEffectKindNames{{
+    {EffectKind::ambient_temperature, "ambient_temperature"},
+    {EffectKind::heat_input, "heat_input"},
+    {EffectKind::speed_dependent_convection, "speed_dependent_convection"},
+    {EffectKind::temperature_dependent_heat, "temperature_dependent_heat"},
+    {EffectKind::boundary_conductance, "boundary_conductance"},
+    {EffectKind::material_parameter, "material_parameter"},
+    {EffectKind::sensor_offset, "sensor_offset"},
+    {EffectKind::sensor_lag, "sensor_lag"},
+}};
+static_assert(core::one_to_one(kEffectKindNames));
+
+/// The kind's name in kEffectKindNames.
 std::string kind_name(EffectKind kind);
 
 struct CalibrationOptions {

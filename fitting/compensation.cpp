@@ -31,17 +31,7 @@ double body_value(const FittedModel& model, const Eigen::VectorXd& x) {
 }  // namespace
 
 std::string status_name(SampleStatus status) {
-  switch (status) {
-    case SampleStatus::ok:
-      return "ok";
-    case SampleStatus::held:
-      return "held";
-    case SampleStatus::late:
-      return "late";
-    case SampleStatus::waiting:
-      return "waiting";
-  }
-  return "unknown";
+  return std::string(core::name_in(kSampleStatusNames, status));
 }
 
 Compensator::Compensator(const std::vector<FittedModel>& models,

@@ -25,7 +25,16 @@ enum class SampleStatus {
   waiting,
 };
 
-/// "ok", "held", "late" or "waiting".
+/// The statuses' names in compensate's output.
+inline constexpr std::array<core::Named<SampleStatus>, 4> kSampleStatusNames{{
+    {SampleStatus::ok, "ok"},
+    {SampleStatus::held, "held"},
+    {SampleStatus::late, "late"},
+    {SampleStatus::waiting, "waiting"},
+}};
+static_assert(core::one_to_one(kSampleStatusNames));
+
+/// The status's name in kSampleStatusNames.
 std::string status_name(SampleStatus status);
 
 /// The models' answer to one sample.

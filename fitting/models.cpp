@@ -102,21 +102,7 @@ Eigen::MatrixXd selected_rows(const Eigen::MatrixXd& m, const std::vector<Eigen:
 }  // namespace
 
 std::string kind_name(ModelKind kind) {
-  switch (kind) {
-    case ModelKind::no_compensation:
-      return "no_compensation";
-    case ModelKind::least_squares:
-      return "least_squares";
-    case ModelKind::ridge:
-      return "ridge";
-    case ModelKind::projection_pursuit:
-      return "projection_pursuit";
-    case ModelKind::distributed_lag:
-      return "distributed_lag";
-    case ModelKind::cnn_bigru_attention:
-      return "cnn_bigru_attention";
-  }
-  return "unknown";
+  return std::string(core::name_in(kModelKindNames, kind));
 }
 
 std::string model_label(const ModelSpec& spec) {

@@ -8,6 +8,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "fitting/features.hpp"
 #include "fitting/group.hpp"
 #include "fitting/linear.hpp"
@@ -63,8 +64,18 @@ struct ModelSpec {
   bool use_inputs = false;
 };
 
-/// "no_compensation", "least_squares", "ridge", "projection_pursuit", "distributed_lag" or
-/// "cnn_bigru_attention".
+/// The kinds' names in fit.json and reports.
+inline constexpr std::array<core::Named<ModelKind>, 6> kModelKindNames{{
+    {ModelKind::no_compensation, "no_compensation"},
+    {ModelKind::least_squares, "least_squares"},
+    {ModelKind::ridge, "ridge"},
+    {ModelKind::projection_pursuit, "projection_pursuit"},
+    {ModelKind::distributed_lag, "distributed_lag"},
+    {ModelKind::cnn_bigru_attention, "cnn_bigru_attention"},
+}};
+static_assert(core::one_to_one(kModelKindNames));
+
+/// The kind's name in kModelKindNames.
 std::string kind_name(ModelKind kind);
 
 /// A short label naming the kind and its settings, e.g. "ridge(lambda=0.001)".

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "fitting/features.hpp"
 #include "fitting/linear.hpp"
 #include "fitting/models.hpp"
@@ -38,8 +39,18 @@ enum class EffectKind {
   drift_in_time,
 };
 
-/// "speed_dependent_offset", "lagged_speed", "lag", "ambient_temperature", "missing_sensor",
-/// "drift_in_time".
+/// The terms' names in calibration.json and reports.
+inline constexpr std::array<core::Named<EffectKind>, 6> kEffectKindNames{{
+    {EffectKind::speed_dependent_offset, "speed_dependent_offset"},
+    {EffectKind::lagged_speed, "lagged_speed"},
+    {EffectKind::lag, "lag"},
+    {EffectKind::ambient_temperature, "ambient_temperature"},
+    {EffectKind::missing_sensor, "missing_sensor"},
+    {EffectKind::drift_in_time, "drift_in_time"},
+}};
+static_assert(core::one_to_one(kEffectKindNames));
+
+/// The term's name in kEffectKindNames.
 std::string effect_kind_name(EffectKind kind);
 
 /// One candidate term with its setting.

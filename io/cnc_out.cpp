@@ -427,25 +427,12 @@ std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::P
 }  // namespace
 
 std::string format_name(CncFormat format) {
-  switch (format) {
-    case CncFormat::sinumerik:
-      return "sinumerik";
-    case CncFormat::twincat:
-      return "twincat";
-    case CncFormat::heidenhain:
-      return "heidenhain";
-    case CncFormat::linuxcnc:
-      return "linuxcnc";
-  }
-  return "unknown";
+  return std::string(core::name_in(kCncFormatNames, format));
 }
 
 CncFormat format_of(const std::string& name) {
-  for (CncFormat f :
-       {CncFormat::sinumerik, CncFormat::twincat, CncFormat::heidenhain, CncFormat::linuxcnc})
-    if (format_name(f) == name) return f;
-  throw core::DataError("--format '" + name +
-                        "': expected sinumerik, twincat, heidenhain or linuxcnc");
+  if (const auto format = core::value_in(kCncFormatNames, name)) return *format;
+  throw core::DataError("--format '" + name + "': expected " + core::names_list(kCncFormatNames));
 }
 
 fitting::ControllerLaw controller_law(CncFormat format, const fitting::CncModel& model,

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "fitting/cnc_export.hpp"
 
 namespace tt::io {
@@ -16,7 +17,16 @@ namespace tt::io {
 /// The four controllers.
 enum class CncFormat { sinumerik, twincat, heidenhain, linuxcnc };
 
-/// "sinumerik", "twincat", "heidenhain", "linuxcnc".
+/// The formats' names on the command line and in export.json.
+inline constexpr std::array<core::Named<CncFormat>, 4> kCncFormatNames{{
+    {CncFormat::sinumerik, "sinumerik"},
+    {CncFormat::twincat, "twincat"},
+    {CncFormat::heidenhain, "heidenhain"},
+    {CncFormat::linuxcnc, "linuxcnc"},
+}};
+static_assert(core::one_to_one(kCncFormatNames));
+
+/// The format's name in kCncFormatNames.
 std::string format_name(CncFormat format);
 
 /// The format named `name`; DataError listing the four otherwise.

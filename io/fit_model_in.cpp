@@ -23,12 +23,9 @@ using nlohmann::json;
 constexpr double um = 1e-6;  // micrometres to metres
 
 ModelKind kind_of(const std::string& name, const Place& p, const std::string& at) {
-  for (ModelKind k :
-       {ModelKind::no_compensation, ModelKind::least_squares, ModelKind::ridge,
-        ModelKind::projection_pursuit, ModelKind::distributed_lag, ModelKind::cnn_bigru_attention})
-    if (fitting::kind_name(k) == name) return k;
-  throw core::DataError(p.at(at + "kind") + " = '" + name +
-                        "': not a model kind thermotwin writes");
+  if (const auto kind = core::value_in(fitting::kModelKindNames, name)) return *kind;
+  throw core::DataError(p.at(at + "kind") + " = '" + name + "': expected " +
+                        core::names_list(fitting::kModelKindNames));
 }
 
 /// The operating inputs a model reads: the key written since compensate exists, else the names

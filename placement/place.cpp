@@ -230,31 +230,13 @@ std::vector<int> ksg_pool_of(const std::vector<int>& pool, const LinearProblem& 
 }  // namespace
 
 std::string_view method_name(Method method) {
-  switch (method) {
-    case Method::kHistogramMi:
-      return "histogram_mi";
-    case Method::kGaussianGreedy:
-      return "gaussian_greedy";
-    case Method::kGaussianGa:
-      return "gaussian_ga";
-    case Method::kKsgGreedy:
-      return "ksg_greedy";
-    case Method::kJmiKsg:
-      return "jmi_ksg";
-    case Method::kQrPod:
-      return "qr_pod";
-    case Method::kCorrelation:
-      return "correlation";
-    case Method::kGreyRelational:
-      return "grey_relational";
-  }
-  return "unknown";
+  return core::name_in(kMethodNames, method);
 }
 
 std::vector<Method> all_methods() {
-  return {Method::kHistogramMi, Method::kGaussianGreedy, Method::kGaussianGa,
-          Method::kKsgGreedy,   Method::kJmiKsg,         Method::kQrPod,
-          Method::kCorrelation, Method::kGreyRelational};
+  std::vector<Method> methods;
+  for (const auto& entry : kMethodNames) methods.push_back(entry.value);
+  return methods;
 }
 
 PlacementResult place_all(const PlacementInput& input, const PlacementOptions& options) {

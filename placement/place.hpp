@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "core/ids.hpp"
 #include "placement/gaussian.hpp"
 #include "placement/saturation.hpp"
@@ -33,8 +34,20 @@ enum class Method {
   kGreyRelational,  ///< grey relational grade, ρ = grey_rho
 };
 
-/// Stable lower-case name used in files: "histogram_mi", "gaussian_greedy", "gaussian_ga",
-/// "ksg_greedy", "jmi_ksg", "qr_pod", "correlation", "grey_relational".
+/// Stable lower-case names used in files, in the order all_methods() lists them.
+inline constexpr std::array<core::Named<Method>, 8> kMethodNames{{
+    {Method::kHistogramMi, "histogram_mi"},
+    {Method::kGaussianGreedy, "gaussian_greedy"},
+    {Method::kGaussianGa, "gaussian_ga"},
+    {Method::kKsgGreedy, "ksg_greedy"},
+    {Method::kJmiKsg, "jmi_ksg"},
+    {Method::kQrPod, "qr_pod"},
+    {Method::kCorrelation, "correlation"},
+    {Method::kGreyRelational, "grey_relational"},
+}};
+static_assert(core::one_to_one(kMethodNames));
+
+/// The method's name in kMethodNames.
 std::string_view method_name(Method method);
 std::vector<Method> all_methods();
 

@@ -32,17 +32,7 @@ double pearson(const Eigen::Ref<const Eigen::VectorXd>& a,
 }  // namespace
 
 std::string method_name(AlignmentMethod method) {
-  switch (method) {
-    case AlignmentMethod::information_distance:
-      return "info";
-    case AlignmentMethod::cross_correlation:
-      return "xcorr";
-    case AlignmentMethod::none:
-      return "noalign";
-    case AlignmentMethod::revolution_mean:
-      return "revmean";
-  }
-  return "unknown";
+  return std::string(core::name_in(kAlignmentMethodNames, method));
 }
 
 AlignmentPlan alignment_plan(const ProbeRecord& record, const AlignmentOptions& options) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "probes/record.hpp"
 
 namespace tt::probes {
@@ -21,7 +22,16 @@ enum class AlignmentMethod {
   revolution_mean,       ///< no angle at all: the mean over whole revolutions
 };
 
-/// Short name used in file names and reports: "info", "xcorr", "noalign", "revmean".
+/// Short names used in file names and reports.
+inline constexpr std::array<core::Named<AlignmentMethod>, 4> kAlignmentMethodNames{{
+    {AlignmentMethod::information_distance, "info"},
+    {AlignmentMethod::cross_correlation, "xcorr"},
+    {AlignmentMethod::none, "noalign"},
+    {AlignmentMethod::revolution_mean, "revmean"},
+}};
+static_assert(core::one_to_one(kAlignmentMethodNames));
+
+/// The method's name in kAlignmentMethodNames.
 std::string method_name(AlignmentMethod method);
 
 struct AlignmentOptions {

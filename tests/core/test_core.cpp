@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
@@ -15,6 +16,26 @@ TEST(Errors, LocatedNamesFileAndLine) {
   EXPECT_EQ(located("a.toml", 12, "bad"), "a.toml:12: bad");
   EXPECT_EQ(located("a.toml", 0, "bad"), "a.toml: bad");
   EXPECT_THROW(throw CaseError("x"), Error);
+}
+
+namespace {
+enum class Colour { red, green, blue };
+constexpr std::array<Named<Colour>, 3> kColours{
+    {{Colour::red, "red"}, {Colour::green, "green"}, {Colour::blue, "blue"}}};
+}  // namespace
+
+TEST(EnumNames, BothDirectionsComeFromOneTable) {
+  static_assert(one_to_one(kColours));
+  for (const auto& entry : kColours) {
+    EXPECT_EQ(name_in(kColours, entry.value), entry.name);
+    EXPECT_EQ(value_in(kColours, entry.name), entry.value);
+  }
+  EXPECT_EQ(name_in(kColours, static_cast<Colour>(7)), "unknown");
+  EXPECT_FALSE(value_in(kColours, "Red").has_value());
+  EXPECT_EQ(names_list(kColours), "red, green or blue");
+  constexpr std::array<Named<Colour>, 2> same_name{{{Colour::red, "a"}, {Colour::green, "a"}}};
+  constexpr std::array<Named<Colour>, 2> same_value{{{Colour::red, "a"}, {Colour::red, "b"}}};
+  static_assert(!one_to_one(same_name) && !one_to_one(same_value));
 }
 
 TEST(Parallel, ChunksAreInOrderWhateverTheThreadCount) {
