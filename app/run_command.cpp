@@ -61,7 +61,7 @@ void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory
 /// histories `place --from` chooses sensors from when the case asks for surface candidates.
 void write_candidates(const CandidateSet& set, const solvers::ThermalHistory& th,
                       const std::filesystem::path& dir) {
-  io::write_candidates_csv(dir / kCandidatesCsv, {set.names, set.nodes, set.positions});
+  io::write_candidates_csv(dir / io::kCandidatesCsv, {set.names, set.nodes, set.positions});
   std::vector<std::string> header{"time_s"};
   for (const auto& id : set.names) header.push_back(id + "_degC");
   Eigen::MatrixXd rows(static_cast<Eigen::Index>(th.times.size()),
@@ -69,7 +69,7 @@ void write_candidates(const CandidateSet& set, const solvers::ThermalHistory& th
   rows.col(0) = Eigen::Map<const Eigen::VectorXd>(th.times.data(), rows.rows());
   rows.rightCols(rows.cols() - 1) =
       solvers::nodal_history(th, set.nodes).array() - core::kCelsiusOffset;
-  io::write_csv(dir / kCandidateTemperaturesCsv, header, rows);
+  io::write_csv(dir / io::kCandidateTemperaturesCsv, header, rows);
 }
 
 /// thermal_error.csv: the TCP and probe columns, then the feed axis's points when there are any.

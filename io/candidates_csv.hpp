@@ -12,6 +12,10 @@
 
 namespace tt::io {
 
+/// Run-directory files of the surface candidates (written by `run` when candidates = "surface").
+inline constexpr const char* kCandidatesCsv = "candidates.csv";
+inline constexpr const char* kCandidateTemperaturesCsv = "candidate_temperatures.csv";
+
 struct CandidateTable {
   std::vector<std::string> ids;
   std::vector<int> nodes;      /// #candidates mesh node

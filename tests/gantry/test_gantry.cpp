@@ -11,7 +11,6 @@
 #include <string>
 
 #include "app/axis_fit.hpp"
-#include "app/study.hpp"
 #include "core/errors.hpp"
 #include "fitting/cnc_export.hpp"
 #include "io/case_reader.hpp"
@@ -26,6 +25,7 @@
 #include "solvers/thermal_error.hpp"
 #include "solvers/thermal_stepper.hpp"
 #include "solvers/virtual_machine.hpp"
+#include "studies/histories.hpp"
 #include "tests/common/gantry_bar.hpp"
 
 namespace tt::gantry_test {
@@ -222,7 +222,7 @@ TEST(Gm1Case, ReadsResolvesAndRoundTrips) {
 
 TEST(Gm1Case, TargetsComeFromTheCaseAndAxisPointsAreNoCandidates) {
   core::CaseSpec s = io::read_case(std::string(TT_SOURCE_DIR) + "/cases/gm1_coarse.toml");
-  const auto cand = app::candidate_points(s);
+  const auto cand = studies::candidate_points(s);
   EXPECT_EQ(cand.size(), 37u);
   for (int c : cand) {
     EXPECT_NE(s.points[c].id[0], 'A') << s.points[c].id;
@@ -233,13 +233,13 @@ TEST(Gm1Case, TargetsComeFromTheCaseAndAxisPointsAreNoCandidates) {
   const Eigen::MatrixXd temps =
       Eigen::MatrixXd::Random(3, static_cast<Eigen::Index>(s.points.size()));
   Eigen::MatrixXd error = Eigen::MatrixXd::Random(3, solvers::kThermalErrorColumns);
-  const app::Histories h = app::histories_from_points(s, times, temps, error);
+  const studies::Histories h = studies::histories_from_points(s, times, temps, error);
   EXPECT_EQ(h.target_names, (std::vector<std::string>{"dx", "dz"}));
   ASSERT_EQ(h.targets.cols(), 2);
   EXPECT_EQ(h.targets.col(0), error.col(solvers::kDx));
   EXPECT_EQ(h.targets.col(1), error.col(solvers::kDz));
   EXPECT_EQ(h.temperature.cols(), 37);
-  EXPECT_THROW(app::target_column("tilt"), core::CaseError);
+  EXPECT_THROW(studies::target_column("tilt"), core::CaseError);
 }
 
 TEST(Gm1Case, BadFeedAxisInputIsRefused) {

@@ -13,13 +13,13 @@
 #include <set>
 #include <string>
 
-#include "app/study.hpp"
 #include "core/errors.hpp"
 #include "io/candidates_csv.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/campaign.hpp"
 #include "solvers/thermal.hpp"
+#include "studies/histories.hpp"
 #include "tests/common/case_toml.hpp"
 
 namespace tt::candidates_test {
@@ -93,7 +93,7 @@ TEST_P(SurfaceCandidates, AreTheCornerVerticesOfTheBodysOutside) {
   const int order = GetParam();
   const core::CaseSpec spec = spec_of(order, kSurfaceBlock);
   const mesh::TetMesh m = mesh::mesh_case(spec);
-  const app::CandidateSet set = app::candidate_set(spec, m);
+  const studies::CandidateSet set = studies::candidate_set(spec, m);
 
   const std::vector<int> expected = block_outside_nodes(m, true);
   ASSERT_GT(expected.size(), 20u);
@@ -121,7 +121,7 @@ TEST(SurfaceCandidateSet, GroupsNamedPointsAndThinning) {
   const core::CaseSpec base =
       spec_of(1, "[placement]\ncandidates = \"surface\"\ngroups = [\"base\"]\n");
   const mesh::TetMesh m = mesh::mesh_case(base);
-  const auto on_base = app::candidate_set(base, m);
+  const auto on_base = studies::candidate_set(base, m);
   std::vector<int> expected;
   for (int n = 0; n < m.corner_count; ++n)
     if (near(m.nodes(n, 2), 0)) expected.push_back(n);
@@ -129,7 +129,7 @@ TEST(SurfaceCandidateSet, GroupsNamedPointsAndThinning) {
 
   // A listed named point comes first under its id, and its vertex is not listed twice.
   const core::CaseSpec with_point = spec_of(1, kSurfaceBlock + "points = [\"S1\"]\n");
-  const auto all = app::candidate_set(with_point, m);  // same geometry: the same mesh
+  const auto all = studies::candidate_set(with_point, m);  // same geometry: the same mesh
   const int s1 = mesh::named_node(m, "S1");
   ASSERT_GE(s1, 0);
   EXPECT_EQ(all.names.front(), "S1");
@@ -140,7 +140,7 @@ TEST(SurfaceCandidateSet, GroupsNamedPointsAndThinning) {
   // Thinned: as many as asked, a subset, spread out: farthest-point sampling leaves no vertex
   // farther from the chosen ones than the closest two chosen ones are from each other.
   const core::CaseSpec thin = spec_of(1, kSurfaceBlock + "max_candidates = 25\n");
-  const auto few = app::candidate_set(thin, m);
+  const auto few = studies::candidate_set(thin, m);
   ASSERT_EQ(few.nodes.size(), 25u);
   const auto full = block_outside_nodes(m, true);
   EXPECT_TRUE(std::includes(full.begin(), full.end(), few.nodes.begin(), few.nodes.end()));
@@ -161,13 +161,13 @@ TEST(SurfaceCandidateSet, GroupsNamedPointsAndThinning) {
 TEST(SurfaceCandidateSet, CampaignHistoriesEqualTheNodalTemperaturesOfADirectRun) {
   const core::CaseSpec spec = spec_of(1, kSurfaceBlock + "points = [\"S1\"]\n");
   const mesh::TetMesh m = mesh::mesh_case(spec);
-  const app::CandidateSet set = app::candidate_set(spec, m);
+  const studies::CandidateSet set = studies::candidate_set(spec, m);
   const auto results =
       solvers::simulate_campaign(m, spec, {{"case", "the case", spec}}, {}, set.nodes);
   ASSERT_EQ(results.size(), 1u);
   const auto& r = results[0];
-  const app::Histories h =
-      app::histories_from_nodes(spec, set, r.times, r.node_temperature, r.error);
+  const studies::Histories h =
+      studies::histories_from_nodes(spec, set, r.times, r.node_temperature, r.error);
 
   const solvers::ThermalHistory direct =
       solvers::thermal_history(m, spec, solvers::thermal_system(m, spec));
@@ -197,9 +197,10 @@ TEST(SurfaceCandidateSet, CampaignHistoriesEqualTheNodalTemperaturesOfADirectRun
 TEST(SurfaceCandidateSet, NamedPointsModeIsTodaysCandidatesOrTheListedOnes) {
   const core::CaseSpec all = spec_of(1, "");
   const mesh::TetMesh m = mesh::mesh_case(all);
-  EXPECT_EQ(app::candidate_set(all, m).names, std::vector<std::string>{"S1"});  // not TCP, Z1, Z2
+  EXPECT_EQ(studies::candidate_set(all, m).names,
+            std::vector<std::string>{"S1"});  // not TCP, Z1, Z2
   const core::CaseSpec listed = spec_of(1, "[placement]\npoints = [\"S1\"]\n");
-  EXPECT_EQ(app::candidate_set(listed, m).nodes, std::vector<int>{mesh::named_node(m, "S1")});
+  EXPECT_EQ(studies::candidate_set(listed, m).nodes, std::vector<int>{mesh::named_node(m, "S1")});
 }
 
 TEST(SurfaceCandidateSet, BadNamesAreCaseErrorsNamingKeyAndValue) {
