@@ -1415,6 +1415,180 @@ std::string selector_text(const core::FaceSelector& s, const Names& bodies) {
   return t + " }";
 }
 
+/// [case], [geometry] (always m), the materials, the bodies, [mesh] and the boundary groups.
+std::string model_toml(const CaseSpec& spec, const Names& bodies) {
+  std::ostringstream o;
+  o << "# Resolved case: SI units, every default explicit. Read from "
+    << fs::absolute(spec.source).lexically_normal().string()
+    << "\n\n[case]\nname = " << toml_string(spec.name)
+    << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
+    << "\n\n[geometry]\nlength_unit = \"m\"\n";
+  for (const auto& m : spec.materials) {
+    o << "\n[materials." << key_text(m.name) << "]\ndensity_kg_m3 = " << number_text(m.density)
+      << "\nspecific_heat_J_kgK = " << number_text(m.specific_heat)
+      << "\nconductivity_W_mK = " << number_text(m.conductivity)
+      << "\nyoungs_modulus_Pa = " << number_text(m.youngs_modulus)
+      << "\npoisson_ratio = " << number_text(m.poisson_ratio)
+      << "\nexpansion_per_K = " << number_text(m.expansion) << "\n";
+  }
+  for (const auto& b : spec.bodies) {
+    o << "\n[[bodies]]\nname = " << toml_string(b.name)
+      << "\nmaterial = " << toml_string(spec.materials.at(b.material).name)
+      << "\nmax_edge = " << number_text(b.max_edge) << "\nadd = " << primitives_text(b.add)
+      << "\nsubtract = " << primitives_text(b.subtract) << "\n";
+  }
+  o << "\n[mesh]\norder = " << spec.mesh.order
+    << "\ncircle_segments = " << spec.mesh.circle_segments
+    << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
+    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg)
+    << "\nmax_tets = " << number_text(spec.mesh.max_tets)
+    << "\ntime_limit_s = " << number_text(spec.mesh.time_limit_s)
+    << "\nmemory_limit_GB = " << number_text(spec.mesh.memory_limit_GB) << "\n";
+  for (const auto& g : spec.groups) {
+    o << "\n[[boundary]]\nname = " << toml_string(g.name)
+      << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";
+    for (const auto& s : g.select) o << "  " << selector_text(s, bodies) << ",\n";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+/// One [[thermal.convection]] entry; a constant sink is written as sink_degC.
+std::string convection_toml(const core::Convection& c, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[[thermal.convection]]\ngroup = " << toml_string(groups.at(c.group))
+    << "\nh_W_m2K = " << number_text(c.h)
+    << "\nh_speed_gain_W_m2K = " << number_text(c.h_speed_gain)
+    << "\nspeed_ref_rpm = " << number_text(c.speed_ref_rpm)
+    << "\nspeed_exponent = " << number_text(c.speed_exponent) << "\n";
+  if (c.sink.time.size() == 1 && c.sink.time[0] == 0) {
+    o << "sink_degC = " << number_text(c.sink.value.at(0)) << "\n";
+  } else {
+    o << "sink_table = [";
+    for (std::size_t i = 0; i < c.sink.time.size(); ++i)
+      o << (i ? ", [" : "[") << number_text(c.sink.time[i]) << ", "
+        << number_text(c.sink.value.at(i)) << "]";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+/// One [[thermal.heat_sources]] entry with exactly the keys its law uses.
+std::string heat_source_toml(const core::HeatSource& s, const Names& bodies) {
+  using Law = core::HeatSource::Law;
+  std::ostringstream o;
+  o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
+    << "\nbody = " << toml_string(bodies.at(s.body))
+    << "\nlaw = " << toml_string(name_of(kLaws, s.law)) << "\n";
+  if (s.law == Law::speed_power) {
+    o << "power_ref_W = " << number_text(s.power_ref)
+      << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
+      << "\nexponent = " << number_text(s.exponent) << "\n";
+  } else if (s.law == Law::constant) {
+    o << "power_ref_W = " << number_text(s.power_ref) << "\n";
+  } else if (s.law == Law::feed_power) {
+    o << "power_ref_W = " << number_text(s.power_ref)
+      << "\nref_feed_m_s = " << number_text(s.ref_feed)
+      << "\nexponent = " << number_text(s.exponent) << "\n";
+  } else {
+    o << "palmgren_f0 = " << number_text(s.palmgren_f0)
+      << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
+      << "\npalmgren_dm = " << number_text(s.palmgren_dm)
+      << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
+      << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
+  }
+  o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
+  if (s.window > 0)
+    o << "moving = { window = " << number_text(s.window)
+      << ", offset = " << number_text(s.window_offset) << " }\n";
+  return o.str();
+}
+
+/// [thermal] with its convection, heat sources and surface fluxes.
+std::string thermal_toml(const core::ThermalSpec& th, const Names& bodies, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
+    << "\nscheme = " << toml_string(name_of(kSchemes, th.scheme))
+    << "\nstep_s = " << number_text(th.step)
+    << "\noutput_interval_s = " << number_text(th.output_interval)
+    << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
+  for (const auto& c : th.convection) o << convection_toml(c, groups);
+  for (const auto& s : th.sources) o << heat_source_toml(s, bodies);
+  for (const auto& f : th.fluxes) {
+    o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
+      << "\nflux_W_m2 = " << number_text(f.flux)
+      << "\nfollows_speed = " << (f.follows_speed ? "true" : "false") << "\n";
+    if (f.follows_speed) o << "ref_speed_rpm = " << number_text(f.ref_speed_rpm) << "\n";
+  }
+  return o.str();
+}
+
+/// [duty_cycle] with its segments listed, and [feed_axis] when there is one.
+std::string motion_toml(const CaseSpec& spec) {
+  std::ostringstream o;
+  o << "\n[duty_cycle]\nend_s = " << number_text(spec.duty_cycle.end) << "\nsegments = [\n";
+  for (const auto& s : spec.duty_cycle.segments)
+    o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
+      << " },\n";
+  o << "]\n";
+  if (!spec.feed_axis.segments.empty()) {
+    const auto& ax = spec.feed_axis;
+    o << "\n[feed_axis]\nname = " << toml_string(ax.name) << "\ndirection = \""
+      << "xyz"[ax.direction] << "\"\nsegments = [\n";
+    for (const auto& s : ax.segments)
+      o << "  { start_s = " << number_text(s.start) << ", from = " << number_text(s.from)
+        << ", to = " << number_text(s.to) << ", feed_m_s = " << number_text(s.feed) << " },\n";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+std::string mechanical_toml(const core::MechanicalSpec& me, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
+    << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
+    << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
+  for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
+    const auto& ps = me.point_supports[i];
+    Names dirs;
+    for (int d = 0; d < 3; ++d)
+      if (ps.fixed[d]) dirs.push_back(std::string(1, "xyz"[d]));
+    o << (i ? ", " : "") << "{ point = " << toml_string(ps.point)
+      << ", fixed = " << strings_text(dirs) << " }";
+  }
+  o << "]\n";
+  if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
+  o << "probes = " << strings_text(me.probe_points) << "\n";
+  o << "targets = " << strings_text(me.targets) << "\n";
+  if (!me.axis_points.empty())
+    o << "axis_points = " << strings_text(me.axis_points)
+      << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
+  return o.str();
+}
+
+/// [outputs], [placement] and the named [points].
+std::string outputs_toml(const CaseSpec& spec, const Names& bodies, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
+    << "\nfields = " << (spec.outputs.fields ? "true" : "false")
+    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
+  const auto& pl = spec.placement;
+  o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
+    << "\npoints = " << strings_text(pl.points) << "\n";
+  if (pl.candidates == core::PlacementSpec::Candidates::surface)
+    o << "bodies = " << names_text(pl.bodies, bodies)
+      << "\ngroups = " << names_text(pl.groups, groups)
+      << "\nmax_candidates = " << pl.max_candidates << "\n";
+  o << "\n[points]\nlist = [\n";
+  for (const auto& p : spec.points) {
+    o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
+    if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));
+    o << " },\n";
+  }
+  o << "]\n";
+  return o.str();
+}
+
 }  // namespace
 
 CaseSpec case_from_toml(std::string_view text, const fs::path& file) {
@@ -1485,147 +1659,16 @@ std::vector<fs::path> case_input_files(const CaseSpec& spec) {
 }
 
 std::string resolved_case_toml(const CaseSpec& spec) {
-  using Law = core::HeatSource::Law;
   const Names bodies = names_of(spec.bodies);
   const Names groups = names_of(spec.groups);
-  std::ostringstream o;
-  o << "# Resolved case: SI units, every default explicit. Read from "
-    << fs::absolute(spec.source).lexically_normal().string()
-    << "\n\n[case]\nname = " << toml_string(spec.name)
-    << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
-    << "\n\n[geometry]\nlength_unit = \"m\"\n";
-  for (const auto& m : spec.materials) {
-    o << "\n[materials." << key_text(m.name) << "]\ndensity_kg_m3 = " << number_text(m.density)
-      << "\nspecific_heat_J_kgK = " << number_text(m.specific_heat)
-      << "\nconductivity_W_mK = " << number_text(m.conductivity)
-      << "\nyoungs_modulus_Pa = " << number_text(m.youngs_modulus)
-      << "\npoisson_ratio = " << number_text(m.poisson_ratio)
-      << "\nexpansion_per_K = " << number_text(m.expansion) << "\n";
-  }
-  for (const auto& b : spec.bodies) {
-    o << "\n[[bodies]]\nname = " << toml_string(b.name)
-      << "\nmaterial = " << toml_string(spec.materials.at(b.material).name)
-      << "\nmax_edge = " << number_text(b.max_edge) << "\nadd = " << primitives_text(b.add)
-      << "\nsubtract = " << primitives_text(b.subtract) << "\n";
-  }
-  o << "\n[mesh]\norder = " << spec.mesh.order
-    << "\ncircle_segments = " << spec.mesh.circle_segments
-    << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
-    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg)
-    << "\nmax_tets = " << number_text(spec.mesh.max_tets)
-    << "\ntime_limit_s = " << number_text(spec.mesh.time_limit_s)
-    << "\nmemory_limit_GB = " << number_text(spec.mesh.memory_limit_GB) << "\n";
-  for (const auto& g : spec.groups) {
-    o << "\n[[boundary]]\nname = " << toml_string(g.name)
-      << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";
-    for (const auto& s : g.select) o << "  " << selector_text(s, bodies) << ",\n";
-    o << "]\n";
-  }
-  const auto& th = spec.thermal;
-  o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
-    << "\nscheme = " << toml_string(name_of(kSchemes, th.scheme))
-    << "\nstep_s = " << number_text(th.step)
-    << "\noutput_interval_s = " << number_text(th.output_interval)
-    << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
-  for (const auto& c : th.convection) {
-    o << "\n[[thermal.convection]]\ngroup = " << toml_string(groups.at(c.group))
-      << "\nh_W_m2K = " << number_text(c.h)
-      << "\nh_speed_gain_W_m2K = " << number_text(c.h_speed_gain)
-      << "\nspeed_ref_rpm = " << number_text(c.speed_ref_rpm)
-      << "\nspeed_exponent = " << number_text(c.speed_exponent) << "\n";
-    if (c.sink.time.size() == 1 && c.sink.time[0] == 0) {
-      o << "sink_degC = " << number_text(c.sink.value.at(0)) << "\n";
-    } else {
-      o << "sink_table = [";
-      for (std::size_t i = 0; i < c.sink.time.size(); ++i)
-        o << (i ? ", [" : "[") << number_text(c.sink.time[i]) << ", "
-          << number_text(c.sink.value.at(i)) << "]";
-      o << "]\n";
-    }
-  }
-  for (const auto& s : th.sources) {
-    o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
-      << "\nbody = " << toml_string(bodies.at(s.body))
-      << "\nlaw = " << toml_string(name_of(kLaws, s.law)) << "\n";
-    if (s.law == Law::speed_power) {
-      o << "power_ref_W = " << number_text(s.power_ref)
-        << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
-        << "\nexponent = " << number_text(s.exponent) << "\n";
-    } else if (s.law == Law::constant) {
-      o << "power_ref_W = " << number_text(s.power_ref) << "\n";
-    } else if (s.law == Law::feed_power) {
-      o << "power_ref_W = " << number_text(s.power_ref)
-        << "\nref_feed_m_s = " << number_text(s.ref_feed)
-        << "\nexponent = " << number_text(s.exponent) << "\n";
-    } else {
-      o << "palmgren_f0 = " << number_text(s.palmgren_f0)
-        << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
-        << "\npalmgren_dm = " << number_text(s.palmgren_dm)
-        << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
-        << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
-    }
-    o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
-    if (s.window > 0)
-      o << "moving = { window = " << number_text(s.window)
-        << ", offset = " << number_text(s.window_offset) << " }\n";
-  }
-  for (const auto& f : th.fluxes) {
-    o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
-      << "\nflux_W_m2 = " << number_text(f.flux)
-      << "\nfollows_speed = " << (f.follows_speed ? "true" : "false") << "\n";
-    if (f.follows_speed) o << "ref_speed_rpm = " << number_text(f.ref_speed_rpm) << "\n";
-  }
-  o << "\n[duty_cycle]\nend_s = " << number_text(spec.duty_cycle.end) << "\nsegments = [\n";
-  for (const auto& s : spec.duty_cycle.segments)
-    o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
-      << " },\n";
-  o << "]\n";
-  if (!spec.feed_axis.segments.empty()) {
-    const auto& ax = spec.feed_axis;
-    o << "\n[feed_axis]\nname = " << toml_string(ax.name) << "\ndirection = \""
-      << "xyz"[ax.direction] << "\"\nsegments = [\n";
-    for (const auto& s : ax.segments)
-      o << "  { start_s = " << number_text(s.start) << ", from = " << number_text(s.from)
-        << ", to = " << number_text(s.to) << ", feed_m_s = " << number_text(s.feed) << " },\n";
-    o << "]\n";
-  }
-  const auto& me = spec.mechanical;
-  o << "\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
-    << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
-    << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
-  for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
-    const auto& ps = me.point_supports[i];
-    Names dirs;
-    for (int d = 0; d < 3; ++d)
-      if (ps.fixed[d]) dirs.push_back(std::string(1, "xyz"[d]));
-    o << (i ? ", " : "") << "{ point = " << toml_string(ps.point)
-      << ", fixed = " << strings_text(dirs) << " }";
-  }
-  o << "]\n";
-  if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
-  o << "probes = " << strings_text(me.probe_points) << "\n";
-  o << "targets = " << strings_text(me.targets) << "\n";
-  if (!me.axis_points.empty())
-    o << "axis_points = " << strings_text(me.axis_points)
-      << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
-  o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
-    << "\nfields = " << (spec.outputs.fields ? "true" : "false")
-    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
-  const auto& pl = spec.placement;
-  o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
-    << "\npoints = " << strings_text(pl.points) << "\n";
-  if (pl.candidates == core::PlacementSpec::Candidates::surface)
-    o << "bodies = " << names_text(pl.bodies, bodies)
-      << "\ngroups = " << names_text(pl.groups, groups)
-      << "\nmax_candidates = " << pl.max_candidates << "\n";
-  o << "\n[points]\nlist = [\n";
-  for (const auto& p : spec.points) {
-    o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
-    if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));
-    o << " },\n";
-  }
-  o << "]\n";
-  return o.str();
+  // One section after the other, so that the first section that cannot be written is the one
+  // reported.
+  std::string out = model_toml(spec, bodies);
+  out += thermal_toml(spec.thermal, bodies, groups);
+  out += motion_toml(spec);
+  out += mechanical_toml(spec.mechanical, groups);
+  out += outputs_toml(spec, bodies, groups);
+  return out;
 }
 
 }  // namespace tt::io
