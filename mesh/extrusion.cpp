@@ -197,87 +197,126 @@ Ring ring_of(const Pslg& g, const std::vector<int>& ids) {
   return r;
 }
 
-Arrangement arrangement(const Pslg& g) {
-  const int nv = static_cast<int>(g.vertices.size());
-  const int nh = 2 * static_cast<int>(g.edges.size());
-  auto origin = [&](int h) { return g.edges[h / 2][h % 2]; };
-  auto dest = [&](int h) { return g.edges[h / 2][1 - h % 2]; };
-  std::vector<std::vector<int>> out(nv);
-  for (int h = 0; h < nh; ++h) out[origin(h)].push_back(h);
-  for (int v = 0; v < nv; ++v) {
-    auto angle = [&](int h) {
-      const Vector2d d = g.vertices[dest(h)] - g.vertices[v];
-      return std::atan2(d.y(), d.x());
-    };
-    std::sort(out[v].begin(), out[v].end(), [&](int a, int b) { return angle(a) < angle(b); });
-  }
-  std::vector<int> pos(nh);
-  for (int v = 0; v < nv; ++v)
-    for (size_t k = 0; k < out[v].size(); ++k) pos[out[v][k]] = static_cast<int>(k);
-  auto next = [&](int h) {
+/// The half-edges of a graph, 2e (a->b) and 2e+1 (b->a), with those leaving each vertex sorted
+/// by angle, so that `next` walks the boundary of the face on a half-edge's left.
+struct HalfEdges {
+  const Pslg* g = nullptr;
+  std::vector<std::vector<int>> out;  /// per vertex: its outgoing half-edges by angle
+  std::vector<int> pos;               /// per half-edge: its index in out[origin]
+
+  int count() const { return 2 * static_cast<int>(g->edges.size()); }
+  int origin(int h) const { return g->edges[h / 2][h % 2]; }
+  int dest(int h) const { return g->edges[h / 2][1 - h % 2]; }
+  int next(int h) const {
     const int v = dest(h);
     const int twin = h ^ 1;
     const int deg = static_cast<int>(out[v].size());
     return out[v][(pos[twin] - 1 + deg) % deg];
-  };
+  }
+};
 
-  // Components, for telling a hole's container from its own outer cycle.
-  std::vector<int> comp(nv);
+HalfEdges half_edges(const Pslg& g) {
+  HalfEdges he{&g, {}, {}};
+  const int nv = static_cast<int>(g.vertices.size());
+  he.out.resize(nv);
+  for (int h = 0; h < he.count(); ++h) he.out[he.origin(h)].push_back(h);
+  for (int v = 0; v < nv; ++v) {
+    auto angle = [&](int h) {
+      const Vector2d d = g.vertices[he.dest(h)] - g.vertices[v];
+      return std::atan2(d.y(), d.x());
+    };
+    std::sort(he.out[v].begin(), he.out[v].end(),
+              [&](int a, int b) { return angle(a) < angle(b); });
+  }
+  he.pos.resize(he.count());
+  for (int v = 0; v < nv; ++v)
+    for (size_t k = 0; k < he.out[v].size(); ++k) he.pos[he.out[v][k]] = static_cast<int>(k);
+  return he;
+}
+
+/// Per vertex, a representative of its connected component: a hole's container must belong to
+/// another component than the hole's own outer cycle.
+std::vector<int> components(const Pslg& g) {
+  std::vector<int> comp(g.vertices.size());
   std::iota(comp.begin(), comp.end(), 0);
   std::function<int(int)> find = [&](int x) { return comp[x] == x ? x : comp[x] = find(comp[x]); };
   for (const auto& e : g.edges) comp[find(e[0])] = find(e[1]);
+  std::vector<int> root(comp.size());
+  for (size_t v = 0; v < comp.size(); ++v) root[v] = find(static_cast<int>(v));
+  return root;
+}
 
-  struct Cycle {
-    std::vector<int> halfedges;
-    std::vector<int> ring;
-    double area;
-    int component;
-  };
-  std::vector<Cycle> cycles;
-  std::vector<int> cycle_of(nh, -1);
-  for (int h0 = 0; h0 < nh; ++h0) {
-    if (cycle_of[h0] >= 0) continue;
+/// A closed walk of half-edges: the outer boundary of a face (area > 0) or a hole (area <= 0).
+struct Cycle {
+  std::vector<int> ring;  /// vertices
+  double area;
+  int component;
+};
+
+/// Every half-edge's cycle; `of_halfedge` maps a half-edge to its index in `list`.
+struct Cycles {
+  std::vector<Cycle> list;
+  std::vector<int> of_halfedge;
+};
+
+Cycles boundary_cycles(const Pslg& g, const HalfEdges& he) {
+  const std::vector<int> component = components(g);
+  Cycles cycles{{}, std::vector<int>(he.count(), -1)};
+  for (int h0 = 0; h0 < he.count(); ++h0) {
+    if (cycles.of_halfedge[h0] >= 0) continue;
     Cycle c;
     int h = h0;
     do {
-      cycle_of[h] = static_cast<int>(cycles.size());
-      c.halfedges.push_back(h);
-      c.ring.push_back(origin(h));
-      h = next(h);
+      cycles.of_halfedge[h] = static_cast<int>(cycles.list.size());
+      c.ring.push_back(he.origin(h));
+      h = he.next(h);
     } while (h != h0);
     c.area = signed_area(ring_of(g, c.ring));
-    c.component = find(c.ring[0]);
-    cycles.push_back(std::move(c));
+    c.component = component[c.ring[0]];
+    cycles.list.push_back(std::move(c));
   }
+  return cycles;
+}
 
-  Arrangement arr;
-  std::vector<int> face_of_cycle(cycles.size(), -1);
-  for (size_t c = 0; c < cycles.size(); ++c) {
-    if (cycles[c].area > 0) {
-      face_of_cycle[c] = static_cast<int>(arr.faces.size());
-      arr.faces.push_back(Face{cycles[c].ring, {}});
+/// The smallest outer cycle of another component that contains hole cycle `c`; -1 when none
+/// does (the hole bounds the unbounded face).
+int enclosing_cycle(const Pslg& g, const std::vector<Cycle>& cycles, size_t c) {
+  const Vector2d p = g.vertices[cycles[c].ring[0]];
+  int best = -1;
+  double best_area = 0;
+  for (size_t d = 0; d < cycles.size(); ++d) {
+    if (cycles[d].area <= 0 || cycles[d].component == cycles[c].component) continue;
+    if (!ring_contains(ring_of(g, cycles[d].ring), p)) continue;
+    if (best < 0 || cycles[d].area < best_area) {
+      best = static_cast<int>(d);
+      best_area = cycles[d].area;
     }
   }
-  for (size_t c = 0; c < cycles.size(); ++c) {
-    if (cycles[c].area > 0) continue;
-    const Vector2d p = g.vertices[cycles[c].ring[0]];
-    int best = -1;
-    double best_area = 0;
-    for (size_t d = 0; d < cycles.size(); ++d) {
-      if (cycles[d].area <= 0 || cycles[d].component == cycles[c].component) continue;
-      if (!ring_contains(ring_of(g, cycles[d].ring), p)) continue;
-      if (best < 0 || cycles[d].area < best_area) {
-        best = static_cast<int>(d);
-        best_area = cycles[d].area;
-      }
+  return best;
+}
+
+Arrangement arrangement(const Pslg& g) {
+  const HalfEdges he = half_edges(g);
+  const Cycles cycles = boundary_cycles(g, he);
+  const std::vector<Cycle>& list = cycles.list;
+  Arrangement arr;
+  std::vector<int> face_of_cycle(list.size(), -1);
+  for (size_t c = 0; c < list.size(); ++c) {
+    if (list[c].area > 0) {
+      face_of_cycle[c] = static_cast<int>(arr.faces.size());
+      arr.faces.push_back(Face{list[c].ring, {}});
     }
+  }
+  for (size_t c = 0; c < list.size(); ++c) {
+    if (list[c].area > 0) continue;
+    const int best = enclosing_cycle(g, list, c);
     if (best >= 0) {
       face_of_cycle[c] = face_of_cycle[best];
-      arr.faces[face_of_cycle[best]].holes.push_back(cycles[c].ring);
+      arr.faces[face_of_cycle[best]].holes.push_back(list[c].ring);
     }
   }
-  arr.halfedge_face.assign(nh, -1);
-  for (int h = 0; h < nh; ++h) arr.halfedge_face[h] = face_of_cycle[cycle_of[h]];
+  arr.halfedge_face.assign(he.count(), -1);
+  for (int h = 0; h < he.count(); ++h) arr.halfedge_face[h] = face_of_cycle[cycles.of_halfedge[h]];
   return arr;
 }
 
