@@ -851,54 +851,80 @@ void check_surface_bodies_clear(const core::CaseSpec& spec,
   }
 }
 
-}  // namespace
-
-ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
-  // 1. Surface-file bodies are read and checked; the others go to the extrusion.
+/// The surface-file bodies of a case, each read and checked.
+std::vector<SurfaceBody> surface_bodies(const core::CaseSpec& spec) {
   std::vector<SurfaceBody> surfaces;
   for (size_t b = 0; b < spec.bodies.size(); ++b)
     if (is_surface_body(spec.bodies[b]))
       surfaces.push_back(surface_body(spec, static_cast<int>(b)));
-  if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
-  check_surface_bodies_clear(spec, surfaces);
+  return surfaces;
+}
 
-  // 2. Named points on or in a surface body belong to it; the others to the extrusion.
+/// 1e-9 of the diagonal of all bodies' bounds [m].
+double geometry_tolerance(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces) {
   Eigen::AlignedBox3d extent;
   for (const auto& s : surfaces) extent.extend(s.bounds);
   for (const auto& b : spec.bodies)
     if (!is_surface_body(b))
       for (const auto& p : b.add) extent.extend(primitive_bounds(p));
-  const double tol = 1e-9 * extent.diagonal().norm();
+  return 1e-9 * extent.diagonal().norm();
+}
+
+/// Which surface body each named point lies on or in (the first one that has it), and where.
+struct SurfacePoints {
+  std::vector<int> surface;                   /// per named point: index into surfaces, or -1
+  std::vector<cgal::PointLocation> location;  /// per named point, where surface >= 0
+};
+
+SurfacePoints surface_points(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces,
+                             double tol) {
+  using Kind = cgal::PointLocation::Kind;
   std::vector<Vector3d> positions;
   for (const auto& p : spec.points) positions.push_back(p.position);
-  using Kind = cgal::PointLocation::Kind;
-  std::vector<int> point_surface(spec.points.size(), -1);
-  std::vector<cgal::PointLocation> location(spec.points.size());
+  SurfacePoints out{std::vector<int>(spec.points.size(), -1),
+                    std::vector<cgal::PointLocation>(spec.points.size())};
   for (size_t s = 0; s < surfaces.size(); ++s) {
     const auto located = cgal::locate_points(surfaces[s].solid.surface, positions, tol);
     for (size_t i = 0; i < located.size(); ++i)
-      if (point_surface[i] < 0 && located[i].kind != Kind::outside)
-        point_surface[i] = static_cast<int>(s), location[i] = located[i];
+      if (out.surface[i] < 0 && located[i].kind != Kind::outside)
+        out.surface[i] = static_cast<int>(s), out.location[i] = located[i];
   }
-  core::CaseSpec extruded = spec;
-  extruded.bodies.clear();
-  extruded.points.clear();
-  std::vector<int> extruded_body, extruded_point;  // reduced index -> index in spec
+  return out;
+}
+
+/// The case reduced to its z-extruded bodies and the named points off every surface body, with
+/// the maps from reduced indices back to the whole case.
+struct ExtrudedSubset {
+  core::CaseSpec spec;
+  std::vector<int> body;   /// reduced body index -> index in the whole case
+  std::vector<int> point;  /// reduced point index -> index in the whole case
+};
+
+ExtrudedSubset extruded_subset(const core::CaseSpec& spec, const SurfacePoints& on_surface) {
+  ExtrudedSubset sub{spec, {}, {}};
+  sub.spec.bodies.clear();
+  sub.spec.points.clear();
   for (size_t b = 0; b < spec.bodies.size(); ++b)
     if (!is_surface_body(spec.bodies[b])) {
-      extruded.bodies.push_back(spec.bodies[b]);
-      extruded_body.push_back(static_cast<int>(b));
+      sub.spec.bodies.push_back(spec.bodies[b]);
+      sub.body.push_back(static_cast<int>(b));
     }
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (point_surface[i] < 0) {
-      extruded.points.push_back(spec.points[i]);
-      extruded_point.push_back(static_cast<int>(i));
+    if (on_surface.surface[i] < 0) {
+      sub.spec.points.push_back(spec.points[i]);
+      sub.point.push_back(static_cast<int>(i));
     }
+  return sub;
+}
 
-  // 3. The extruded bodies, with body and point indices mapped back to the whole case.
+/// The PLC of the extruded bodies, with body and point indices mapped back to the whole case
+/// (point_vertex has an entry per named point of `spec`); no hole point falls in a surface body.
+ExtrudedPlc extruded_subset_plc(const core::CaseSpec& spec, const ExtrudedSubset& sub,
+                                const std::vector<SurfaceBody>& surfaces) {
+  using Kind = cgal::PointLocation::Kind;
   ExtrudedPlc result;
   result.point_vertex.assign(spec.points.size(), -1);
-  if (!extruded.bodies.empty()) {
+  if (!sub.spec.bodies.empty()) {
     auto is_free = [&](const Vector3d& p) {
       for (const auto& s : surfaces)
         if (s.bounds.contains(p) &&
@@ -906,81 +932,118 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
           return false;
       return true;
     };
-    ExtrudedPlc part = extruded_part(extruded, is_free);
-    for (auto& r : part.plc.regions) r.region = extruded_body[r.region];
-    for (size_t i = 0; i < extruded_point.size(); ++i)
-      result.point_vertex[extruded_point[i]] = part.point_vertex[i];
+    ExtrudedPlc part = extruded_part(sub.spec, is_free);
+    for (auto& r : part.plc.regions) r.region = sub.body[r.region];
+    for (size_t i = 0; i < sub.point.size(); ++i)
+      result.point_vertex[sub.point[i]] = part.point_vertex[i];
     result.plc = std::move(part.plc);
-  } else if (!extruded.points.empty()) {
-    throw outside_every_body(spec, extruded.points.front());
+  } else if (!sub.spec.points.empty()) {
+    throw outside_every_body(spec, sub.spec.points.front());
   }
+  return result;
+}
 
-  // 4. Each surface body: its triangles as facets, a region point, and its named points.
-  Plc& plc = result.plc;
-  for (size_t s = 0; s < surfaces.size(); ++s) {
-    const cgal::SurfaceSolid& solid = surfaces[s].solid;
-    const int first = static_cast<int>(plc.vertices.size());
-    plc.vertices.insert(plc.vertices.end(), solid.surface.vertices.begin(),
-                        solid.surface.vertices.end());
-    const size_t first_facet = plc.facets.size();
-    std::vector<int> patch_of;
-    for (const auto& patch : planar_patches(solid.surface, tol, patch_of)) {
-      PlcFacet facet;
-      for (const auto& ring : patch.polygons) {
-        facet.polygons.emplace_back();
-        for (int v : ring) facet.polygons.back().push_back(first + v);
-      }
-      plc.facets.push_back(std::move(facet));
+/// Where a surface body's vertices and facets were put in the PLC.
+struct PlacedSurface {
+  const cgal::TriangleSurface* surface = nullptr;
+  std::vector<int> patch_of;  /// per triangle: its patch, whose facet is first_facet + patch
+  int first_vertex = 0;
+  size_t first_facet = 0;
+};
+
+/// Adds a surface's vertices, and each of its planar patches as one facet.
+PlacedSurface add_surface_facets(Plc& plc, const cgal::TriangleSurface& surface, double tol) {
+  PlacedSurface placed{&surface, {}, static_cast<int>(plc.vertices.size()), plc.facets.size()};
+  plc.vertices.insert(plc.vertices.end(), surface.vertices.begin(), surface.vertices.end());
+  for (const auto& patch : planar_patches(surface, tol, placed.patch_of)) {
+    PlcFacet facet;
+    for (const auto& ring : patch.polygons) {
+      facet.polygons.emplace_back();
+      for (int v : ring) facet.polygons.back().push_back(placed.first_vertex + v);
     }
-    for (size_t i = 0; i < spec.points.size(); ++i) {
-      if (point_surface[i] != static_cast<int>(s)) continue;
-      const Vector3d& x = spec.points[i].position;
-      switch (location[i].kind) {
-        case Kind::vertex:  // moved by at most tol so that the point is exact
-          result.point_vertex[i] = first + location[i].index;
-          plc.vertices[result.point_vertex[i]] = x;
-          break;
-        case Kind::triangle: {
-          const int v = static_cast<int>(plc.vertices.size());
-          plc.vertices.push_back(x);
-          result.point_vertex[i] = v;
-          // On an edge between two patches the point joins both facets' rings (TetGen crashes on a
-          // lone vertex on a facet's boundary); inside a patch it is a lone vertex of its facet.
-          const auto& tri = solid.surface.triangles[location[i].index];
-          const int own = patch_of[location[i].index];
-          bool on_crease = false;
-          for (int k = 0; k < 3 && !on_crease; ++k) {
-            const int a = tri[k], b = tri[(k + 1) % 3];
-            const Vector3d& xa = solid.surface.vertices[a];
-            const Vector3d& xb = solid.surface.vertices[b];
-            const double t = std::clamp((x - xa).dot(xb - xa) / (xb - xa).squaredNorm(), 0.0, 1.0);
-            if ((xa + t * (xb - xa) - x).norm() > tol) continue;
-            for (size_t f = 0; f < solid.surface.triangles.size(); ++f) {
-              const auto& u = solid.surface.triangles[f];
-              for (int e = 0; e < 3; ++e)
-                if (u[e] == b && u[(e + 1) % 3] == a && patch_of[f] != own) {
-                  on_crease = true;
-                  insert_on_edge(plc.facets[first_facet + own], first + a, first + b, v,
-                                 plc.vertices);
-                  insert_on_edge(plc.facets[first_facet + patch_of[f]], first + a, first + b, v,
-                                 plc.vertices);
-                }
-            }
-          }
-          if (!on_crease) plc.facets[first_facet + own].polygons.push_back({v});
-          break;
-        }
-        case Kind::inside:
-          plc.interior_points.push_back(x);
-          break;
-        case Kind::outside:
-          break;
-      }
-    }
-    const double h = spec.bodies[surfaces[s].body].max_edge;
-    plc.regions.push_back(
-        PlcRegion{solid.inside_point, surfaces[s].body, h * h * h / (6.0 * std::sqrt(2.0))});
+    plc.facets.push_back(std::move(facet));
   }
+  return placed;
+}
+
+/// Adds named point x, lying on triangle `t` of a placed surface, as a new vertex, returned. On
+/// an edge between two patches the point joins both facets' rings (TetGen crashes on a lone
+/// vertex on a facet's boundary); inside a patch it is a lone vertex of its facet.
+int add_point_on_triangle(Plc& plc, const PlacedSurface& placed, int t, const Vector3d& x,
+                          double tol) {
+  const cgal::TriangleSurface& surface = *placed.surface;
+  const int first = placed.first_vertex;
+  const int v = static_cast<int>(plc.vertices.size());
+  plc.vertices.push_back(x);
+  const auto& tri = surface.triangles[t];
+  const int own = placed.patch_of[t];
+  bool on_crease = false;
+  for (int k = 0; k < 3 && !on_crease; ++k) {
+    const int a = tri[k], b = tri[(k + 1) % 3];
+    const Vector3d& xa = surface.vertices[a];
+    const Vector3d& xb = surface.vertices[b];
+    const double s = std::clamp((x - xa).dot(xb - xa) / (xb - xa).squaredNorm(), 0.0, 1.0);
+    if ((xa + s * (xb - xa) - x).norm() > tol) continue;
+    for (size_t f = 0; f < surface.triangles.size(); ++f) {
+      const auto& u = surface.triangles[f];
+      for (int e = 0; e < 3; ++e)
+        if (u[e] == b && u[(e + 1) % 3] == a && placed.patch_of[f] != own) {
+          on_crease = true;
+          insert_on_edge(plc.facets[placed.first_facet + own], first + a, first + b, v,
+                         plc.vertices);
+          insert_on_edge(plc.facets[placed.first_facet + placed.patch_of[f]], first + a, first + b,
+                         v, plc.vertices);
+        }
+    }
+  }
+  if (!on_crease) plc.facets[placed.first_facet + own].polygons.push_back({v});
+  return v;
+}
+
+/// Adds surface body `s`: its triangles as facets, its named points and a region point.
+void add_surface_body(const core::CaseSpec& spec, const SurfaceBody& body, int s,
+                      const SurfacePoints& on_surface, double tol, ExtrudedPlc& result) {
+  using Kind = cgal::PointLocation::Kind;
+  Plc& plc = result.plc;
+  const cgal::SurfaceSolid& solid = body.solid;
+  const PlacedSurface placed = add_surface_facets(plc, solid.surface, tol);
+  for (size_t i = 0; i < spec.points.size(); ++i) {
+    if (on_surface.surface[i] != s) continue;
+    const Vector3d& x = spec.points[i].position;
+    const cgal::PointLocation& at = on_surface.location[i];
+    switch (at.kind) {
+      case Kind::vertex:  // moved by at most tol so that the point is exact
+        result.point_vertex[i] = placed.first_vertex + at.index;
+        plc.vertices[result.point_vertex[i]] = x;
+        break;
+      case Kind::triangle:
+        result.point_vertex[i] = add_point_on_triangle(plc, placed, at.index, x, tol);
+        break;
+      case Kind::inside:
+        plc.interior_points.push_back(x);
+        break;
+      case Kind::outside:
+        break;
+    }
+  }
+  const double h = spec.bodies[body.body].max_edge;
+  plc.regions.push_back(
+      PlcRegion{solid.inside_point, body.body, h * h * h / (6.0 * std::sqrt(2.0))});
+}
+
+}  // namespace
+
+ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
+  // Surface-file bodies are read and checked; the others go to the extrusion.
+  const std::vector<SurfaceBody> surfaces = surface_bodies(spec);
+  if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
+  check_surface_bodies_clear(spec, surfaces);
+  // Named points on or in a surface body belong to it; the others to the extrusion.
+  const double tol = geometry_tolerance(spec, surfaces);
+  const SurfacePoints on_surface = surface_points(spec, surfaces, tol);
+  ExtrudedPlc result = extruded_subset_plc(spec, extruded_subset(spec, on_surface), surfaces);
+  for (size_t s = 0; s < surfaces.size(); ++s)
+    add_surface_body(spec, surfaces[s], static_cast<int>(s), on_surface, tol, result);
   return result;
 }
 
