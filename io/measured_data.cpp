@@ -205,8 +205,8 @@ std::optional<PublishedFigure> published_figure(const fs::path& file, const json
   return f;
 }
 
-/// meta.json as a run with no samples yet.
-MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
+/// meta.json parsed; it must be a JSON object.
+json parsed_meta(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in)
     throw core::IoError(file.string() +
@@ -221,6 +221,97 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   }
   if (!meta.is_object())
     throw core::DataError(core::located(file.string(), 0, "expected a JSON object"));
+  return meta;
+}
+
+/// The column ids met so far: inputs, sensors and displacements share one name space.
+class ColumnIds {
+ public:
+  explicit ColumnIds(const fs::path& file) : file_(file) {}
+  void add(const std::string& id, const std::string& path) {
+    if (!ids_.insert(id).second)
+      meta_error(file_, path, "id '" + id + "' is used twice; every column id must be unique");
+  }
+
+ private:
+  const fs::path& file_;
+  std::set<std::string> ids_;
+};
+
+/// meta.json's inputs: ids of speed columns in rpm.
+std::vector<std::string> meta_inputs(const fs::path& file, const json& meta, ColumnIds& ids) {
+  std::vector<std::string> out;
+  const json& inputs = id_list(file, meta, "inputs", false);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string path = "inputs[" + std::to_string(i) + "]";
+    const std::string id = item_id(file, inputs[i], path);
+    ids.add(id, path + ".id");
+    const std::string unit =
+        string_value(file, required_key(file, inputs[i], "unit", path + ".unit"), path + ".unit");
+    if (unit != "rpm")
+      meta_error(file, path + ".unit", "unknown unit '" + unit + "': expected 'rpm'");
+    out.push_back(id);
+  }
+  return out;
+}
+
+/// meta.json's sensors; a position must lie in `box` when there is one.
+std::vector<MeasuredSensor> meta_sensors(const fs::path& file, const json& meta,
+                                         const std::optional<Eigen::AlignedBox3d>& box,
+                                         const std::string& machine, ColumnIds& ids) {
+  std::vector<MeasuredSensor> out;
+  const json& sensors = id_list(file, meta, "sensors", true);
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    const std::string path = "sensors[" + std::to_string(i) + "]";
+    MeasuredSensor s;
+    s.id = item_id(file, sensors[i], path);
+    ids.add(s.id, path + ".id");
+    s.position = optional_vector(file, sensors[i], "position", path + ".position");
+    require_inside(file, box, s.position, path + ".position", machine);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+/// meta.json's displacements; a point must lie in `box`, a direction becomes a unit vector.
+std::vector<MeasuredProbe> meta_probes(const fs::path& file, const json& meta,
+                                       const std::optional<Eigen::AlignedBox3d>& box,
+                                       const std::string& machine, ColumnIds& ids) {
+  std::vector<MeasuredProbe> out;
+  const json& probes = id_list(file, meta, "displacements", true);
+  for (std::size_t i = 0; i < probes.size(); ++i) {
+    const std::string path = "displacements[" + std::to_string(i) + "]";
+    MeasuredProbe p;
+    p.id = item_id(file, probes[i], path);
+    ids.add(p.id, path + ".id");
+    p.point = optional_vector(file, probes[i], "point", path + ".point");
+    require_inside(file, box, p.point, path + ".point", machine);
+    p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
+    if (p.direction) {
+      const double norm = p.direction->norm();
+      if (!(norm > 0)) meta_error(file, path + ".direction", "[0, 0, 0]: expected a unit vector");
+      *p.direction /= norm;
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+/// meta.json's ambient_sensor, when given (not null): the id of one of `sensors`.
+std::optional<std::string> meta_ambient_sensor(const fs::path& file, const json& meta,
+                                               const std::vector<MeasuredSensor>& sensors) {
+  const auto it = meta.find("ambient_sensor");
+  if (it == meta.end() || it->is_null()) return std::nullopt;
+  const std::string id = string_value(file, *it, "ambient_sensor");
+  bool found = false;
+  for (const auto& s : sensors) found = found || s.id == id;
+  if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
+  return id;
+}
+
+/// meta.json as a run with no samples yet.
+MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
+  json meta = parsed_meta(file);
   MeasuredRun run;
   run.folder = file.parent_path();
   const std::string format =
@@ -239,55 +330,11 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   run.initial_temperature_c = optional_temperature(file, meta, "initial_temperature_degC");
   run.nominal_ambient_c = optional_temperature(file, meta, "nominal_ambient_degC");
 
-  std::set<std::string> ids;
-  const auto unique = [&](const std::string& id, const std::string& path) {
-    if (!ids.insert(id).second)
-      meta_error(file, path, "id '" + id + "' is used twice; every column id must be unique");
-  };
-  const json& inputs = id_list(file, meta, "inputs", false);
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const std::string path = "inputs[" + std::to_string(i) + "]";
-    const std::string id = item_id(file, inputs[i], path);
-    unique(id, path + ".id");
-    const std::string unit =
-        string_value(file, required_key(file, inputs[i], "unit", path + ".unit"), path + ".unit");
-    if (unit != "rpm")
-      meta_error(file, path + ".unit", "unknown unit '" + unit + "': expected 'rpm'");
-    run.inputs.push_back(id);
-  }
-  const json& sensors = id_list(file, meta, "sensors", true);
-  for (std::size_t i = 0; i < sensors.size(); ++i) {
-    const std::string path = "sensors[" + std::to_string(i) + "]";
-    MeasuredSensor s;
-    s.id = item_id(file, sensors[i], path);
-    unique(s.id, path + ".id");
-    s.position = optional_vector(file, sensors[i], "position", path + ".position");
-    require_inside(file, box, s.position, path + ".position", run.machine);
-    run.sensors.push_back(std::move(s));
-  }
-  const json& probes = id_list(file, meta, "displacements", true);
-  for (std::size_t i = 0; i < probes.size(); ++i) {
-    const std::string path = "displacements[" + std::to_string(i) + "]";
-    MeasuredProbe p;
-    p.id = item_id(file, probes[i], path);
-    unique(p.id, path + ".id");
-    p.point = optional_vector(file, probes[i], "point", path + ".point");
-    require_inside(file, box, p.point, path + ".point", run.machine);
-    p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
-    if (p.direction) {
-      const double norm = p.direction->norm();
-      if (!(norm > 0)) meta_error(file, path + ".direction", "[0, 0, 0]: expected a unit vector");
-      *p.direction /= norm;
-    }
-    run.displacements.push_back(std::move(p));
-  }
-  if (const auto it = meta.find("ambient_sensor"); it != meta.end() && !it->is_null()) {
-    const std::string id = string_value(file, *it, "ambient_sensor");
-    bool found = false;
-    for (const auto& s : run.sensors) found = found || s.id == id;
-    if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
-    run.ambient_sensor = id;
-  }
+  ColumnIds ids(file);
+  run.inputs = meta_inputs(file, meta, ids);
+  run.sensors = meta_sensors(file, meta, box, run.machine, ids);
+  run.displacements = meta_probes(file, meta, box, run.machine, ids);
+  run.ambient_sensor = meta_ambient_sensor(file, meta, run.sensors);
   run.published = published_figure(file, meta, run);
   run.meta = std::move(meta);
   return run;
