@@ -504,12 +504,9 @@ double exact_body_volume(const Body& body) {
 
 namespace {
 
-/// The PLC of z-extruded bodies only. `is_free` says whether a point of empty space lies outside
-/// every surface-file body, so that no hole point falls inside one.
-ExtrudedPlc extruded_part(const core::CaseSpec& spec,
-                          const std::function<bool(const Vector3d&)>& is_free) {
+/// 1e-9 of the diagonal of every primitive's faceted bounds [m]; refuses a case without bodies.
+double extrusion_tolerance(const core::CaseSpec& spec) {
   const int n = spec.mesh.circle_segments;
-  // 1. Extent and tolerance.
   Eigen::AlignedBox3d extent;
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
@@ -523,13 +520,31 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
       }
   if (extent.isEmpty())
     throw core::GeometryError(spec.source.string() + ": the case has no bodies");
-  const double tol = 1e-9 * extent.diagonal().norm();
+  return 1e-9 * extent.diagonal().norm();
+}
 
-  // 2. The planar graph: named points first so that their coordinates are kept exactly.
+/// The layered cells of an extrusion: the cross-section graph and its faces, the z breakpoints,
+/// and per (face, slab) cell a representative point and the body that fills it (-1: empty).
+struct Layers {
   Pslg g;
+  Arrangement arr;
+  std::vector<int> degree;          /// per 2D vertex: its number of edges
+  std::vector<int> point_vertex2d;  /// per named point: its 2D vertex
+  std::vector<double> z;            /// breakpoints, ascending
+  int nslab = 0;
+  std::vector<Vector2d> rep;            /// per face: a point inside it
+  std::vector<std::vector<int>> label;  /// per face and slab: body index or -1
+
+  int cell(int f, int j) const { return f < 0 || j < 0 || j >= nslab ? -1 : label[f][j]; }
+};
+
+/// The planar graph of every primitive's rings: named points first so that their coordinates
+/// are kept exactly.
+void add_cross_section(const core::CaseSpec& spec, double tol, Layers& l) {
+  const int n = spec.mesh.circle_segments;
+  Pslg& g = l.g;
   g.tol = tol;
-  std::vector<int> point_vertex2d;
-  for (const auto& p : spec.points) point_vertex2d.push_back(g.vertex(p.position.head<2>()));
+  for (const auto& p : spec.points) l.point_vertex2d.push_back(g.vertex(p.position.head<2>()));
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
       for (const auto& p : *list) {
@@ -542,11 +557,13 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         }
       }
   resolve_pslg(g);
-  const Arrangement arr = arrangement(g);
-  std::vector<int> degree(g.vertices.size(), 0);
-  for (const auto& e : g.edges) ++degree[e[0]], ++degree[e[1]];
+  l.arr = arrangement(g);
+  l.degree.assign(g.vertices.size(), 0);
+  for (const auto& e : g.edges) ++l.degree[e[0]], ++l.degree[e[1]];
+}
 
-  // 3. Breakpoints along z: primitive ends and the heights of named points on vertical faces.
+/// Breakpoints along z: primitive ends and the heights of named points on vertical faces.
+void add_breakpoints(const core::CaseSpec& spec, double tol, Layers& l) {
   std::vector<ZValue> zs;
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
@@ -556,143 +573,195 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         zs.push_back({z1, false});
       }
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (degree[point_vertex2d[i]] > 0) zs.push_back({spec.points[i].position.z(), true});
-  const std::vector<double> z = merged_breakpoints(zs, tol);
-  const int nslab = static_cast<int>(z.size()) - 1;
+    if (l.degree[l.point_vertex2d[i]] > 0) zs.push_back({spec.points[i].position.z(), true});
+  l.z = merged_breakpoints(zs, tol);
+  l.nslab = static_cast<int>(l.z.size()) - 1;
+}
 
-  // 4. Representative points and the body of every (face, slab) cell.
-  const int nf = static_cast<int>(arr.faces.size());
-  std::vector<Vector2d> rep(nf);
+/// Representative points and the body of every (face, slab) cell; two bodies in one cell overlap.
+void add_cell_bodies(const core::CaseSpec& spec, Layers& l) {
+  const int n = spec.mesh.circle_segments;
+  const int nf = static_cast<int>(l.arr.faces.size());
+  l.rep.resize(nf);
   for (int f = 0; f < nf; ++f)
-    rep[f] = point_beside(g, arr.faces[f].outer, +1,
-                          [&](const Vector2d& p) { return face_contains(g, arr.faces[f], p); });
-  std::vector<std::vector<int>> label(nf, std::vector<int>(nslab, -1));
+    l.rep[f] = point_beside(l.g, l.arr.faces[f].outer, +1, [&](const Vector2d& p) {
+      return face_contains(l.g, l.arr.faces[f], p);
+    });
+  l.label.assign(nf, std::vector<int>(l.nslab, -1));
   for (int f = 0; f < nf; ++f) {
-    for (int j = 0; j < nslab; ++j) {
-      const Vector3d p(rep[f].x(), rep[f].y(), 0.5 * (z[j] + z[j + 1]));
+    for (int j = 0; j < l.nslab; ++j) {
+      const Vector3d p(l.rep[f].x(), l.rep[f].y(), 0.5 * (l.z[j] + l.z[j + 1]));
       for (size_t b = 0; b < spec.bodies.size(); ++b) {
         if (!body_contains_tol(spec.bodies[b], p, n, 0.0, 0.0)) continue;
-        if (label[f][j] >= 0) {
+        if (l.label[f][j] >= 0) {
           std::ostringstream msg;
-          msg << spec.source.string() << ": bodies '" << spec.bodies[label[f][j]].name << "' and '"
-              << spec.bodies[b].name << "' overlap near (" << p.x() << ", " << p.y() << ", "
-              << p.z() << ") m without a declared subtraction. Hint: subtract one from the other, "
+          msg << spec.source.string() << ": bodies '" << spec.bodies[l.label[f][j]].name
+              << "' and '" << spec.bodies[b].name << "' overlap near (" << p.x() << ", " << p.y()
+              << ", " << p.z()
+              << ") m without a declared subtraction. Hint: subtract one from the other, "
               << "or make them only touch.";
           throw core::GeometryError(msg.str());
         }
-        label[f][j] = static_cast<int>(b);
+        l.label[f][j] = static_cast<int>(b);
       }
     }
   }
-  auto cell = [&](int f, int j) { return f < 0 || j < 0 || j >= nslab ? -1 : label[f][j]; };
+}
 
-  // 5. Facets.
-  ExtrudedPlc result;
-  Plc& plc = result.plc;
-  std::map<std::pair<int, int>, int> vertex3d;
-  auto v3 = [&](int v2, int zi) {
+/// The PLC's 3D vertices, one per (2D vertex, z breakpoint), numbered as first asked for.
+class LayerVertices {
+ public:
+  int at(const Layers& l, Plc& plc, int v2, int zi) {
     auto [it, fresh] =
-        vertex3d.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
-    if (fresh) plc.vertices.emplace_back(g.vertices[v2].x(), g.vertices[v2].y(), z[zi]);
+        index_.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
+    if (fresh) plc.vertices.emplace_back(l.g.vertices[v2].x(), l.g.vertices[v2].y(), l.z[zi]);
     return it->second;
-  };
-  for (size_t e = 0; e < g.edges.size(); ++e) {
-    const int fl = arr.halfedge_face[2 * e], fr = arr.halfedge_face[2 * e + 1];
-    for (int j = 0; j < nslab; ++j) {
-      if (cell(fl, j) == cell(fr, j)) continue;
-      const int a = g.edges[e][0], b = g.edges[e][1];
-      plc.facets.push_back(PlcFacet{{{v3(a, j), v3(b, j), v3(b, j + 1), v3(a, j + 1)}}, {}});
+  }
+  /// The vertex at (v2, zi) if it exists, else -1.
+  int find(int v2, int zi) const {
+    const auto it = index_.find({v2, zi});
+    return it == index_.end() ? -1 : it->second;
+  }
+
+ private:
+  std::map<std::pair<int, int>, int> index_;
+};
+
+/// A vertical facet per graph edge and slab where the cells on its two sides differ.
+void add_side_facets(const Layers& l, LayerVertices& v3, Plc& plc) {
+  for (size_t e = 0; e < l.g.edges.size(); ++e) {
+    const int fl = l.arr.halfedge_face[2 * e], fr = l.arr.halfedge_face[2 * e + 1];
+    for (int j = 0; j < l.nslab; ++j) {
+      if (l.cell(fl, j) == l.cell(fr, j)) continue;
+      const int a = l.g.edges[e][0], b = l.g.edges[e][1];
+      plc.facets.push_back(PlcFacet{{{v3.at(l, plc, a, j), v3.at(l, plc, b, j),
+                                      v3.at(l, plc, b, j + 1), v3.at(l, plc, a, j + 1)}},
+                                    {}});
     }
   }
-  // Named points floating inside a horizontal face.
+}
+
+/// A horizontal facet per face and breakpoint where the cells below and above differ, with its
+/// holes and the named points floating inside it (their vertices go to result.point_vertex).
+void add_cap_facets(const core::CaseSpec& spec, const Layers& l, double tol, LayerVertices& v3,
+                    ExtrudedPlc& result) {
+  Plc& plc = result.plc;
+  const int nf = static_cast<int>(l.arr.faces.size());
   std::vector<int> isolated_face(spec.points.size(), -1);
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (degree[point_vertex2d[i]] == 0)
+    if (l.degree[l.point_vertex2d[i]] == 0)
       for (int f = 0; f < nf; ++f)
-        if (face_contains(g, arr.faces[f], g.vertices[point_vertex2d[i]])) isolated_face[i] = f;
+        if (face_contains(l.g, l.arr.faces[f], l.g.vertices[l.point_vertex2d[i]]))
+          isolated_face[i] = f;
   result.point_vertex.assign(spec.points.size(), -1);
-  for (int j = 0; j <= nslab; ++j) {
+  for (int j = 0; j <= l.nslab; ++j) {
     for (int f = 0; f < nf; ++f) {
-      if (cell(f, j - 1) == cell(f, j)) continue;
+      if (l.cell(f, j - 1) == l.cell(f, j)) continue;
       PlcFacet facet;
       std::vector<int> ring;
-      for (int v : arr.faces[f].outer) ring.push_back(v3(v, j));
+      for (int v : l.arr.faces[f].outer) ring.push_back(v3.at(l, plc, v, j));
       facet.polygons.push_back(ring);
-      for (const auto& hole : arr.faces[f].holes) {
+      for (const auto& hole : l.arr.faces[f].holes) {
         ring.clear();
-        for (int v : hole) ring.push_back(v3(v, j));
+        for (int v : hole) ring.push_back(v3.at(l, plc, v, j));
         facet.polygons.push_back(ring);
-        const Ring hole_ring = ring_of(g, hole);
+        const Ring hole_ring = ring_of(l.g, hole);
         const Vector2d h = point_beside(
-            g, hole, -1, [&](const Vector2d& p) { return ring_contains(hole_ring, p); });
-        facet.holes.emplace_back(h.x(), h.y(), z[j]);
+            l.g, hole, -1, [&](const Vector2d& p) { return ring_contains(hole_ring, p); });
+        facet.holes.emplace_back(h.x(), h.y(), l.z[j]);
       }
       for (size_t i = 0; i < spec.points.size(); ++i) {
-        if (isolated_face[i] != f || std::abs(spec.points[i].position.z() - z[j]) > tol) continue;
-        const int v = v3(point_vertex2d[i], j);
+        if (isolated_face[i] != f || std::abs(spec.points[i].position.z() - l.z[j]) > tol) continue;
+        const int v = v3.at(l, plc, l.point_vertex2d[i], j);
         facet.polygons.push_back({v});
         result.point_vertex[i] = v;
       }
       plc.facets.push_back(std::move(facet));
     }
   }
+}
 
-  // 6. Regions and holes, one point per cell; hole points stay out of surface-file bodies.
+/// A point of empty cell (f, j) outside every surface-file body (`is_free`).
+Vector3d hole_point(const core::CaseSpec& spec, const Layers& l, int f, int j,
+                    const std::function<bool(const Vector3d&)>& is_free) {
   auto free_in_slab = [&](const Vector2d& q, int j) -> std::optional<Vector3d> {
     for (double s : {0.5, 0.25, 0.75, 0.1, 0.9, 0.02, 0.98}) {
-      const Vector3d p(q.x(), q.y(), z[j] + s * (z[j + 1] - z[j]));
+      const Vector3d p(q.x(), q.y(), l.z[j] + s * (l.z[j + 1] - l.z[j]));
       if (is_free(p)) return p;
     }
     return std::nullopt;
   };
-  auto hole_point = [&](int f, int j) {
-    if (const auto p = free_in_slab(rep[f], j)) return *p;
-    try {
-      const Vector2d q = point_beside(g, arr.faces[f].outer, +1, [&](const Vector2d& c) {
-        return face_contains(g, arr.faces[f], c) && free_in_slab(c, j).has_value();
-      });
-      return *free_in_slab(q, j);
-    } catch (const core::GeometryError&) {
-      std::ostringstream msg;
-      msg << spec.source.string() << ": a surface-file body fills the empty space near ("
-          << rep[f].x() << ", " << rep[f].y() << ", " << 0.5 * (z[j] + z[j + 1])
-          << ") m so closely that no point of that space is left to mark it empty. Hint: leave "
-             "a clear gap around surface-file bodies.";
-      throw core::GeometryError(msg.str());
-    }
-  };
-  for (int f = 0; f < nf; ++f) {
-    for (int j = 0; j < nslab; ++j) {
-      const Vector3d p(rep[f].x(), rep[f].y(), 0.5 * (z[j] + z[j + 1]));
-      const int b = label[f][j];
+  if (const auto p = free_in_slab(l.rep[f], j)) return *p;
+  try {
+    const Vector2d q = point_beside(l.g, l.arr.faces[f].outer, +1, [&](const Vector2d& c) {
+      return face_contains(l.g, l.arr.faces[f], c) && free_in_slab(c, j).has_value();
+    });
+    return *free_in_slab(q, j);
+  } catch (const core::GeometryError&) {
+    std::ostringstream msg;
+    msg << spec.source.string() << ": a surface-file body fills the empty space near ("
+        << l.rep[f].x() << ", " << l.rep[f].y() << ", " << 0.5 * (l.z[j] + l.z[j + 1])
+        << ") m so closely that no point of that space is left to mark it empty. Hint: leave "
+           "a clear gap around surface-file bodies.";
+    throw core::GeometryError(msg.str());
+  }
+}
+
+/// One region point per filled cell and one hole point per empty cell.
+void add_regions_and_holes(const core::CaseSpec& spec, const Layers& l,
+                           const std::function<bool(const Vector3d&)>& is_free, Plc& plc) {
+  for (int f = 0; f < static_cast<int>(l.arr.faces.size()); ++f) {
+    for (int j = 0; j < l.nslab; ++j) {
+      const Vector3d p(l.rep[f].x(), l.rep[f].y(), 0.5 * (l.z[j] + l.z[j + 1]));
+      const int b = l.label[f][j];
       if (b < 0) {
-        plc.holes.push_back(hole_point(f, j));
+        plc.holes.push_back(hole_point(spec, l, f, j, is_free));
       } else {
         const double h = spec.bodies[b].max_edge;
         plc.regions.push_back(PlcRegion{p, b, h * h * h / (6.0 * std::sqrt(2.0))});
       }
     }
   }
+}
 
-  // 7. Named points: a PLC vertex already, or inserted inside a body.
+/// Named points not yet placed: a PLC vertex already, or inserted inside a body.
+void add_named_points(const core::CaseSpec& spec, const Layers& l, double tol,
+                      const LayerVertices& v3, ExtrudedPlc& result) {
   for (size_t i = 0; i < spec.points.size(); ++i) {
     if (result.point_vertex[i] >= 0) continue;
     const auto& pt = spec.points[i];
     int zi = -1;
-    for (int j = 0; j <= nslab; ++j)
-      if (std::abs(z[j] - pt.position.z()) <= tol) zi = j;
+    for (int j = 0; j <= l.nslab; ++j)
+      if (std::abs(l.z[j] - pt.position.z()) <= tol) zi = j;
     if (zi >= 0) {
-      auto it = vertex3d.find({point_vertex2d[i], zi});
-      if (it != vertex3d.end()) {
-        result.point_vertex[i] = it->second;
+      if (const int v = v3.find(l.point_vertex2d[i], zi); v >= 0) {
+        result.point_vertex[i] = v;
         continue;
       }
     }
     bool inside = false;
-    for (const auto& b : spec.bodies) inside = inside || body_contains(b, pt.position, n);
+    for (const auto& b : spec.bodies)
+      inside = inside || body_contains(b, pt.position, spec.mesh.circle_segments);
     if (!inside) throw outside_every_body(spec, pt);
-    plc.interior_points.push_back(pt.position);
+    result.plc.interior_points.push_back(pt.position);
   }
+}
+
+/// The PLC of z-extruded bodies only. `is_free` says whether a point of empty space lies outside
+/// every surface-file body, so that no hole point falls inside one.
+ExtrudedPlc extruded_part(const core::CaseSpec& spec,
+                          const std::function<bool(const Vector3d&)>& is_free) {
+  const double tol = extrusion_tolerance(spec);
+  Layers layers;
+  add_cross_section(spec, tol, layers);
+  add_breakpoints(spec, tol, layers);
+  add_cell_bodies(spec, layers);
+  ExtrudedPlc result;
+  LayerVertices v3;
+  add_side_facets(layers, v3, result.plc);
+  add_cap_facets(spec, layers, tol, v3, result);
+  add_regions_and_holes(spec, layers, is_free, result.plc);
+  add_named_points(spec, layers, tol, v3, result);
   return result;
 }
 
