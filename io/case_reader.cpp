@@ -884,11 +884,170 @@ core::TimeTable sink_table(const Ctx& c, const toml::node& n, const std::string&
   return table;
 }
 
+/// A convection entry's sink: sink_degC (constant) or sink_table (over time), one of the two.
+core::TimeTable convection_sink(const Tab& cv) {
+  const Ctx& c = *cv.ctx;
+  const toml::node* sd = cv.get("sink_degC");
+  const toml::node* st = cv.get("sink_table");
+  if (sd && st)
+    fail_value(c, *st, cv.at("sink_table"), "give either sink_degC or sink_table, not both");
+  if (st) return sink_table(c, *st, cv.at("sink_table"));
+  if (!sd)
+    fail(c, cv.line(),
+         cv.at("sink_degC") +
+             ": missing; expected the sink temperature (sink_degC = 20.0 or "
+             "sink_table = [[t_s, degC], ...])");
+  core::TimeTable sink;
+  sink.time = {0.0};
+  sink.value = {temperature_c(c, *sd, cv.at("sink_degC"))};
+  return sink;
+}
+
+/// One [[thermal.convection]] entry; a boundary group has at most one (`before`).
+core::Convection read_convection(const Tab& cv, const Names& groups,
+                                 const std::vector<core::Convection>& before) {
+  const Ctx& c = *cv.ctx;
+  cv.allow({"group", "h_W_m2K", "h_speed_gain_W_m2K", "speed_ref_rpm", "speed_exponent",
+            "sink_degC", "sink_table"});
+  core::Convection conv;
+  conv.group = reference(cv, "group", groups, "boundary group");
+  for (const auto& b : before)
+    if (b.group == conv.group)
+      fail_value(c, cv.need("group", ""), cv.at("group"), "already has a convection entry",
+                 "merge the two into one");
+  conv.h = number(cv, "h_W_m2K", Sign::non_negative, "heat transfer coefficient in W/(m^2 K)");
+  conv.h_speed_gain = number_or(cv, "h_speed_gain_W_m2K", 0.0, Sign::non_negative);
+  if (cv.get("h_speed_gain_W_m2K") && !cv.get("speed_ref_rpm"))
+    fail(c, cv.line(),
+         cv.at("speed_ref_rpm") +
+             ": missing; expected the speed at which the gain applies, "
+             "required with h_speed_gain_W_m2K");
+  conv.speed_ref_rpm = number_or(cv, "speed_ref_rpm", conv.speed_ref_rpm, Sign::positive);
+  conv.speed_exponent = number_or(cv, "speed_exponent", conv.speed_exponent, Sign::non_negative);
+  conv.sink = convection_sink(cv);
+  return conv;
+}
+
+// The keys of a [[thermal.heat_sources]] entry that each law uses.
+const Names kSpeedLawKeys = {"power_ref_W", "ref_speed_rpm", "exponent"};
+const Names kConstantLawKeys = {"power_ref_W"};
+const Names kPalmgrenLawKeys = {"palmgren_f0", "palmgren_nu_cSt", "palmgren_dm", "palmgren_f1",
+                                "palmgren_p1_N"};
+const Names kFeedLawKeys = {"power_ref_W", "ref_feed_m_min", "ref_feed_m_s", "exponent"};
+
+/// Every key of a heat source, in the order a near-miss suggestion considers them.
+const Names kHeatSourceKeys = [] {
+  Names all = {"name", "body", "law", "temperature_coefficient_per_K"};
+  for (const Names* keys : {&kSpeedLawKeys, &kPalmgrenLawKeys})
+    all.insert(all.end(), keys->begin(), keys->end());
+  all.insert(all.end(), {"ref_feed_m_min", "ref_feed_m_s", "moving"});
+  return all;
+}();
+
+/// A key that some law uses.
+bool is_law_key(const std::string& key) {
+  for (const Names* keys : {&kSpeedLawKeys, &kConstantLawKeys, &kPalmgrenLawKeys, &kFeedLawKeys})
+    if (std::find(keys->begin(), keys->end(), key) != keys->end()) return true;
+  return false;
+}
+
+const Names& law_keys(core::HeatSource::Law law) {
+  using Law = core::HeatSource::Law;
+  return law == Law::speed_power  ? kSpeedLawKeys
+         : law == Law::constant   ? kConstantLawKeys
+         : law == Law::feed_power ? kFeedLawKeys
+                                  : kPalmgrenLawKeys;
+}
+
+/// Refuses a key of another law than the source's (a left-over would be silently ignored).
+void check_law_keys(const Tab& h, core::HeatSource::Law law) {
+  const Names& used = law_keys(law);
+  const std::string& law_name = name_of(kLaws, law);
+  for (auto&& [k, v] : *h.t) {
+    const bool law_key = is_law_key(std::string(k.str()));
+    if (law_key && std::find(used.begin(), used.end(), k.str()) == used.end())
+      fail(*h.ctx, line_of(v),
+           h.at(k.str()) + " = " + value_text(v) + ": not used by law = \"" + law_name +
+               "\"; remove it or change the law");
+  }
+}
+
+/// The parameters of `src.law`, read into `src`; feed_power needs a [feed_axis].
+void read_law_parameters(const Tab& h, const CaseSpec& spec, core::HeatSource& src) {
+  using Law = core::HeatSource::Law;
+  if (src.law == Law::speed_power) {
+    src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_speed_rpm in W");
+    src.ref_speed_rpm = number(h, "ref_speed_rpm", Sign::positive);
+    src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
+  } else if (src.law == Law::constant) {
+    src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat in W");
+  } else if (src.law == Law::feed_power) {
+    if (spec.feed_axis.segments.empty())
+      fail_value(*h.ctx, *h.get("law"), h.at("law"), "needs a [feed_axis] table",
+                 "declare the axis's motion in [feed_axis]");
+    src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_feed_m_min in W");
+    src.ref_feed = feed_speed(h, "ref_feed", Sign::positive);
+    src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
+  } else {
+    src.palmgren_f0 = number(h, "palmgren_f0", Sign::positive, "bearing type factor f0");
+    src.palmgren_nu_cSt =
+        number(h, "palmgren_nu_cSt", Sign::positive, "lubricant kinematic viscosity in cSt");
+    src.palmgren_dm = length(h, "palmgren_dm", Sign::positive, "bearing pitch diameter");
+    src.palmgren_f1 = number(h, "palmgren_f1", Sign::non_negative, "load factor f1");
+    src.palmgren_p1 = number(h, "palmgren_p1_N", Sign::non_negative, "equivalent load in N");
+  }
+}
+
+/// A source's `moving = { window, offset }`: it heats a window that travels with the feed axis.
+void read_moving_window(const Tab& h, const toml::node& mv, const CaseSpec& spec,
+                        core::HeatSource& src) {
+  const Ctx& c = *h.ctx;
+  const Tab w = as_tab(c, mv, h.at("moving"), "an inline table { window, offset }");
+  w.allow({"window", "offset"});
+  if (spec.feed_axis.segments.empty())
+    fail_value(c, mv, h.at("moving"), "needs a [feed_axis] table to move with");
+  if (src.temperature_coefficient != 0)
+    fail_value(c, mv, h.at("moving"), "cannot be combined with temperature_coefficient_per_K");
+  src.window = length(w, "window", Sign::positive, "length of the heated part in length_unit");
+  src.window_offset = number_or(w, "offset", 0.0) / c.length_divisor;
+}
+
+/// One [[thermal.heat_sources]] entry; its name is unique among the sources read before it.
+core::HeatSource read_heat_source(const Tab& h, const CaseSpec& spec, const Names& bodies) {
+  using Law = core::HeatSource::Law;
+  h.allow(kHeatSourceKeys);
+  core::HeatSource src;
+  src.name = name(h, "name");
+  unique(h, "name", src.name, names_of(spec.thermal.sources), "heat source");
+  src.body = reference(h, "body", bodies, "body");
+  src.law = choice_or<Law>(h, "law", Law::speed_power, kLaws);
+  check_law_keys(h, src.law);
+  read_law_parameters(h, spec, src);
+  src.temperature_coefficient = number_or(h, "temperature_coefficient_per_K", 0.0);
+  if (const auto* mv = h.get("moving")) read_moving_window(h, *mv, spec, src);
+  return src;
+}
+
+/// One [[thermal.surface_flux]] entry.
+core::SurfaceFlux read_surface_flux(const Tab& f, const Names& groups) {
+  f.allow({"group", "flux_W_m2", "follows_speed", "ref_speed_rpm"});
+  core::SurfaceFlux flux;
+  flux.group = reference(f, "group", groups, "boundary group");
+  flux.flux = number(f, "flux_W_m2", Sign::any, "heat flux into the body in W/m^2");
+  flux.follows_speed = flag_or(f, "follows_speed", false);
+  if (flux.follows_speed) {
+    flux.ref_speed_rpm =
+        number(f, "ref_speed_rpm", Sign::positive, "speed at which flux_W_m2 holds");
+  } else if (const auto* r = f.get("ref_speed_rpm")) {
+    fail_value(*f.ctx, *r, f.at("ref_speed_rpm"), "only used with follows_speed = true");
+  }
+  return flux;
+}
+
 void read_thermal(const Tab& root, CaseSpec& spec) {
   const toml::node* n = root.get("thermal");
   if (!n) return;
   const Tab t = as_tab(*root.ctx, *n, "thermal");
-  const Ctx& c = *t.ctx;
   t.allow({"initial_temperature_degC", "scheme", "step_s", "output_interval_s", "lumped_mass",
            "convection", "heat_sources", "surface_flux"});
   auto& th = spec.thermal;
@@ -902,124 +1061,14 @@ void read_thermal(const Tab& root, CaseSpec& spec) {
 
   const Names groups = names_of(spec.groups);
   const Names bodies = names_of(spec.bodies);
-  std::vector<int> convected;
   each_table(t, "convection", [&](const Tab& cv, std::size_t) {
-    cv.allow({"group", "h_W_m2K", "h_speed_gain_W_m2K", "speed_ref_rpm", "speed_exponent",
-              "sink_degC", "sink_table"});
-    core::Convection conv;
-    conv.group = reference(cv, "group", groups, "boundary group");
-    if (std::find(convected.begin(), convected.end(), conv.group) != convected.end())
-      fail_value(c, cv.need("group", ""), cv.at("group"), "already has a convection entry",
-                 "merge the two into one");
-    convected.push_back(conv.group);
-    conv.h = number(cv, "h_W_m2K", Sign::non_negative, "heat transfer coefficient in W/(m^2 K)");
-    conv.h_speed_gain = number_or(cv, "h_speed_gain_W_m2K", 0.0, Sign::non_negative);
-    if (cv.get("h_speed_gain_W_m2K") && !cv.get("speed_ref_rpm"))
-      fail(c, cv.line(),
-           cv.at("speed_ref_rpm") +
-               ": missing; expected the speed at which the gain applies, "
-               "required with h_speed_gain_W_m2K");
-    conv.speed_ref_rpm = number_or(cv, "speed_ref_rpm", conv.speed_ref_rpm, Sign::positive);
-    conv.speed_exponent = number_or(cv, "speed_exponent", conv.speed_exponent, Sign::non_negative);
-    const toml::node* sd = cv.get("sink_degC");
-    const toml::node* st = cv.get("sink_table");
-    if (sd && st)
-      fail_value(c, *st, cv.at("sink_table"), "give either sink_degC or sink_table, not both");
-    if (sd) {
-      conv.sink.time = {0.0};
-      conv.sink.value = {temperature_c(c, *sd, cv.at("sink_degC"))};
-    } else if (st) {
-      conv.sink = sink_table(c, *st, cv.at("sink_table"));
-    } else {
-      fail(c, cv.line(),
-           cv.at("sink_degC") +
-               ": missing; expected the sink temperature (sink_degC = 20.0 or "
-               "sink_table = [[t_s, degC], ...])");
-    }
-    th.convection.push_back(conv);
+    th.convection.push_back(read_convection(cv, groups, th.convection));
   });
-
-  using Law = core::HeatSource::Law;
-  const Names law_keys_speed = {"power_ref_W", "ref_speed_rpm", "exponent"};
-  const Names law_keys_const = {"power_ref_W"};
-  const Names law_keys_palm = {"palmgren_f0", "palmgren_nu_cSt", "palmgren_dm", "palmgren_f1",
-                               "palmgren_p1_N"};
-  const Names law_keys_feed = {"power_ref_W", "ref_feed_m_min", "ref_feed_m_s", "exponent"};
-  Names all_keys = {"name",        "body",          "law",     "temperature_coefficient_per_K",
-                    "power_ref_W", "ref_speed_rpm", "exponent"};
-  all_keys.insert(all_keys.end(), law_keys_palm.begin(), law_keys_palm.end());
-  all_keys.push_back("ref_feed_m_min");
-  all_keys.push_back("ref_feed_m_s");
-  all_keys.push_back("moving");  // after the law keys: not a law key itself
   each_table(t, "heat_sources", [&](const Tab& h, std::size_t) {
-    h.allow(all_keys);
-    core::HeatSource src;
-    src.name = name(h, "name");
-    unique(h, "name", src.name, names_of(th.sources), "heat source");
-    src.body = reference(h, "body", bodies, "body");
-    src.law = choice_or<Law>(h, "law", Law::speed_power, kLaws);
-    const Names& used = src.law == Law::speed_power  ? law_keys_speed
-                        : src.law == Law::constant   ? law_keys_const
-                        : src.law == Law::feed_power ? law_keys_feed
-                                                     : law_keys_palm;
-    const std::string& law_name = name_of(kLaws, src.law);
-    for (auto&& [k, v] : *h.t) {
-      const bool law_key = k.str() != "moving" && std::find(all_keys.begin() + 4, all_keys.end(),
-                                                            k.str()) != all_keys.end();
-      if (law_key && std::find(used.begin(), used.end(), k.str()) == used.end())
-        fail(c, line_of(v),
-             h.at(k.str()) + " = " + value_text(v) + ": not used by law = \"" + law_name +
-                 "\"; remove it or change the law");
-    }
-    if (src.law == Law::speed_power) {
-      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_speed_rpm in W");
-      src.ref_speed_rpm = number(h, "ref_speed_rpm", Sign::positive);
-      src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
-    } else if (src.law == Law::constant) {
-      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat in W");
-    } else if (src.law == Law::feed_power) {
-      if (spec.feed_axis.segments.empty())
-        fail_value(c, *h.get("law"), h.at("law"), "needs a [feed_axis] table",
-                   "declare the axis's motion in [feed_axis]");
-      src.power_ref = number(h, "power_ref_W", Sign::non_negative, "heat at ref_feed_m_min in W");
-      src.ref_feed = feed_speed(h, "ref_feed", Sign::positive);
-      src.exponent = number_or(h, "exponent", 1.0, Sign::non_negative);
-    } else {
-      src.palmgren_f0 = number(h, "palmgren_f0", Sign::positive, "bearing type factor f0");
-      src.palmgren_nu_cSt =
-          number(h, "palmgren_nu_cSt", Sign::positive, "lubricant kinematic viscosity in cSt");
-      src.palmgren_dm = length(h, "palmgren_dm", Sign::positive, "bearing pitch diameter");
-      src.palmgren_f1 = number(h, "palmgren_f1", Sign::non_negative, "load factor f1");
-      src.palmgren_p1 = number(h, "palmgren_p1_N", Sign::non_negative, "equivalent load in N");
-    }
-    src.temperature_coefficient = number_or(h, "temperature_coefficient_per_K", 0.0);
-    if (const auto* mv = h.get("moving")) {
-      const Tab w = as_tab(c, *mv, h.at("moving"), "an inline table { window, offset }");
-      w.allow({"window", "offset"});
-      if (spec.feed_axis.segments.empty())
-        fail_value(c, *mv, h.at("moving"), "needs a [feed_axis] table to move with");
-      if (src.temperature_coefficient != 0)
-        fail_value(c, *mv, h.at("moving"), "cannot be combined with temperature_coefficient_per_K");
-      src.window = length(w, "window", Sign::positive, "length of the heated part in length_unit");
-      src.window_offset = number_or(w, "offset", 0.0) / c.length_divisor;
-    }
-    th.sources.push_back(src);
+    th.sources.push_back(read_heat_source(h, spec, bodies));
   });
-
-  each_table(t, "surface_flux", [&](const Tab& f, std::size_t) {
-    f.allow({"group", "flux_W_m2", "follows_speed", "ref_speed_rpm"});
-    core::SurfaceFlux flux;
-    flux.group = reference(f, "group", groups, "boundary group");
-    flux.flux = number(f, "flux_W_m2", Sign::any, "heat flux into the body in W/m^2");
-    flux.follows_speed = flag_or(f, "follows_speed", false);
-    if (flux.follows_speed) {
-      flux.ref_speed_rpm =
-          number(f, "ref_speed_rpm", Sign::positive, "speed at which flux_W_m2 holds");
-    } else if (const auto* r = f.get("ref_speed_rpm")) {
-      fail_value(c, *r, f.at("ref_speed_rpm"), "only used with follows_speed = true");
-    }
-    th.fluxes.push_back(flux);
-  });
+  each_table(t, "surface_flux",
+             [&](const Tab& f, std::size_t) { th.fluxes.push_back(read_surface_flux(f, groups)); });
 }
 
 /// A step longer than the run leaves nothing to integrate (the default step included).
@@ -1366,6 +1415,180 @@ std::string selector_text(const core::FaceSelector& s, const Names& bodies) {
   return t + " }";
 }
 
+/// [case], [geometry] (always m), the materials, the bodies, [mesh] and the boundary groups.
+std::string model_toml(const CaseSpec& spec, const Names& bodies) {
+  std::ostringstream o;
+  o << "# Resolved case: SI units, every default explicit. Read from "
+    << fs::absolute(spec.source).lexically_normal().string()
+    << "\n\n[case]\nname = " << toml_string(spec.name)
+    << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
+    << "\n\n[geometry]\nlength_unit = \"m\"\n";
+  for (const auto& m : spec.materials) {
+    o << "\n[materials." << key_text(m.name) << "]\ndensity_kg_m3 = " << number_text(m.density)
+      << "\nspecific_heat_J_kgK = " << number_text(m.specific_heat)
+      << "\nconductivity_W_mK = " << number_text(m.conductivity)
+      << "\nyoungs_modulus_Pa = " << number_text(m.youngs_modulus)
+      << "\npoisson_ratio = " << number_text(m.poisson_ratio)
+      << "\nexpansion_per_K = " << number_text(m.expansion) << "\n";
+  }
+  for (const auto& b : spec.bodies) {
+    o << "\n[[bodies]]\nname = " << toml_string(b.name)
+      << "\nmaterial = " << toml_string(spec.materials.at(b.material).name)
+      << "\nmax_edge = " << number_text(b.max_edge) << "\nadd = " << primitives_text(b.add)
+      << "\nsubtract = " << primitives_text(b.subtract) << "\n";
+  }
+  o << "\n[mesh]\norder = " << spec.mesh.order
+    << "\ncircle_segments = " << spec.mesh.circle_segments
+    << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
+    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg)
+    << "\nmax_tets = " << number_text(spec.mesh.max_tets)
+    << "\ntime_limit_s = " << number_text(spec.mesh.time_limit_s)
+    << "\nmemory_limit_GB = " << number_text(spec.mesh.memory_limit_GB) << "\n";
+  for (const auto& g : spec.groups) {
+    o << "\n[[boundary]]\nname = " << toml_string(g.name)
+      << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";
+    for (const auto& s : g.select) o << "  " << selector_text(s, bodies) << ",\n";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+/// One [[thermal.convection]] entry; a constant sink is written as sink_degC.
+std::string convection_toml(const core::Convection& c, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[[thermal.convection]]\ngroup = " << toml_string(groups.at(c.group))
+    << "\nh_W_m2K = " << number_text(c.h)
+    << "\nh_speed_gain_W_m2K = " << number_text(c.h_speed_gain)
+    << "\nspeed_ref_rpm = " << number_text(c.speed_ref_rpm)
+    << "\nspeed_exponent = " << number_text(c.speed_exponent) << "\n";
+  if (c.sink.time.size() == 1 && c.sink.time[0] == 0) {
+    o << "sink_degC = " << number_text(c.sink.value.at(0)) << "\n";
+  } else {
+    o << "sink_table = [";
+    for (std::size_t i = 0; i < c.sink.time.size(); ++i)
+      o << (i ? ", [" : "[") << number_text(c.sink.time[i]) << ", "
+        << number_text(c.sink.value.at(i)) << "]";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+/// One [[thermal.heat_sources]] entry with exactly the keys its law uses.
+std::string heat_source_toml(const core::HeatSource& s, const Names& bodies) {
+  using Law = core::HeatSource::Law;
+  std::ostringstream o;
+  o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
+    << "\nbody = " << toml_string(bodies.at(s.body))
+    << "\nlaw = " << toml_string(name_of(kLaws, s.law)) << "\n";
+  if (s.law == Law::speed_power) {
+    o << "power_ref_W = " << number_text(s.power_ref)
+      << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
+      << "\nexponent = " << number_text(s.exponent) << "\n";
+  } else if (s.law == Law::constant) {
+    o << "power_ref_W = " << number_text(s.power_ref) << "\n";
+  } else if (s.law == Law::feed_power) {
+    o << "power_ref_W = " << number_text(s.power_ref)
+      << "\nref_feed_m_s = " << number_text(s.ref_feed)
+      << "\nexponent = " << number_text(s.exponent) << "\n";
+  } else {
+    o << "palmgren_f0 = " << number_text(s.palmgren_f0)
+      << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
+      << "\npalmgren_dm = " << number_text(s.palmgren_dm)
+      << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
+      << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
+  }
+  o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
+  if (s.window > 0)
+    o << "moving = { window = " << number_text(s.window)
+      << ", offset = " << number_text(s.window_offset) << " }\n";
+  return o.str();
+}
+
+/// [thermal] with its convection, heat sources and surface fluxes.
+std::string thermal_toml(const core::ThermalSpec& th, const Names& bodies, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
+    << "\nscheme = " << toml_string(name_of(kSchemes, th.scheme))
+    << "\nstep_s = " << number_text(th.step)
+    << "\noutput_interval_s = " << number_text(th.output_interval)
+    << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
+  for (const auto& c : th.convection) o << convection_toml(c, groups);
+  for (const auto& s : th.sources) o << heat_source_toml(s, bodies);
+  for (const auto& f : th.fluxes) {
+    o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
+      << "\nflux_W_m2 = " << number_text(f.flux)
+      << "\nfollows_speed = " << (f.follows_speed ? "true" : "false") << "\n";
+    if (f.follows_speed) o << "ref_speed_rpm = " << number_text(f.ref_speed_rpm) << "\n";
+  }
+  return o.str();
+}
+
+/// [duty_cycle] with its segments listed, and [feed_axis] when there is one.
+std::string motion_toml(const CaseSpec& spec) {
+  std::ostringstream o;
+  o << "\n[duty_cycle]\nend_s = " << number_text(spec.duty_cycle.end) << "\nsegments = [\n";
+  for (const auto& s : spec.duty_cycle.segments)
+    o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
+      << " },\n";
+  o << "]\n";
+  if (!spec.feed_axis.segments.empty()) {
+    const auto& ax = spec.feed_axis;
+    o << "\n[feed_axis]\nname = " << toml_string(ax.name) << "\ndirection = \""
+      << "xyz"[ax.direction] << "\"\nsegments = [\n";
+    for (const auto& s : ax.segments)
+      o << "  { start_s = " << number_text(s.start) << ", from = " << number_text(s.from)
+        << ", to = " << number_text(s.to) << ", feed_m_s = " << number_text(s.feed) << " },\n";
+    o << "]\n";
+  }
+  return o.str();
+}
+
+std::string mechanical_toml(const core::MechanicalSpec& me, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
+    << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
+    << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
+  for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
+    const auto& ps = me.point_supports[i];
+    Names dirs;
+    for (int d = 0; d < 3; ++d)
+      if (ps.fixed[d]) dirs.push_back(std::string(1, "xyz"[d]));
+    o << (i ? ", " : "") << "{ point = " << toml_string(ps.point)
+      << ", fixed = " << strings_text(dirs) << " }";
+  }
+  o << "]\n";
+  if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
+  o << "probes = " << strings_text(me.probe_points) << "\n";
+  o << "targets = " << strings_text(me.targets) << "\n";
+  if (!me.axis_points.empty())
+    o << "axis_points = " << strings_text(me.axis_points)
+      << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
+  return o.str();
+}
+
+/// [outputs], [placement] and the named [points].
+std::string outputs_toml(const CaseSpec& spec, const Names& bodies, const Names& groups) {
+  std::ostringstream o;
+  o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
+    << "\nfields = " << (spec.outputs.fields ? "true" : "false")
+    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
+  const auto& pl = spec.placement;
+  o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
+    << "\npoints = " << strings_text(pl.points) << "\n";
+  if (pl.candidates == core::PlacementSpec::Candidates::surface)
+    o << "bodies = " << names_text(pl.bodies, bodies)
+      << "\ngroups = " << names_text(pl.groups, groups)
+      << "\nmax_candidates = " << pl.max_candidates << "\n";
+  o << "\n[points]\nlist = [\n";
+  for (const auto& p : spec.points) {
+    o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
+    if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));
+    o << " },\n";
+  }
+  o << "]\n";
+  return o.str();
+}
+
 }  // namespace
 
 CaseSpec case_from_toml(std::string_view text, const fs::path& file) {
@@ -1436,147 +1659,16 @@ std::vector<fs::path> case_input_files(const CaseSpec& spec) {
 }
 
 std::string resolved_case_toml(const CaseSpec& spec) {
-  using Law = core::HeatSource::Law;
   const Names bodies = names_of(spec.bodies);
   const Names groups = names_of(spec.groups);
-  std::ostringstream o;
-  o << "# Resolved case: SI units, every default explicit. Read from "
-    << fs::absolute(spec.source).lexically_normal().string()
-    << "\n\n[case]\nname = " << toml_string(spec.name)
-    << "\nmachine = " << toml_string(spec.machine) << "\nseed = " << spec.seed
-    << "\n\n[geometry]\nlength_unit = \"m\"\n";
-  for (const auto& m : spec.materials) {
-    o << "\n[materials." << key_text(m.name) << "]\ndensity_kg_m3 = " << number_text(m.density)
-      << "\nspecific_heat_J_kgK = " << number_text(m.specific_heat)
-      << "\nconductivity_W_mK = " << number_text(m.conductivity)
-      << "\nyoungs_modulus_Pa = " << number_text(m.youngs_modulus)
-      << "\npoisson_ratio = " << number_text(m.poisson_ratio)
-      << "\nexpansion_per_K = " << number_text(m.expansion) << "\n";
-  }
-  for (const auto& b : spec.bodies) {
-    o << "\n[[bodies]]\nname = " << toml_string(b.name)
-      << "\nmaterial = " << toml_string(spec.materials.at(b.material).name)
-      << "\nmax_edge = " << number_text(b.max_edge) << "\nadd = " << primitives_text(b.add)
-      << "\nsubtract = " << primitives_text(b.subtract) << "\n";
-  }
-  o << "\n[mesh]\norder = " << spec.mesh.order
-    << "\ncircle_segments = " << spec.mesh.circle_segments
-    << "\nradius_edge_ratio = " << number_text(spec.mesh.radius_edge_ratio)
-    << "\nmin_dihedral_deg = " << number_text(spec.mesh.min_dihedral_deg)
-    << "\nmax_tets = " << number_text(spec.mesh.max_tets)
-    << "\ntime_limit_s = " << number_text(spec.mesh.time_limit_s)
-    << "\nmemory_limit_GB = " << number_text(spec.mesh.memory_limit_GB) << "\n";
-  for (const auto& g : spec.groups) {
-    o << "\n[[boundary]]\nname = " << toml_string(g.name)
-      << "\nrest = " << (g.rest ? "true" : "false") << "\nselect = [\n";
-    for (const auto& s : g.select) o << "  " << selector_text(s, bodies) << ",\n";
-    o << "]\n";
-  }
-  const auto& th = spec.thermal;
-  o << "\n[thermal]\ninitial_temperature_degC = " << number_text(th.initial_temperature_c)
-    << "\nscheme = " << toml_string(name_of(kSchemes, th.scheme))
-    << "\nstep_s = " << number_text(th.step)
-    << "\noutput_interval_s = " << number_text(th.output_interval)
-    << "\nlumped_mass = " << (th.lumped_mass ? "true" : "false") << "\n";
-  for (const auto& c : th.convection) {
-    o << "\n[[thermal.convection]]\ngroup = " << toml_string(groups.at(c.group))
-      << "\nh_W_m2K = " << number_text(c.h)
-      << "\nh_speed_gain_W_m2K = " << number_text(c.h_speed_gain)
-      << "\nspeed_ref_rpm = " << number_text(c.speed_ref_rpm)
-      << "\nspeed_exponent = " << number_text(c.speed_exponent) << "\n";
-    if (c.sink.time.size() == 1 && c.sink.time[0] == 0) {
-      o << "sink_degC = " << number_text(c.sink.value.at(0)) << "\n";
-    } else {
-      o << "sink_table = [";
-      for (std::size_t i = 0; i < c.sink.time.size(); ++i)
-        o << (i ? ", [" : "[") << number_text(c.sink.time[i]) << ", "
-          << number_text(c.sink.value.at(i)) << "]";
-      o << "]\n";
-    }
-  }
-  for (const auto& s : th.sources) {
-    o << "\n[[thermal.heat_sources]]\nname = " << toml_string(s.name)
-      << "\nbody = " << toml_string(bodies.at(s.body))
-      << "\nlaw = " << toml_string(name_of(kLaws, s.law)) << "\n";
-    if (s.law == Law::speed_power) {
-      o << "power_ref_W = " << number_text(s.power_ref)
-        << "\nref_speed_rpm = " << number_text(s.ref_speed_rpm)
-        << "\nexponent = " << number_text(s.exponent) << "\n";
-    } else if (s.law == Law::constant) {
-      o << "power_ref_W = " << number_text(s.power_ref) << "\n";
-    } else if (s.law == Law::feed_power) {
-      o << "power_ref_W = " << number_text(s.power_ref)
-        << "\nref_feed_m_s = " << number_text(s.ref_feed)
-        << "\nexponent = " << number_text(s.exponent) << "\n";
-    } else {
-      o << "palmgren_f0 = " << number_text(s.palmgren_f0)
-        << "\npalmgren_nu_cSt = " << number_text(s.palmgren_nu_cSt)
-        << "\npalmgren_dm = " << number_text(s.palmgren_dm)
-        << "\npalmgren_f1 = " << number_text(s.palmgren_f1)
-        << "\npalmgren_p1_N = " << number_text(s.palmgren_p1) << "\n";
-    }
-    o << "temperature_coefficient_per_K = " << number_text(s.temperature_coefficient) << "\n";
-    if (s.window > 0)
-      o << "moving = { window = " << number_text(s.window)
-        << ", offset = " << number_text(s.window_offset) << " }\n";
-  }
-  for (const auto& f : th.fluxes) {
-    o << "\n[[thermal.surface_flux]]\ngroup = " << toml_string(groups.at(f.group))
-      << "\nflux_W_m2 = " << number_text(f.flux)
-      << "\nfollows_speed = " << (f.follows_speed ? "true" : "false") << "\n";
-    if (f.follows_speed) o << "ref_speed_rpm = " << number_text(f.ref_speed_rpm) << "\n";
-  }
-  o << "\n[duty_cycle]\nend_s = " << number_text(spec.duty_cycle.end) << "\nsegments = [\n";
-  for (const auto& s : spec.duty_cycle.segments)
-    o << "  { start_s = " << number_text(s.start) << ", speed_rpm = " << number_text(s.speed_rpm)
-      << " },\n";
-  o << "]\n";
-  if (!spec.feed_axis.segments.empty()) {
-    const auto& ax = spec.feed_axis;
-    o << "\n[feed_axis]\nname = " << toml_string(ax.name) << "\ndirection = \""
-      << "xyz"[ax.direction] << "\"\nsegments = [\n";
-    for (const auto& s : ax.segments)
-      o << "  { start_s = " << number_text(s.start) << ", from = " << number_text(s.from)
-        << ", to = " << number_text(s.to) << ", feed_m_s = " << number_text(s.feed) << " },\n";
-    o << "]\n";
-  }
-  const auto& me = spec.mechanical;
-  o << "\n[mechanical]\nenabled = " << (me.enabled ? "true" : "false")
-    << "\nreference_temperature_degC = " << number_text(me.reference_temperature_c)
-    << "\nfixed = " << names_text(me.fixed_groups, groups) << "\npoint_supports = [";
-  for (std::size_t i = 0; i < me.point_supports.size(); ++i) {
-    const auto& ps = me.point_supports[i];
-    Names dirs;
-    for (int d = 0; d < 3; ++d)
-      if (ps.fixed[d]) dirs.push_back(std::string(1, "xyz"[d]));
-    o << (i ? ", " : "") << "{ point = " << toml_string(ps.point)
-      << ", fixed = " << strings_text(dirs) << " }";
-  }
-  o << "]\n";
-  if (!me.tcp_point.empty()) o << "tcp = " << toml_string(me.tcp_point) << "\n";
-  o << "probes = " << strings_text(me.probe_points) << "\n";
-  o << "targets = " << strings_text(me.targets) << "\n";
-  if (!me.axis_points.empty())
-    o << "axis_points = " << strings_text(me.axis_points)
-      << "\naxis_polynomial_degree = " << me.axis_polynomial_degree << "\n";
-  o << "\n[outputs]\nplot_points = " << strings_text(spec.outputs.plot_points)
-    << "\nfields = " << (spec.outputs.fields ? "true" : "false")
-    << "\nfields_interval_s = " << number_text(spec.outputs.fields_interval) << "\n";
-  const auto& pl = spec.placement;
-  o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
-    << "\npoints = " << strings_text(pl.points) << "\n";
-  if (pl.candidates == core::PlacementSpec::Candidates::surface)
-    o << "bodies = " << names_text(pl.bodies, bodies)
-      << "\ngroups = " << names_text(pl.groups, groups)
-      << "\nmax_candidates = " << pl.max_candidates << "\n";
-  o << "\n[points]\nlist = [\n";
-  for (const auto& p : spec.points) {
-    o << "  { id = " << toml_string(p.id) << ", position = " << vec_text(p.position);
-    if (p.on_group >= 0) o << ", on = " << toml_string(groups.at(p.on_group));
-    o << " },\n";
-  }
-  o << "]\n";
-  return o.str();
+  // One section after the other, so that the first section that cannot be written is the one
+  // reported.
+  std::string out = model_toml(spec, bodies);
+  out += thermal_toml(spec.thermal, bodies, groups);
+  out += motion_toml(spec);
+  out += mechanical_toml(spec.mechanical, groups);
+  out += outputs_toml(spec, bodies, groups);
+  return out;
 }
 
 }  // namespace tt::io

@@ -205,8 +205,8 @@ std::optional<PublishedFigure> published_figure(const fs::path& file, const json
   return f;
 }
 
-/// meta.json as a run with no samples yet.
-MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
+/// meta.json parsed; it must be a JSON object.
+json parsed_meta(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in)
     throw core::IoError(file.string() +
@@ -221,6 +221,97 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   }
   if (!meta.is_object())
     throw core::DataError(core::located(file.string(), 0, "expected a JSON object"));
+  return meta;
+}
+
+/// The column ids met so far: inputs, sensors and displacements share one name space.
+class ColumnIds {
+ public:
+  explicit ColumnIds(const fs::path& file) : file_(file) {}
+  void add(const std::string& id, const std::string& path) {
+    if (!ids_.insert(id).second)
+      meta_error(file_, path, "id '" + id + "' is used twice; every column id must be unique");
+  }
+
+ private:
+  const fs::path& file_;
+  std::set<std::string> ids_;
+};
+
+/// meta.json's inputs: ids of speed columns in rpm.
+std::vector<std::string> meta_inputs(const fs::path& file, const json& meta, ColumnIds& ids) {
+  std::vector<std::string> out;
+  const json& inputs = id_list(file, meta, "inputs", false);
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string path = "inputs[" + std::to_string(i) + "]";
+    const std::string id = item_id(file, inputs[i], path);
+    ids.add(id, path + ".id");
+    const std::string unit =
+        string_value(file, required_key(file, inputs[i], "unit", path + ".unit"), path + ".unit");
+    if (unit != "rpm")
+      meta_error(file, path + ".unit", "unknown unit '" + unit + "': expected 'rpm'");
+    out.push_back(id);
+  }
+  return out;
+}
+
+/// meta.json's sensors; a position must lie in `box` when there is one.
+std::vector<MeasuredSensor> meta_sensors(const fs::path& file, const json& meta,
+                                         const std::optional<Eigen::AlignedBox3d>& box,
+                                         const std::string& machine, ColumnIds& ids) {
+  std::vector<MeasuredSensor> out;
+  const json& sensors = id_list(file, meta, "sensors", true);
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    const std::string path = "sensors[" + std::to_string(i) + "]";
+    MeasuredSensor s;
+    s.id = item_id(file, sensors[i], path);
+    ids.add(s.id, path + ".id");
+    s.position = optional_vector(file, sensors[i], "position", path + ".position");
+    require_inside(file, box, s.position, path + ".position", machine);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+/// meta.json's displacements; a point must lie in `box`, a direction becomes a unit vector.
+std::vector<MeasuredProbe> meta_probes(const fs::path& file, const json& meta,
+                                       const std::optional<Eigen::AlignedBox3d>& box,
+                                       const std::string& machine, ColumnIds& ids) {
+  std::vector<MeasuredProbe> out;
+  const json& probes = id_list(file, meta, "displacements", true);
+  for (std::size_t i = 0; i < probes.size(); ++i) {
+    const std::string path = "displacements[" + std::to_string(i) + "]";
+    MeasuredProbe p;
+    p.id = item_id(file, probes[i], path);
+    ids.add(p.id, path + ".id");
+    p.point = optional_vector(file, probes[i], "point", path + ".point");
+    require_inside(file, box, p.point, path + ".point", machine);
+    p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
+    if (p.direction) {
+      const double norm = p.direction->norm();
+      if (!(norm > 0)) meta_error(file, path + ".direction", "[0, 0, 0]: expected a unit vector");
+      *p.direction /= norm;
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+/// meta.json's ambient_sensor, when given (not null): the id of one of `sensors`.
+std::optional<std::string> meta_ambient_sensor(const fs::path& file, const json& meta,
+                                               const std::vector<MeasuredSensor>& sensors) {
+  const auto it = meta.find("ambient_sensor");
+  if (it == meta.end() || it->is_null()) return std::nullopt;
+  const std::string id = string_value(file, *it, "ambient_sensor");
+  bool found = false;
+  for (const auto& s : sensors) found = found || s.id == id;
+  if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
+  return id;
+}
+
+/// meta.json as a run with no samples yet.
+MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits) {
+  json meta = parsed_meta(file);
   MeasuredRun run;
   run.folder = file.parent_path();
   const std::string format =
@@ -239,55 +330,11 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   run.initial_temperature_c = optional_temperature(file, meta, "initial_temperature_degC");
   run.nominal_ambient_c = optional_temperature(file, meta, "nominal_ambient_degC");
 
-  std::set<std::string> ids;
-  const auto unique = [&](const std::string& id, const std::string& path) {
-    if (!ids.insert(id).second)
-      meta_error(file, path, "id '" + id + "' is used twice; every column id must be unique");
-  };
-  const json& inputs = id_list(file, meta, "inputs", false);
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const std::string path = "inputs[" + std::to_string(i) + "]";
-    const std::string id = item_id(file, inputs[i], path);
-    unique(id, path + ".id");
-    const std::string unit =
-        string_value(file, required_key(file, inputs[i], "unit", path + ".unit"), path + ".unit");
-    if (unit != "rpm")
-      meta_error(file, path + ".unit", "unknown unit '" + unit + "': expected 'rpm'");
-    run.inputs.push_back(id);
-  }
-  const json& sensors = id_list(file, meta, "sensors", true);
-  for (std::size_t i = 0; i < sensors.size(); ++i) {
-    const std::string path = "sensors[" + std::to_string(i) + "]";
-    MeasuredSensor s;
-    s.id = item_id(file, sensors[i], path);
-    unique(s.id, path + ".id");
-    s.position = optional_vector(file, sensors[i], "position", path + ".position");
-    require_inside(file, box, s.position, path + ".position", run.machine);
-    run.sensors.push_back(std::move(s));
-  }
-  const json& probes = id_list(file, meta, "displacements", true);
-  for (std::size_t i = 0; i < probes.size(); ++i) {
-    const std::string path = "displacements[" + std::to_string(i) + "]";
-    MeasuredProbe p;
-    p.id = item_id(file, probes[i], path);
-    unique(p.id, path + ".id");
-    p.point = optional_vector(file, probes[i], "point", path + ".point");
-    require_inside(file, box, p.point, path + ".point", run.machine);
-    p.direction = optional_vector(file, probes[i], "direction", path + ".direction");
-    if (p.direction) {
-      const double norm = p.direction->norm();
-      if (!(norm > 0)) meta_error(file, path + ".direction", "[0, 0, 0]: expected a unit vector");
-      *p.direction /= norm;
-    }
-    run.displacements.push_back(std::move(p));
-  }
-  if (const auto it = meta.find("ambient_sensor"); it != meta.end() && !it->is_null()) {
-    const std::string id = string_value(file, *it, "ambient_sensor");
-    bool found = false;
-    for (const auto& s : run.sensors) found = found || s.id == id;
-    if (!found) meta_error(file, "ambient_sensor", "'" + id + "' is not the id of one of sensors");
-    run.ambient_sensor = id;
-  }
+  ColumnIds ids(file);
+  run.inputs = meta_inputs(file, meta, ids);
+  run.sensors = meta_sensors(file, meta, box, run.machine, ids);
+  run.displacements = meta_probes(file, meta, box, run.machine, ids);
+  run.ambient_sensor = meta_ambient_sensor(file, meta, run.sensors);
   run.published = published_figure(file, meta, run);
   run.meta = std::move(meta);
   return run;
@@ -402,8 +449,8 @@ std::vector<ColumnSlot> header_slots(const fs::path& file, std::string_view line
   return slots;
 }
 
-/// data.csv into run's matrices, converted to SI.
-void read_samples(const fs::path& file, const MeasuredReadLimits& limits, MeasuredRun& run) {
+/// data.csv's size, refused beyond limits.max_bytes.
+std::uintmax_t checked_size(const fs::path& file, const MeasuredReadLimits& limits) {
   std::error_code ec;
   const auto bytes = fs::file_size(file, ec);
   if (ec) throw core::IoError(file.string() + ": cannot read: " + ec.message());
@@ -412,82 +459,87 @@ void read_samples(const fs::path& file, const MeasuredReadLimits& limits, Measur
         core::located(file.string(), 0,
                       "file size " + std::to_string(bytes) + " bytes exceeds the limit of " +
                           std::to_string(limits.max_bytes) + " bytes; raise max_bytes to read it"));
-  LineReader reader(file);
-  if (!reader.is_open()) throw core::IoError(file.string() + ": cannot open for reading");
-  std::string_view line;
-  if (!reader.next(line))
-    throw core::DataError(
-        core::located(file.string(), 1, "empty file: expected a header row starting with time_s"));
+  return bytes;
+}
+
+/// The header of data.csv as matched by header_slots: each column's role and name.
+struct Columns {
+  std::vector<ColumnSlot> slots;
   std::vector<std::string> names;
-  const std::vector<ColumnSlot> slots = header_slots(file, line, run, names);
-  const std::size_t columns = slots.size();
-  // Row-major values in the file's column order; reshaped once at the end.
-  std::vector<double> values;
-  values.reserve(std::min<std::size_t>(bytes / 4, std::size_t(1) << 26));
-  std::size_t rows = 0;
-  double last_time = -std::numeric_limits<double>::infinity();
-  const double missing = std::numeric_limits<double>::quiet_NaN();
-  while (reader.next(line)) {
-    if (trimmed(line).empty()) continue;
-    const int number = reader.line_number();
-    if (++rows > limits.max_rows)
+};
+
+/// One cell's value in the file's unit; an empty cell is a missing reading (NaN), except a time.
+double cell_value(const fs::path& file, int number, const std::string& where, std::string_view cell,
+                  ColumnRole role, bool first_column) {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  if (!cell.empty()) {
+    const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
+    const auto result = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (result.ec != std::errc() || result.ptr != digits.data() + digits.size() || digits.empty())
       throw core::DataError(core::located(file.string(), number,
-                                          "more than " + std::to_string(limits.max_rows) +
-                                              " rows; raise max_rows to read this file"));
-    std::size_t start = 0, column = 0;
-    while (true) {
-      const auto comma = line.find(',', start);
-      if (column >= columns)
-        throw core::DataError(core::located(file.string(), number,
-                                            "column " + std::to_string(column + 1) +
-                                                ": more cells than the " + std::to_string(columns) +
-                                                " columns of the header"));
-      const std::string_view cell = trimmed(line.substr(start, comma - start));
-      const std::string where = "column " + std::to_string(column + 1) + " '" + names[column] + "'";
-      double value = missing;
-      if (!cell.empty()) {
-        const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
-        const auto result = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-        if (result.ec != std::errc() || result.ptr != digits.data() + digits.size() ||
-            digits.empty())
-          throw core::DataError(core::located(
-              file.string(), number, where + ": '" + cell_text(cell) + "' is not a number"));
-        if (!std::isfinite(value))
-          throw core::DataError(
-              core::located(file.string(), number,
-                            where + ": '" + cell_text(cell) +
-                                "' is not a finite number; leave the cell empty for a missing "
-                                "reading"));
-        if (slots[column].role == ColumnRole::sensor && value < core::limits::kAbsoluteZeroDegC)
-          throw core::DataError(core::located(
-              file.string(), number,
-              where + ": " + cell_text(cell) +
-                  " degC is below absolute zero (-273.15 degC); temperatures are in degC"));
-      } else if (column == 0) {
-        throw core::DataError(
-            core::located(file.string(), number, where + ": empty time; every row needs one"));
-      }
-      if (column == 0) {
-        if (!(value > last_time)) {
-          char text[160];
-          std::snprintf(text, sizeof text,
-                        "%s: time %.17g s does not increase (previous row: %.17g s)", where.c_str(),
-                        value, last_time);
-          throw core::DataError(core::located(file.string(), number, text));
-        }
-        last_time = value;
-      }
-      values.push_back(value);
-      ++column;
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
-    if (column != columns)
-      throw core::DataError(core::located(file.string(), number,
-                                          "column " + std::to_string(column + 1) + ": row has " +
-                                              std::to_string(column) + " cells: expected " +
-                                              std::to_string(columns)));
+                                          where + ": '" + cell_text(cell) + "' is not a number"));
+    if (!std::isfinite(value))
+      throw core::DataError(
+          core::located(file.string(), number,
+                        where + ": '" + cell_text(cell) +
+                            "' is not a finite number; leave the cell empty for a missing "
+                            "reading"));
+    if (role == ColumnRole::sensor && value < core::limits::kAbsoluteZeroDegC)
+      throw core::DataError(core::located(
+          file.string(), number,
+          where + ": " + cell_text(cell) +
+              " degC is below absolute zero (-273.15 degC); temperatures are in degC"));
+  } else if (first_column) {
+    throw core::DataError(
+        core::located(file.string(), number, where + ": empty time; every row needs one"));
   }
+  return value;
+}
+
+/// Appends the cells of data row `line` (line `number`) to `values`; its time must exceed
+/// `last_time`, which becomes it.
+void append_row(const fs::path& file, int number, std::string_view line, const Columns& header,
+                double& last_time, std::vector<double>& values) {
+  const std::size_t columns = header.slots.size();
+  std::size_t start = 0, column = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    if (column >= columns)
+      throw core::DataError(core::located(file.string(), number,
+                                          "column " + std::to_string(column + 1) +
+                                              ": more cells than the " + std::to_string(columns) +
+                                              " columns of the header"));
+    const std::string_view cell = trimmed(line.substr(start, comma - start));
+    const std::string where =
+        "column " + std::to_string(column + 1) + " '" + header.names[column] + "'";
+    const double value =
+        cell_value(file, number, where, cell, header.slots[column].role, column == 0);
+    if (column == 0) {
+      if (!(value > last_time)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "%s: time %.17g s does not increase (previous row: %.17g s)", where.c_str(),
+                      value, last_time);
+        throw core::DataError(core::located(file.string(), number, text));
+      }
+      last_time = value;
+    }
+    values.push_back(value);
+    ++column;
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  if (column != columns)
+    throw core::DataError(core::located(file.string(), number,
+                                        "column " + std::to_string(column + 1) + ": row has " +
+                                            std::to_string(column) + " cells: expected " +
+                                            std::to_string(columns)));
+}
+
+/// Row-major `values` in the file's columns into run's matrices, converted to SI.
+void fill_samples(const std::vector<double>& values, std::size_t rows,
+                  const std::vector<ColumnSlot>& slots, MeasuredRun& run) {
+  const std::size_t columns = slots.size();
   const auto n = static_cast<Eigen::Index>(rows);
   run.time.resize(n);
   run.input_values.resize(n, static_cast<Eigen::Index>(run.inputs.size()));
@@ -513,6 +565,34 @@ void read_samples(const fs::path& file, const MeasuredReadLimits& limits, Measur
       }
     }
   }
+}
+
+/// data.csv into run's matrices, converted to SI.
+void read_samples(const fs::path& file, const MeasuredReadLimits& limits, MeasuredRun& run) {
+  const auto bytes = checked_size(file, limits);
+  LineReader reader(file);
+  if (!reader.is_open()) throw core::IoError(file.string() + ": cannot open for reading");
+  std::string_view line;
+  if (!reader.next(line))
+    throw core::DataError(
+        core::located(file.string(), 1, "empty file: expected a header row starting with time_s"));
+  Columns header;
+  header.slots = header_slots(file, line, run, header.names);
+  // Row-major values in the file's column order; reshaped once at the end.
+  std::vector<double> values;
+  values.reserve(std::min<std::size_t>(bytes / 4, std::size_t(1) << 26));
+  std::size_t rows = 0;
+  double last_time = -std::numeric_limits<double>::infinity();
+  while (reader.next(line)) {
+    if (trimmed(line).empty()) continue;
+    const int number = reader.line_number();
+    if (++rows > limits.max_rows)
+      throw core::DataError(core::located(file.string(), number,
+                                          "more than " + std::to_string(limits.max_rows) +
+                                              " rows; raise max_rows to read this file"));
+    append_row(file, number, line, header, last_time, values);
+  }
+  fill_samples(values, rows, header.slots, run);
 }
 
 json vector_json(const std::optional<Eigen::Vector3d>& v) {

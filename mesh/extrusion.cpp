@@ -197,87 +197,126 @@ Ring ring_of(const Pslg& g, const std::vector<int>& ids) {
   return r;
 }
 
-Arrangement arrangement(const Pslg& g) {
-  const int nv = static_cast<int>(g.vertices.size());
-  const int nh = 2 * static_cast<int>(g.edges.size());
-  auto origin = [&](int h) { return g.edges[h / 2][h % 2]; };
-  auto dest = [&](int h) { return g.edges[h / 2][1 - h % 2]; };
-  std::vector<std::vector<int>> out(nv);
-  for (int h = 0; h < nh; ++h) out[origin(h)].push_back(h);
-  for (int v = 0; v < nv; ++v) {
-    auto angle = [&](int h) {
-      const Vector2d d = g.vertices[dest(h)] - g.vertices[v];
-      return std::atan2(d.y(), d.x());
-    };
-    std::sort(out[v].begin(), out[v].end(), [&](int a, int b) { return angle(a) < angle(b); });
-  }
-  std::vector<int> pos(nh);
-  for (int v = 0; v < nv; ++v)
-    for (size_t k = 0; k < out[v].size(); ++k) pos[out[v][k]] = static_cast<int>(k);
-  auto next = [&](int h) {
+/// The half-edges of a graph, 2e (a->b) and 2e+1 (b->a), with those leaving each vertex sorted
+/// by angle, so that `next` walks the boundary of the face on a half-edge's left.
+struct HalfEdges {
+  const Pslg* g = nullptr;
+  std::vector<std::vector<int>> out;  /// per vertex: its outgoing half-edges by angle
+  std::vector<int> pos;               /// per half-edge: its index in out[origin]
+
+  int count() const { return 2 * static_cast<int>(g->edges.size()); }
+  int origin(int h) const { return g->edges[h / 2][h % 2]; }
+  int dest(int h) const { return g->edges[h / 2][1 - h % 2]; }
+  int next(int h) const {
     const int v = dest(h);
     const int twin = h ^ 1;
     const int deg = static_cast<int>(out[v].size());
     return out[v][(pos[twin] - 1 + deg) % deg];
-  };
+  }
+};
 
-  // Components, for telling a hole's container from its own outer cycle.
-  std::vector<int> comp(nv);
+HalfEdges half_edges(const Pslg& g) {
+  HalfEdges he{&g, {}, {}};
+  const int nv = static_cast<int>(g.vertices.size());
+  he.out.resize(nv);
+  for (int h = 0; h < he.count(); ++h) he.out[he.origin(h)].push_back(h);
+  for (int v = 0; v < nv; ++v) {
+    auto angle = [&](int h) {
+      const Vector2d d = g.vertices[he.dest(h)] - g.vertices[v];
+      return std::atan2(d.y(), d.x());
+    };
+    std::sort(he.out[v].begin(), he.out[v].end(),
+              [&](int a, int b) { return angle(a) < angle(b); });
+  }
+  he.pos.resize(he.count());
+  for (int v = 0; v < nv; ++v)
+    for (size_t k = 0; k < he.out[v].size(); ++k) he.pos[he.out[v][k]] = static_cast<int>(k);
+  return he;
+}
+
+/// Per vertex, a representative of its connected component: a hole's container must belong to
+/// another component than the hole's own outer cycle.
+std::vector<int> components(const Pslg& g) {
+  std::vector<int> comp(g.vertices.size());
   std::iota(comp.begin(), comp.end(), 0);
   std::function<int(int)> find = [&](int x) { return comp[x] == x ? x : comp[x] = find(comp[x]); };
   for (const auto& e : g.edges) comp[find(e[0])] = find(e[1]);
+  std::vector<int> root(comp.size());
+  for (size_t v = 0; v < comp.size(); ++v) root[v] = find(static_cast<int>(v));
+  return root;
+}
 
-  struct Cycle {
-    std::vector<int> halfedges;
-    std::vector<int> ring;
-    double area;
-    int component;
-  };
-  std::vector<Cycle> cycles;
-  std::vector<int> cycle_of(nh, -1);
-  for (int h0 = 0; h0 < nh; ++h0) {
-    if (cycle_of[h0] >= 0) continue;
+/// A closed walk of half-edges: the outer boundary of a face (area > 0) or a hole (area <= 0).
+struct Cycle {
+  std::vector<int> ring;  /// vertices
+  double area;
+  int component;
+};
+
+/// Every half-edge's cycle; `of_halfedge` maps a half-edge to its index in `list`.
+struct Cycles {
+  std::vector<Cycle> list;
+  std::vector<int> of_halfedge;
+};
+
+Cycles boundary_cycles(const Pslg& g, const HalfEdges& he) {
+  const std::vector<int> component = components(g);
+  Cycles cycles{{}, std::vector<int>(he.count(), -1)};
+  for (int h0 = 0; h0 < he.count(); ++h0) {
+    if (cycles.of_halfedge[h0] >= 0) continue;
     Cycle c;
     int h = h0;
     do {
-      cycle_of[h] = static_cast<int>(cycles.size());
-      c.halfedges.push_back(h);
-      c.ring.push_back(origin(h));
-      h = next(h);
+      cycles.of_halfedge[h] = static_cast<int>(cycles.list.size());
+      c.ring.push_back(he.origin(h));
+      h = he.next(h);
     } while (h != h0);
     c.area = signed_area(ring_of(g, c.ring));
-    c.component = find(c.ring[0]);
-    cycles.push_back(std::move(c));
+    c.component = component[c.ring[0]];
+    cycles.list.push_back(std::move(c));
   }
+  return cycles;
+}
 
-  Arrangement arr;
-  std::vector<int> face_of_cycle(cycles.size(), -1);
-  for (size_t c = 0; c < cycles.size(); ++c) {
-    if (cycles[c].area > 0) {
-      face_of_cycle[c] = static_cast<int>(arr.faces.size());
-      arr.faces.push_back(Face{cycles[c].ring, {}});
+/// The smallest outer cycle of another component that contains hole cycle `c`; -1 when none
+/// does (the hole bounds the unbounded face).
+int enclosing_cycle(const Pslg& g, const std::vector<Cycle>& cycles, size_t c) {
+  const Vector2d p = g.vertices[cycles[c].ring[0]];
+  int best = -1;
+  double best_area = 0;
+  for (size_t d = 0; d < cycles.size(); ++d) {
+    if (cycles[d].area <= 0 || cycles[d].component == cycles[c].component) continue;
+    if (!ring_contains(ring_of(g, cycles[d].ring), p)) continue;
+    if (best < 0 || cycles[d].area < best_area) {
+      best = static_cast<int>(d);
+      best_area = cycles[d].area;
     }
   }
-  for (size_t c = 0; c < cycles.size(); ++c) {
-    if (cycles[c].area > 0) continue;
-    const Vector2d p = g.vertices[cycles[c].ring[0]];
-    int best = -1;
-    double best_area = 0;
-    for (size_t d = 0; d < cycles.size(); ++d) {
-      if (cycles[d].area <= 0 || cycles[d].component == cycles[c].component) continue;
-      if (!ring_contains(ring_of(g, cycles[d].ring), p)) continue;
-      if (best < 0 || cycles[d].area < best_area) {
-        best = static_cast<int>(d);
-        best_area = cycles[d].area;
-      }
+  return best;
+}
+
+Arrangement arrangement(const Pslg& g) {
+  const HalfEdges he = half_edges(g);
+  const Cycles cycles = boundary_cycles(g, he);
+  const std::vector<Cycle>& list = cycles.list;
+  Arrangement arr;
+  std::vector<int> face_of_cycle(list.size(), -1);
+  for (size_t c = 0; c < list.size(); ++c) {
+    if (list[c].area > 0) {
+      face_of_cycle[c] = static_cast<int>(arr.faces.size());
+      arr.faces.push_back(Face{list[c].ring, {}});
     }
+  }
+  for (size_t c = 0; c < list.size(); ++c) {
+    if (list[c].area > 0) continue;
+    const int best = enclosing_cycle(g, list, c);
     if (best >= 0) {
       face_of_cycle[c] = face_of_cycle[best];
-      arr.faces[face_of_cycle[best]].holes.push_back(cycles[c].ring);
+      arr.faces[face_of_cycle[best]].holes.push_back(list[c].ring);
     }
   }
-  arr.halfedge_face.assign(nh, -1);
-  for (int h = 0; h < nh; ++h) arr.halfedge_face[h] = face_of_cycle[cycle_of[h]];
+  arr.halfedge_face.assign(he.count(), -1);
+  for (int h = 0; h < he.count(); ++h) arr.halfedge_face[h] = face_of_cycle[cycles.of_halfedge[h]];
   return arr;
 }
 
@@ -465,12 +504,9 @@ double exact_body_volume(const Body& body) {
 
 namespace {
 
-/// The PLC of z-extruded bodies only. `is_free` says whether a point of empty space lies outside
-/// every surface-file body, so that no hole point falls inside one.
-ExtrudedPlc extruded_part(const core::CaseSpec& spec,
-                          const std::function<bool(const Vector3d&)>& is_free) {
+/// 1e-9 of the diagonal of every primitive's faceted bounds [m]; refuses a case without bodies.
+double extrusion_tolerance(const core::CaseSpec& spec) {
   const int n = spec.mesh.circle_segments;
-  // 1. Extent and tolerance.
   Eigen::AlignedBox3d extent;
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
@@ -484,13 +520,31 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
       }
   if (extent.isEmpty())
     throw core::GeometryError(spec.source.string() + ": the case has no bodies");
-  const double tol = 1e-9 * extent.diagonal().norm();
+  return 1e-9 * extent.diagonal().norm();
+}
 
-  // 2. The planar graph: named points first so that their coordinates are kept exactly.
+/// The layered cells of an extrusion: the cross-section graph and its faces, the z breakpoints,
+/// and per (face, slab) cell a representative point and the body that fills it (-1: empty).
+struct Layers {
   Pslg g;
+  Arrangement arr;
+  std::vector<int> degree;          /// per 2D vertex: its number of edges
+  std::vector<int> point_vertex2d;  /// per named point: its 2D vertex
+  std::vector<double> z;            /// breakpoints, ascending
+  int nslab = 0;
+  std::vector<Vector2d> rep;            /// per face: a point inside it
+  std::vector<std::vector<int>> label;  /// per face and slab: body index or -1
+
+  int cell(int f, int j) const { return f < 0 || j < 0 || j >= nslab ? -1 : label[f][j]; }
+};
+
+/// The planar graph of every primitive's rings: named points first so that their coordinates
+/// are kept exactly.
+void add_cross_section(const core::CaseSpec& spec, double tol, Layers& l) {
+  const int n = spec.mesh.circle_segments;
+  Pslg& g = l.g;
   g.tol = tol;
-  std::vector<int> point_vertex2d;
-  for (const auto& p : spec.points) point_vertex2d.push_back(g.vertex(p.position.head<2>()));
+  for (const auto& p : spec.points) l.point_vertex2d.push_back(g.vertex(p.position.head<2>()));
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
       for (const auto& p : *list) {
@@ -503,11 +557,13 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         }
       }
   resolve_pslg(g);
-  const Arrangement arr = arrangement(g);
-  std::vector<int> degree(g.vertices.size(), 0);
-  for (const auto& e : g.edges) ++degree[e[0]], ++degree[e[1]];
+  l.arr = arrangement(g);
+  l.degree.assign(g.vertices.size(), 0);
+  for (const auto& e : g.edges) ++l.degree[e[0]], ++l.degree[e[1]];
+}
 
-  // 3. Breakpoints along z: primitive ends and the heights of named points on vertical faces.
+/// Breakpoints along z: primitive ends and the heights of named points on vertical faces.
+void add_breakpoints(const core::CaseSpec& spec, double tol, Layers& l) {
   std::vector<ZValue> zs;
   for (const auto& b : spec.bodies)
     for (const auto* list : {&b.add, &b.subtract})
@@ -517,143 +573,195 @@ ExtrudedPlc extruded_part(const core::CaseSpec& spec,
         zs.push_back({z1, false});
       }
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (degree[point_vertex2d[i]] > 0) zs.push_back({spec.points[i].position.z(), true});
-  const std::vector<double> z = merged_breakpoints(zs, tol);
-  const int nslab = static_cast<int>(z.size()) - 1;
+    if (l.degree[l.point_vertex2d[i]] > 0) zs.push_back({spec.points[i].position.z(), true});
+  l.z = merged_breakpoints(zs, tol);
+  l.nslab = static_cast<int>(l.z.size()) - 1;
+}
 
-  // 4. Representative points and the body of every (face, slab) cell.
-  const int nf = static_cast<int>(arr.faces.size());
-  std::vector<Vector2d> rep(nf);
+/// Representative points and the body of every (face, slab) cell; two bodies in one cell overlap.
+void add_cell_bodies(const core::CaseSpec& spec, Layers& l) {
+  const int n = spec.mesh.circle_segments;
+  const int nf = static_cast<int>(l.arr.faces.size());
+  l.rep.resize(nf);
   for (int f = 0; f < nf; ++f)
-    rep[f] = point_beside(g, arr.faces[f].outer, +1,
-                          [&](const Vector2d& p) { return face_contains(g, arr.faces[f], p); });
-  std::vector<std::vector<int>> label(nf, std::vector<int>(nslab, -1));
+    l.rep[f] = point_beside(l.g, l.arr.faces[f].outer, +1, [&](const Vector2d& p) {
+      return face_contains(l.g, l.arr.faces[f], p);
+    });
+  l.label.assign(nf, std::vector<int>(l.nslab, -1));
   for (int f = 0; f < nf; ++f) {
-    for (int j = 0; j < nslab; ++j) {
-      const Vector3d p(rep[f].x(), rep[f].y(), 0.5 * (z[j] + z[j + 1]));
+    for (int j = 0; j < l.nslab; ++j) {
+      const Vector3d p(l.rep[f].x(), l.rep[f].y(), 0.5 * (l.z[j] + l.z[j + 1]));
       for (size_t b = 0; b < spec.bodies.size(); ++b) {
         if (!body_contains_tol(spec.bodies[b], p, n, 0.0, 0.0)) continue;
-        if (label[f][j] >= 0) {
+        if (l.label[f][j] >= 0) {
           std::ostringstream msg;
-          msg << spec.source.string() << ": bodies '" << spec.bodies[label[f][j]].name << "' and '"
-              << spec.bodies[b].name << "' overlap near (" << p.x() << ", " << p.y() << ", "
-              << p.z() << ") m without a declared subtraction. Hint: subtract one from the other, "
+          msg << spec.source.string() << ": bodies '" << spec.bodies[l.label[f][j]].name
+              << "' and '" << spec.bodies[b].name << "' overlap near (" << p.x() << ", " << p.y()
+              << ", " << p.z()
+              << ") m without a declared subtraction. Hint: subtract one from the other, "
               << "or make them only touch.";
           throw core::GeometryError(msg.str());
         }
-        label[f][j] = static_cast<int>(b);
+        l.label[f][j] = static_cast<int>(b);
       }
     }
   }
-  auto cell = [&](int f, int j) { return f < 0 || j < 0 || j >= nslab ? -1 : label[f][j]; };
+}
 
-  // 5. Facets.
-  ExtrudedPlc result;
-  Plc& plc = result.plc;
-  std::map<std::pair<int, int>, int> vertex3d;
-  auto v3 = [&](int v2, int zi) {
+/// The PLC's 3D vertices, one per (2D vertex, z breakpoint), numbered as first asked for.
+class LayerVertices {
+ public:
+  int at(const Layers& l, Plc& plc, int v2, int zi) {
     auto [it, fresh] =
-        vertex3d.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
-    if (fresh) plc.vertices.emplace_back(g.vertices[v2].x(), g.vertices[v2].y(), z[zi]);
+        index_.emplace(std::make_pair(v2, zi), static_cast<int>(plc.vertices.size()));
+    if (fresh) plc.vertices.emplace_back(l.g.vertices[v2].x(), l.g.vertices[v2].y(), l.z[zi]);
     return it->second;
-  };
-  for (size_t e = 0; e < g.edges.size(); ++e) {
-    const int fl = arr.halfedge_face[2 * e], fr = arr.halfedge_face[2 * e + 1];
-    for (int j = 0; j < nslab; ++j) {
-      if (cell(fl, j) == cell(fr, j)) continue;
-      const int a = g.edges[e][0], b = g.edges[e][1];
-      plc.facets.push_back(PlcFacet{{{v3(a, j), v3(b, j), v3(b, j + 1), v3(a, j + 1)}}, {}});
+  }
+  /// The vertex at (v2, zi) if it exists, else -1.
+  int find(int v2, int zi) const {
+    const auto it = index_.find({v2, zi});
+    return it == index_.end() ? -1 : it->second;
+  }
+
+ private:
+  std::map<std::pair<int, int>, int> index_;
+};
+
+/// A vertical facet per graph edge and slab where the cells on its two sides differ.
+void add_side_facets(const Layers& l, LayerVertices& v3, Plc& plc) {
+  for (size_t e = 0; e < l.g.edges.size(); ++e) {
+    const int fl = l.arr.halfedge_face[2 * e], fr = l.arr.halfedge_face[2 * e + 1];
+    for (int j = 0; j < l.nslab; ++j) {
+      if (l.cell(fl, j) == l.cell(fr, j)) continue;
+      const int a = l.g.edges[e][0], b = l.g.edges[e][1];
+      plc.facets.push_back(PlcFacet{{{v3.at(l, plc, a, j), v3.at(l, plc, b, j),
+                                      v3.at(l, plc, b, j + 1), v3.at(l, plc, a, j + 1)}},
+                                    {}});
     }
   }
-  // Named points floating inside a horizontal face.
+}
+
+/// A horizontal facet per face and breakpoint where the cells below and above differ, with its
+/// holes and the named points floating inside it (their vertices go to result.point_vertex).
+void add_cap_facets(const core::CaseSpec& spec, const Layers& l, double tol, LayerVertices& v3,
+                    ExtrudedPlc& result) {
+  Plc& plc = result.plc;
+  const int nf = static_cast<int>(l.arr.faces.size());
   std::vector<int> isolated_face(spec.points.size(), -1);
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (degree[point_vertex2d[i]] == 0)
+    if (l.degree[l.point_vertex2d[i]] == 0)
       for (int f = 0; f < nf; ++f)
-        if (face_contains(g, arr.faces[f], g.vertices[point_vertex2d[i]])) isolated_face[i] = f;
+        if (face_contains(l.g, l.arr.faces[f], l.g.vertices[l.point_vertex2d[i]]))
+          isolated_face[i] = f;
   result.point_vertex.assign(spec.points.size(), -1);
-  for (int j = 0; j <= nslab; ++j) {
+  for (int j = 0; j <= l.nslab; ++j) {
     for (int f = 0; f < nf; ++f) {
-      if (cell(f, j - 1) == cell(f, j)) continue;
+      if (l.cell(f, j - 1) == l.cell(f, j)) continue;
       PlcFacet facet;
       std::vector<int> ring;
-      for (int v : arr.faces[f].outer) ring.push_back(v3(v, j));
+      for (int v : l.arr.faces[f].outer) ring.push_back(v3.at(l, plc, v, j));
       facet.polygons.push_back(ring);
-      for (const auto& hole : arr.faces[f].holes) {
+      for (const auto& hole : l.arr.faces[f].holes) {
         ring.clear();
-        for (int v : hole) ring.push_back(v3(v, j));
+        for (int v : hole) ring.push_back(v3.at(l, plc, v, j));
         facet.polygons.push_back(ring);
-        const Ring hole_ring = ring_of(g, hole);
+        const Ring hole_ring = ring_of(l.g, hole);
         const Vector2d h = point_beside(
-            g, hole, -1, [&](const Vector2d& p) { return ring_contains(hole_ring, p); });
-        facet.holes.emplace_back(h.x(), h.y(), z[j]);
+            l.g, hole, -1, [&](const Vector2d& p) { return ring_contains(hole_ring, p); });
+        facet.holes.emplace_back(h.x(), h.y(), l.z[j]);
       }
       for (size_t i = 0; i < spec.points.size(); ++i) {
-        if (isolated_face[i] != f || std::abs(spec.points[i].position.z() - z[j]) > tol) continue;
-        const int v = v3(point_vertex2d[i], j);
+        if (isolated_face[i] != f || std::abs(spec.points[i].position.z() - l.z[j]) > tol) continue;
+        const int v = v3.at(l, plc, l.point_vertex2d[i], j);
         facet.polygons.push_back({v});
         result.point_vertex[i] = v;
       }
       plc.facets.push_back(std::move(facet));
     }
   }
+}
 
-  // 6. Regions and holes, one point per cell; hole points stay out of surface-file bodies.
+/// A point of empty cell (f, j) outside every surface-file body (`is_free`).
+Vector3d hole_point(const core::CaseSpec& spec, const Layers& l, int f, int j,
+                    const std::function<bool(const Vector3d&)>& is_free) {
   auto free_in_slab = [&](const Vector2d& q, int j) -> std::optional<Vector3d> {
     for (double s : {0.5, 0.25, 0.75, 0.1, 0.9, 0.02, 0.98}) {
-      const Vector3d p(q.x(), q.y(), z[j] + s * (z[j + 1] - z[j]));
+      const Vector3d p(q.x(), q.y(), l.z[j] + s * (l.z[j + 1] - l.z[j]));
       if (is_free(p)) return p;
     }
     return std::nullopt;
   };
-  auto hole_point = [&](int f, int j) {
-    if (const auto p = free_in_slab(rep[f], j)) return *p;
-    try {
-      const Vector2d q = point_beside(g, arr.faces[f].outer, +1, [&](const Vector2d& c) {
-        return face_contains(g, arr.faces[f], c) && free_in_slab(c, j).has_value();
-      });
-      return *free_in_slab(q, j);
-    } catch (const core::GeometryError&) {
-      std::ostringstream msg;
-      msg << spec.source.string() << ": a surface-file body fills the empty space near ("
-          << rep[f].x() << ", " << rep[f].y() << ", " << 0.5 * (z[j] + z[j + 1])
-          << ") m so closely that no point of that space is left to mark it empty. Hint: leave "
-             "a clear gap around surface-file bodies.";
-      throw core::GeometryError(msg.str());
-    }
-  };
-  for (int f = 0; f < nf; ++f) {
-    for (int j = 0; j < nslab; ++j) {
-      const Vector3d p(rep[f].x(), rep[f].y(), 0.5 * (z[j] + z[j + 1]));
-      const int b = label[f][j];
+  if (const auto p = free_in_slab(l.rep[f], j)) return *p;
+  try {
+    const Vector2d q = point_beside(l.g, l.arr.faces[f].outer, +1, [&](const Vector2d& c) {
+      return face_contains(l.g, l.arr.faces[f], c) && free_in_slab(c, j).has_value();
+    });
+    return *free_in_slab(q, j);
+  } catch (const core::GeometryError&) {
+    std::ostringstream msg;
+    msg << spec.source.string() << ": a surface-file body fills the empty space near ("
+        << l.rep[f].x() << ", " << l.rep[f].y() << ", " << 0.5 * (l.z[j] + l.z[j + 1])
+        << ") m so closely that no point of that space is left to mark it empty. Hint: leave "
+           "a clear gap around surface-file bodies.";
+    throw core::GeometryError(msg.str());
+  }
+}
+
+/// One region point per filled cell and one hole point per empty cell.
+void add_regions_and_holes(const core::CaseSpec& spec, const Layers& l,
+                           const std::function<bool(const Vector3d&)>& is_free, Plc& plc) {
+  for (int f = 0; f < static_cast<int>(l.arr.faces.size()); ++f) {
+    for (int j = 0; j < l.nslab; ++j) {
+      const Vector3d p(l.rep[f].x(), l.rep[f].y(), 0.5 * (l.z[j] + l.z[j + 1]));
+      const int b = l.label[f][j];
       if (b < 0) {
-        plc.holes.push_back(hole_point(f, j));
+        plc.holes.push_back(hole_point(spec, l, f, j, is_free));
       } else {
         const double h = spec.bodies[b].max_edge;
         plc.regions.push_back(PlcRegion{p, b, h * h * h / (6.0 * std::sqrt(2.0))});
       }
     }
   }
+}
 
-  // 7. Named points: a PLC vertex already, or inserted inside a body.
+/// Named points not yet placed: a PLC vertex already, or inserted inside a body.
+void add_named_points(const core::CaseSpec& spec, const Layers& l, double tol,
+                      const LayerVertices& v3, ExtrudedPlc& result) {
   for (size_t i = 0; i < spec.points.size(); ++i) {
     if (result.point_vertex[i] >= 0) continue;
     const auto& pt = spec.points[i];
     int zi = -1;
-    for (int j = 0; j <= nslab; ++j)
-      if (std::abs(z[j] - pt.position.z()) <= tol) zi = j;
+    for (int j = 0; j <= l.nslab; ++j)
+      if (std::abs(l.z[j] - pt.position.z()) <= tol) zi = j;
     if (zi >= 0) {
-      auto it = vertex3d.find({point_vertex2d[i], zi});
-      if (it != vertex3d.end()) {
-        result.point_vertex[i] = it->second;
+      if (const int v = v3.find(l.point_vertex2d[i], zi); v >= 0) {
+        result.point_vertex[i] = v;
         continue;
       }
     }
     bool inside = false;
-    for (const auto& b : spec.bodies) inside = inside || body_contains(b, pt.position, n);
+    for (const auto& b : spec.bodies)
+      inside = inside || body_contains(b, pt.position, spec.mesh.circle_segments);
     if (!inside) throw outside_every_body(spec, pt);
-    plc.interior_points.push_back(pt.position);
+    result.plc.interior_points.push_back(pt.position);
   }
+}
+
+/// The PLC of z-extruded bodies only. `is_free` says whether a point of empty space lies outside
+/// every surface-file body, so that no hole point falls inside one.
+ExtrudedPlc extruded_part(const core::CaseSpec& spec,
+                          const std::function<bool(const Vector3d&)>& is_free) {
+  const double tol = extrusion_tolerance(spec);
+  Layers layers;
+  add_cross_section(spec, tol, layers);
+  add_breakpoints(spec, tol, layers);
+  add_cell_bodies(spec, layers);
+  ExtrudedPlc result;
+  LayerVertices v3;
+  add_side_facets(layers, v3, result.plc);
+  add_cap_facets(spec, layers, tol, v3, result);
+  add_regions_and_holes(spec, layers, is_free, result.plc);
+  add_named_points(spec, layers, tol, v3, result);
   return result;
 }
 
@@ -812,54 +920,80 @@ void check_surface_bodies_clear(const core::CaseSpec& spec,
   }
 }
 
-}  // namespace
-
-ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
-  // 1. Surface-file bodies are read and checked; the others go to the extrusion.
+/// The surface-file bodies of a case, each read and checked.
+std::vector<SurfaceBody> surface_bodies(const core::CaseSpec& spec) {
   std::vector<SurfaceBody> surfaces;
   for (size_t b = 0; b < spec.bodies.size(); ++b)
     if (is_surface_body(spec.bodies[b]))
       surfaces.push_back(surface_body(spec, static_cast<int>(b)));
-  if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
-  check_surface_bodies_clear(spec, surfaces);
+  return surfaces;
+}
 
-  // 2. Named points on or in a surface body belong to it; the others to the extrusion.
+/// 1e-9 of the diagonal of all bodies' bounds [m].
+double geometry_tolerance(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces) {
   Eigen::AlignedBox3d extent;
   for (const auto& s : surfaces) extent.extend(s.bounds);
   for (const auto& b : spec.bodies)
     if (!is_surface_body(b))
       for (const auto& p : b.add) extent.extend(primitive_bounds(p));
-  const double tol = 1e-9 * extent.diagonal().norm();
+  return 1e-9 * extent.diagonal().norm();
+}
+
+/// Which surface body each named point lies on or in (the first one that has it), and where.
+struct SurfacePoints {
+  std::vector<int> surface;                   /// per named point: index into surfaces, or -1
+  std::vector<cgal::PointLocation> location;  /// per named point, where surface >= 0
+};
+
+SurfacePoints surface_points(const core::CaseSpec& spec, const std::vector<SurfaceBody>& surfaces,
+                             double tol) {
+  using Kind = cgal::PointLocation::Kind;
   std::vector<Vector3d> positions;
   for (const auto& p : spec.points) positions.push_back(p.position);
-  using Kind = cgal::PointLocation::Kind;
-  std::vector<int> point_surface(spec.points.size(), -1);
-  std::vector<cgal::PointLocation> location(spec.points.size());
+  SurfacePoints out{std::vector<int>(spec.points.size(), -1),
+                    std::vector<cgal::PointLocation>(spec.points.size())};
   for (size_t s = 0; s < surfaces.size(); ++s) {
     const auto located = cgal::locate_points(surfaces[s].solid.surface, positions, tol);
     for (size_t i = 0; i < located.size(); ++i)
-      if (point_surface[i] < 0 && located[i].kind != Kind::outside)
-        point_surface[i] = static_cast<int>(s), location[i] = located[i];
+      if (out.surface[i] < 0 && located[i].kind != Kind::outside)
+        out.surface[i] = static_cast<int>(s), out.location[i] = located[i];
   }
-  core::CaseSpec extruded = spec;
-  extruded.bodies.clear();
-  extruded.points.clear();
-  std::vector<int> extruded_body, extruded_point;  // reduced index -> index in spec
+  return out;
+}
+
+/// The case reduced to its z-extruded bodies and the named points off every surface body, with
+/// the maps from reduced indices back to the whole case.
+struct ExtrudedSubset {
+  core::CaseSpec spec;
+  std::vector<int> body;   /// reduced body index -> index in the whole case
+  std::vector<int> point;  /// reduced point index -> index in the whole case
+};
+
+ExtrudedSubset extruded_subset(const core::CaseSpec& spec, const SurfacePoints& on_surface) {
+  ExtrudedSubset sub{spec, {}, {}};
+  sub.spec.bodies.clear();
+  sub.spec.points.clear();
   for (size_t b = 0; b < spec.bodies.size(); ++b)
     if (!is_surface_body(spec.bodies[b])) {
-      extruded.bodies.push_back(spec.bodies[b]);
-      extruded_body.push_back(static_cast<int>(b));
+      sub.spec.bodies.push_back(spec.bodies[b]);
+      sub.body.push_back(static_cast<int>(b));
     }
   for (size_t i = 0; i < spec.points.size(); ++i)
-    if (point_surface[i] < 0) {
-      extruded.points.push_back(spec.points[i]);
-      extruded_point.push_back(static_cast<int>(i));
+    if (on_surface.surface[i] < 0) {
+      sub.spec.points.push_back(spec.points[i]);
+      sub.point.push_back(static_cast<int>(i));
     }
+  return sub;
+}
 
-  // 3. The extruded bodies, with body and point indices mapped back to the whole case.
+/// The PLC of the extruded bodies, with body and point indices mapped back to the whole case
+/// (point_vertex has an entry per named point of `spec`); no hole point falls in a surface body.
+ExtrudedPlc extruded_subset_plc(const core::CaseSpec& spec, const ExtrudedSubset& sub,
+                                const std::vector<SurfaceBody>& surfaces) {
+  using Kind = cgal::PointLocation::Kind;
   ExtrudedPlc result;
   result.point_vertex.assign(spec.points.size(), -1);
-  if (!extruded.bodies.empty()) {
+  if (!sub.spec.bodies.empty()) {
     auto is_free = [&](const Vector3d& p) {
       for (const auto& s : surfaces)
         if (s.bounds.contains(p) &&
@@ -867,81 +1001,118 @@ ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
           return false;
       return true;
     };
-    ExtrudedPlc part = extruded_part(extruded, is_free);
-    for (auto& r : part.plc.regions) r.region = extruded_body[r.region];
-    for (size_t i = 0; i < extruded_point.size(); ++i)
-      result.point_vertex[extruded_point[i]] = part.point_vertex[i];
+    ExtrudedPlc part = extruded_part(sub.spec, is_free);
+    for (auto& r : part.plc.regions) r.region = sub.body[r.region];
+    for (size_t i = 0; i < sub.point.size(); ++i)
+      result.point_vertex[sub.point[i]] = part.point_vertex[i];
     result.plc = std::move(part.plc);
-  } else if (!extruded.points.empty()) {
-    throw outside_every_body(spec, extruded.points.front());
+  } else if (!sub.spec.points.empty()) {
+    throw outside_every_body(spec, sub.spec.points.front());
   }
+  return result;
+}
 
-  // 4. Each surface body: its triangles as facets, a region point, and its named points.
-  Plc& plc = result.plc;
-  for (size_t s = 0; s < surfaces.size(); ++s) {
-    const cgal::SurfaceSolid& solid = surfaces[s].solid;
-    const int first = static_cast<int>(plc.vertices.size());
-    plc.vertices.insert(plc.vertices.end(), solid.surface.vertices.begin(),
-                        solid.surface.vertices.end());
-    const size_t first_facet = plc.facets.size();
-    std::vector<int> patch_of;
-    for (const auto& patch : planar_patches(solid.surface, tol, patch_of)) {
-      PlcFacet facet;
-      for (const auto& ring : patch.polygons) {
-        facet.polygons.emplace_back();
-        for (int v : ring) facet.polygons.back().push_back(first + v);
-      }
-      plc.facets.push_back(std::move(facet));
+/// Where a surface body's vertices and facets were put in the PLC.
+struct PlacedSurface {
+  const cgal::TriangleSurface* surface = nullptr;
+  std::vector<int> patch_of;  /// per triangle: its patch, whose facet is first_facet + patch
+  int first_vertex = 0;
+  size_t first_facet = 0;
+};
+
+/// Adds a surface's vertices, and each of its planar patches as one facet.
+PlacedSurface add_surface_facets(Plc& plc, const cgal::TriangleSurface& surface, double tol) {
+  PlacedSurface placed{&surface, {}, static_cast<int>(plc.vertices.size()), plc.facets.size()};
+  plc.vertices.insert(plc.vertices.end(), surface.vertices.begin(), surface.vertices.end());
+  for (const auto& patch : planar_patches(surface, tol, placed.patch_of)) {
+    PlcFacet facet;
+    for (const auto& ring : patch.polygons) {
+      facet.polygons.emplace_back();
+      for (int v : ring) facet.polygons.back().push_back(placed.first_vertex + v);
     }
-    for (size_t i = 0; i < spec.points.size(); ++i) {
-      if (point_surface[i] != static_cast<int>(s)) continue;
-      const Vector3d& x = spec.points[i].position;
-      switch (location[i].kind) {
-        case Kind::vertex:  // moved by at most tol so that the point is exact
-          result.point_vertex[i] = first + location[i].index;
-          plc.vertices[result.point_vertex[i]] = x;
-          break;
-        case Kind::triangle: {
-          const int v = static_cast<int>(plc.vertices.size());
-          plc.vertices.push_back(x);
-          result.point_vertex[i] = v;
-          // On an edge between two patches the point joins both facets' rings (TetGen crashes on a
-          // lone vertex on a facet's boundary); inside a patch it is a lone vertex of its facet.
-          const auto& tri = solid.surface.triangles[location[i].index];
-          const int own = patch_of[location[i].index];
-          bool on_crease = false;
-          for (int k = 0; k < 3 && !on_crease; ++k) {
-            const int a = tri[k], b = tri[(k + 1) % 3];
-            const Vector3d& xa = solid.surface.vertices[a];
-            const Vector3d& xb = solid.surface.vertices[b];
-            const double t = std::clamp((x - xa).dot(xb - xa) / (xb - xa).squaredNorm(), 0.0, 1.0);
-            if ((xa + t * (xb - xa) - x).norm() > tol) continue;
-            for (size_t f = 0; f < solid.surface.triangles.size(); ++f) {
-              const auto& u = solid.surface.triangles[f];
-              for (int e = 0; e < 3; ++e)
-                if (u[e] == b && u[(e + 1) % 3] == a && patch_of[f] != own) {
-                  on_crease = true;
-                  insert_on_edge(plc.facets[first_facet + own], first + a, first + b, v,
-                                 plc.vertices);
-                  insert_on_edge(plc.facets[first_facet + patch_of[f]], first + a, first + b, v,
-                                 plc.vertices);
-                }
-            }
-          }
-          if (!on_crease) plc.facets[first_facet + own].polygons.push_back({v});
-          break;
-        }
-        case Kind::inside:
-          plc.interior_points.push_back(x);
-          break;
-        case Kind::outside:
-          break;
-      }
-    }
-    const double h = spec.bodies[surfaces[s].body].max_edge;
-    plc.regions.push_back(
-        PlcRegion{solid.inside_point, surfaces[s].body, h * h * h / (6.0 * std::sqrt(2.0))});
+    plc.facets.push_back(std::move(facet));
   }
+  return placed;
+}
+
+/// Adds named point x, lying on triangle `t` of a placed surface, as a new vertex, returned. On
+/// an edge between two patches the point joins both facets' rings (TetGen crashes on a lone
+/// vertex on a facet's boundary); inside a patch it is a lone vertex of its facet.
+int add_point_on_triangle(Plc& plc, const PlacedSurface& placed, int t, const Vector3d& x,
+                          double tol) {
+  const cgal::TriangleSurface& surface = *placed.surface;
+  const int first = placed.first_vertex;
+  const int v = static_cast<int>(plc.vertices.size());
+  plc.vertices.push_back(x);
+  const auto& tri = surface.triangles[t];
+  const int own = placed.patch_of[t];
+  bool on_crease = false;
+  for (int k = 0; k < 3 && !on_crease; ++k) {
+    const int a = tri[k], b = tri[(k + 1) % 3];
+    const Vector3d& xa = surface.vertices[a];
+    const Vector3d& xb = surface.vertices[b];
+    const double s = std::clamp((x - xa).dot(xb - xa) / (xb - xa).squaredNorm(), 0.0, 1.0);
+    if ((xa + s * (xb - xa) - x).norm() > tol) continue;
+    for (size_t f = 0; f < surface.triangles.size(); ++f) {
+      const auto& u = surface.triangles[f];
+      for (int e = 0; e < 3; ++e)
+        if (u[e] == b && u[(e + 1) % 3] == a && placed.patch_of[f] != own) {
+          on_crease = true;
+          insert_on_edge(plc.facets[placed.first_facet + own], first + a, first + b, v,
+                         plc.vertices);
+          insert_on_edge(plc.facets[placed.first_facet + placed.patch_of[f]], first + a, first + b,
+                         v, plc.vertices);
+        }
+    }
+  }
+  if (!on_crease) plc.facets[placed.first_facet + own].polygons.push_back({v});
+  return v;
+}
+
+/// Adds surface body `s`: its triangles as facets, its named points and a region point.
+void add_surface_body(const core::CaseSpec& spec, const SurfaceBody& body, int s,
+                      const SurfacePoints& on_surface, double tol, ExtrudedPlc& result) {
+  using Kind = cgal::PointLocation::Kind;
+  Plc& plc = result.plc;
+  const cgal::SurfaceSolid& solid = body.solid;
+  const PlacedSurface placed = add_surface_facets(plc, solid.surface, tol);
+  for (size_t i = 0; i < spec.points.size(); ++i) {
+    if (on_surface.surface[i] != s) continue;
+    const Vector3d& x = spec.points[i].position;
+    const cgal::PointLocation& at = on_surface.location[i];
+    switch (at.kind) {
+      case Kind::vertex:  // moved by at most tol so that the point is exact
+        result.point_vertex[i] = placed.first_vertex + at.index;
+        plc.vertices[result.point_vertex[i]] = x;
+        break;
+      case Kind::triangle:
+        result.point_vertex[i] = add_point_on_triangle(plc, placed, at.index, x, tol);
+        break;
+      case Kind::inside:
+        plc.interior_points.push_back(x);
+        break;
+      case Kind::outside:
+        break;
+    }
+  }
+  const double h = spec.bodies[body.body].max_edge;
+  plc.regions.push_back(
+      PlcRegion{solid.inside_point, body.body, h * h * h / (6.0 * std::sqrt(2.0))});
+}
+
+}  // namespace
+
+ExtrudedPlc extruded_plc(const core::CaseSpec& spec) {
+  // Surface-file bodies are read and checked; the others go to the extrusion.
+  const std::vector<SurfaceBody> surfaces = surface_bodies(spec);
+  if (surfaces.empty()) return extruded_part(spec, [](const Vector3d&) { return true; });
+  check_surface_bodies_clear(spec, surfaces);
+  // Named points on or in a surface body belong to it; the others to the extrusion.
+  const double tol = geometry_tolerance(spec, surfaces);
+  const SurfacePoints on_surface = surface_points(spec, surfaces, tol);
+  ExtrudedPlc result = extruded_subset_plc(spec, extruded_subset(spec, on_surface), surfaces);
+  for (size_t s = 0; s < surfaces.size(); ++s)
+    add_surface_body(spec, surfaces[s], static_cast<int>(s), on_surface, tol, result);
   return result;
 }
 

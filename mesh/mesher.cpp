@@ -200,76 +200,74 @@ void require_mesh_within_bounds(const core::CaseSpec& spec, const MeshEstimate& 
   throw core::MeshError(o.str());
 }
 
-TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
-                      const std::vector<int>& point_vertex) {
-  TetMesh m;
-  m.order = spec.mesh.order;
+namespace {
+
+/// Sorted corner nodes of local face f of tet t: the key shared by the two tets of a face.
+std::array<int, 3> face_key(const TetMesh& m, int t, int f) {
+  std::array<int, 3> key = {m.tets(t, kFaceCorners[f][0]), m.tets(t, kFaceCorners[f][1]),
+                            m.tets(t, kFaceCorners[f][2])};
+  std::sort(key.begin(), key.end());
+  return key;
+}
+
+/// Node coordinates: TetGen's corners, then (order 2) one mid-edge node per edge, numbered as
+/// the tets first reach them and written into the tets' columns 4..9.
+std::vector<Vector3d> nodes_with_mid_edges(const LinearTets& lin, TetMesh& m) {
+  std::vector<Vector3d> nodes = lin.nodes;
+  if (m.order != 2) return nodes;
   const int nt = static_cast<int>(lin.tets.size());
   const int nc = static_cast<int>(lin.nodes.size());
-  m.corner_count = nc;
-  for (const auto& b : spec.bodies) m.region_names.push_back(b.name);
-  m.tets.resize(nt, m.order == 1 ? 4 : 10);
-  m.tet_region.resize(nt);
+  std::unordered_map<long long, int> mid;
+  mid.reserve(static_cast<size_t>(nt) * 2);
   for (int t = 0; t < nt; ++t) {
-    for (int k = 0; k < 4; ++k) m.tets(t, k) = lin.tets[t][k];
-    m.tet_region[t] = core::RegionId{lin.region[t]};
-  }
-  std::vector<Vector3d> nodes = lin.nodes;
-  if (m.order == 2) {
-    std::unordered_map<long long, int> mid;
-    mid.reserve(static_cast<size_t>(nt) * 2);
-    for (int t = 0; t < nt; ++t) {
-      for (int e = 0; e < 6; ++e) {
-        const int a = m.tets(t, kTetEdges[e][0]), b = m.tets(t, kTetEdges[e][1]);
-        const long long key = static_cast<long long>(std::min(a, b)) * nc + std::max(a, b);
-        auto [it, fresh] = mid.emplace(key, static_cast<int>(nodes.size()));
-        if (fresh) nodes.push_back(0.5 * (nodes[a] + nodes[b]));
-        m.tets(t, 4 + e) = it->second;
-      }
+    for (int e = 0; e < 6; ++e) {
+      const int a = m.tets(t, kTetEdges[e][0]), b = m.tets(t, kTetEdges[e][1]);
+      const long long key = static_cast<long long>(std::min(a, b)) * nc + std::max(a, b);
+      auto [it, fresh] = mid.emplace(key, static_cast<int>(nodes.size()));
+      if (fresh) nodes.push_back(0.5 * (nodes[a] + nodes[b]));
+      m.tets(t, 4 + e) = it->second;
     }
   }
-  m.nodes.resize(static_cast<int>(nodes.size()), 3);
-  for (size_t i = 0; i < nodes.size(); ++i) m.nodes.row(static_cast<int>(i)) = nodes[i].transpose();
+  return nodes;
+}
 
-  // Faces seen once are exterior; faces between different bodies are interfaces.
+/// The faces to keep as (tet, local face, other tet), sorted: faces seen once are exterior
+/// (other -1); faces between different bodies are interfaces, owned by the lower body index.
+std::vector<std::array<int, 3>> boundary_faces(const TetMesh& m) {
   struct Seen {
     int tet, local, count, other;
   };
   std::map<std::array<int, 3>, Seen> seen;
-  for (int t = 0; t < nt; ++t) {
+  for (int t = 0; t < static_cast<int>(m.tets.rows()); ++t) {
     for (int f = 0; f < 4; ++f) {
-      std::array<int, 3> key = {m.tets(t, kFaceCorners[f][0]), m.tets(t, kFaceCorners[f][1]),
-                                m.tets(t, kFaceCorners[f][2])};
-      std::sort(key.begin(), key.end());
-      auto [it, fresh] = seen.emplace(key, Seen{t, f, 1, -1});
+      auto [it, fresh] = seen.emplace(face_key(m, t, f), Seen{t, f, 1, -1});
       if (!fresh) {
         ++it->second.count;
         it->second.other = t;
       }
     }
   }
-  std::vector<std::array<int, 3>> picked;  // (tet, local face, other tet)
+  std::vector<std::array<int, 3>> picked;
   for (const auto& [key, s] : seen) {
     if (s.count == 1)
       picked.push_back({s.tet, s.local, -1});
     else if (m.tet_region[s.tet] != m.tet_region[s.other]) {
-      // Interfaces are owned by the lower body index.
       const bool swap = core::index_of(m.tet_region[s.other]) < core::index_of(m.tet_region[s.tet]);
       int owner = swap ? s.other : s.tet, other = swap ? s.tet : s.other;
       int local = s.local;
       if (swap) {
-        for (int f = 0; f < 4; ++f) {
-          std::array<int, 3> k2 = {m.tets(owner, kFaceCorners[f][0]),
-                                   m.tets(owner, kFaceCorners[f][1]),
-                                   m.tets(owner, kFaceCorners[f][2])};
-          std::sort(k2.begin(), k2.end());
-          if (k2 == key) local = f;
-        }
+        for (int f = 0; f < 4; ++f)
+          if (face_key(m, owner, f) == key) local = f;
       }
       picked.push_back({owner, local, other});
     }
   }
   std::sort(picked.begin(), picked.end());
+  return picked;
+}
+
+/// m.faces, face_tet and face_other_tet from the picked (tet, local face, other tet).
+void set_faces(const std::vector<std::array<int, 3>>& picked, TetMesh& m) {
   const int npf = m.order == 1 ? 3 : 6;
   m.faces.resize(static_cast<int>(picked.size()), npf);
   m.face_tet.resize(picked.size());
@@ -286,15 +284,19 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
     m.face_tet[i] = t;
     m.face_other_tet[i] = other;
   }
+}
 
-  // Boundary groups: ordinary groups in order first, then the "rest" groups in order.
+/// Each face's boundary group: ordinary groups in order first, then the "rest" groups in order;
+/// a face takes the first group that selects it.
+void set_face_groups(const core::CaseSpec& spec, TetMesh& m) {
   for (const auto& grp : spec.groups) m.group_names.push_back(grp.name);
-  m.face_group.assign(picked.size(), core::BoundaryId{-1});
+  const int nf = static_cast<int>(m.faces.rows());
+  m.face_group.assign(nf, core::BoundaryId{-1});
   const double tol = selection_tolerance(m.nodes);
   for (int pass = 0; pass < 2; ++pass) {
     for (size_t gi = 0; gi < spec.groups.size(); ++gi) {
       if (spec.groups[gi].rest != (pass == 1)) continue;
-      for (int f = 0; f < static_cast<int>(picked.size()); ++f) {
+      for (int f = 0; f < nf; ++f) {
         if (core::index_of(m.face_group[f]) >= 0) continue;
         const FaceGeometry g = face_geometry(m, f);
         for (const auto& s : spec.groups[gi].select) {
@@ -306,15 +308,20 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
       }
     }
   }
+}
 
-  // Named points.
+/// The named points at their PLC vertices (or the nearest corner node when TetGen inserted
+/// them); a point that names a boundary group must lie on one of its faces.
+void set_named_points(const LinearTets& lin, const core::CaseSpec& spec,
+                      const std::vector<int>& point_vertex, TetMesh& m) {
+  const int nc = static_cast<int>(lin.nodes.size());
   for (size_t i = 0; i < spec.points.size(); ++i) {
     const auto& p = spec.points[i];
     int node = point_vertex[i];
     if (node < 0) {
       double best = 1e300;
       for (int v = 0; v < nc; ++v) {
-        const double d = (nodes[v] - p.position).norm();
+        const double d = (lin.nodes[v] - p.position).norm();
         if (d < best) best = d, node = v;
       }
     }
@@ -330,6 +337,29 @@ TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
                                   "' that it names. Hint: check its coordinates.");
     }
   }
+}
+
+}  // namespace
+
+TetMesh assemble_mesh(const LinearTets& lin, const core::CaseSpec& spec,
+                      const std::vector<int>& point_vertex) {
+  TetMesh m;
+  m.order = spec.mesh.order;
+  const int nt = static_cast<int>(lin.tets.size());
+  m.corner_count = static_cast<int>(lin.nodes.size());
+  for (const auto& b : spec.bodies) m.region_names.push_back(b.name);
+  m.tets.resize(nt, m.order == 1 ? 4 : 10);
+  m.tet_region.resize(nt);
+  for (int t = 0; t < nt; ++t) {
+    for (int k = 0; k < 4; ++k) m.tets(t, k) = lin.tets[t][k];
+    m.tet_region[t] = core::RegionId{lin.region[t]};
+  }
+  const std::vector<Vector3d> nodes = nodes_with_mid_edges(lin, m);
+  m.nodes.resize(static_cast<int>(nodes.size()), 3);
+  for (size_t i = 0; i < nodes.size(); ++i) m.nodes.row(static_cast<int>(i)) = nodes[i].transpose();
+  set_faces(boundary_faces(m), m);
+  set_face_groups(spec, m);
+  set_named_points(lin, spec, point_vertex, m);
   return m;
 }
 

@@ -126,136 +126,160 @@ std::string bounded_text(const std::filesystem::path& path, const std::string& w
   return std::move(*text);
 }
 
-}  // namespace
-
-ProbeRecord read_raw_csv(const std::filesystem::path& path, const RawCsvConstants& given) {
-  const std::string file = path.string();
-  std::istringstream in(bounded_text(path, "raw probe CSV"));
-
-  std::map<std::string, HeaderValue> header;
-  std::vector<std::string> names;
-  ProbeRecord record;
-  std::vector<std::vector<double>> rows;  // samples of the reading being read, µm
-  long long reading_id = 0;
-  int reading_last_line = 0;
-  std::vector<int> last_lines;  // line of each reading's last sample, for length errors
-
-  auto close_reading = [&]() {
-    if (rows.empty()) return;
-    Reading& r = record.readings.back();
-    r.samples_m.resize(static_cast<Eigen::Index>(rows.size()),
-                       static_cast<Eigen::Index>(rows.front().size()));
-    for (std::size_t j = 0; j < rows.size(); ++j)
-      for (std::size_t p = 0; p < rows[j].size(); ++p)
-        r.samples_m(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(p)) = rows[j][p] * 1e-6;
-    last_lines.push_back(reading_last_line);
-    rows.clear();
-  };
-
-  std::string raw_line;
-  int line = 0;
-  while (std::getline(in, raw_line)) {
-    ++line;
-    const std::string text = trimmed(raw_line);
-    if (text.empty()) continue;
-    if (text.front() == '#') {
-      std::string token;
-      std::istringstream tokens(text.substr(1));
-      while (tokens >> token) {
-        while (!token.empty() && token.back() == ',') token.pop_back();
-        const auto eq = token.find('=');
-        if (eq == std::string::npos) continue;
-        const std::string key = token.substr(0, eq);
-        if (key != "speed_rpm" && key != "sample_rate_hz" && key != "probe_distance_mm") continue;
-        HeaderValue hv{0.0, line};
-        if (!parse_double(token.substr(eq + 1), hv.value) || !(hv.value > 0.0))
-          throw core::DataError(core::located(
-              file, line,
-              key + "='" + token.substr(eq + 1) + "' in the header: expected a number > 0"));
-        const auto seen = header.find(key);
-        if (seen != header.end() && seen->second.value != hv.value)
-          throw core::DataError(
-              core::located(file, line,
-                            key + " given twice with different values (first on line " +
-                                std::to_string(seen->second.line) + "); keep one"));
-        header[key] = hv;
-      }
-      continue;
-    }
-    const std::vector<std::string> fields = split_fields(text);
-    if (names.empty()) {
-      names = fields;
-      const bool axial = names.size() == raw_columns.size() + 1;
-      for (std::size_t c = 0; c < std::max(names.size(), raw_columns.size() + 1); ++c) {
-        const std::string want = c < raw_columns.size() ? raw_columns[c] : "s5_um";
-        const std::string got = c < names.size() ? names[c] : "";
-        if ((c < raw_columns.size() || axial) && got != want)
-          throw core::DataError(core::located(
-              file, line,
-              "column " + std::to_string(c + 1) + ": header '" + got + "', expected '" + want +
-                  "'; the column line must be reading,time_s,sample,s1_um,s2_um,s3_um,s4_um with "
-                  "an "
-                  "optional s5_um"));
-        if (c >= raw_columns.size() && !axial && c < names.size())
-          throw core::DataError(core::located(file, line,
-                                              "column " + std::to_string(c + 1) +
-                                                  ": unexpected header '" + names[c] +
-                                                  "'; only s5_um may follow s4_um"));
-      }
-      continue;
-    }
-    if (fields.size() != names.size())
+/// The known constants of one header comment line ('# speed_rpm=3000 sample_rate_hz=10000 ...'),
+/// added to `header`; other tokens are free text. A constant given twice must agree.
+void add_header_constants(const std::string& file, int line, const std::string& comment,
+                          std::map<std::string, HeaderValue>& header) {
+  std::string token;
+  std::istringstream tokens(comment);
+  while (tokens >> token) {
+    while (!token.empty() && token.back() == ',') token.pop_back();
+    const auto eq = token.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = token.substr(0, eq);
+    if (key != "speed_rpm" && key != "sample_rate_hz" && key != "probe_distance_mm") continue;
+    HeaderValue hv{0.0, line};
+    if (!parse_double(token.substr(eq + 1), hv.value) || !(hv.value > 0.0))
       throw core::DataError(core::located(
           file, line,
-          "column " + std::to_string(std::min(fields.size(), names.size()) + 1) + ": " +
-              std::to_string(fields.size()) + " fields, expected " + std::to_string(names.size()) +
-              " (" + (names.size() > raw_columns.size() ? "s1_um..s5_um" : "s1_um..s4_um") + ")"));
-    const FieldContext ctx{file, line, names};
-    const long long id = integer_field(ctx, fields, 0, "an integer reading number");
-    const double time = number_field(ctx, fields, 1, "a time in seconds");
-    const long long sample = integer_field(ctx, fields, 2, "an integer sample index");
-    std::vector<double> values(names.size() - 3);
-    for (std::size_t c = 3; c < names.size(); ++c)
-      values[c - 3] = number_field(ctx, fields, c, "a displacement in µm");
-
-    const bool new_reading = record.readings.empty() || id != reading_id;
-    if (new_reading) {
-      if (!record.readings.empty() && id < reading_id)
-        throw core::DataError(
-            field_error(ctx, 0, fields[0],
-                        "after reading " + std::to_string(reading_id) +
-                            ": reading numbers must increase, each reading's rows together"));
-      if (!record.readings.empty() && !(time > record.readings.back().start_time_s))
-        throw core::DataError(field_error(ctx, 1, fields[1],
-                                          "after the previous reading's start " +
-                                              fmt("%.10g", record.readings.back().start_time_s) +
-                                              " s: reading start times must increase"));
-      if (sample != 0)
-        throw core::DataError(
-            field_error(ctx, 2, fields[2], "0: every reading starts at sample 0"));
-      close_reading();
-      reading_id = id;
-      record.readings.push_back(Reading{time, {}});
-    } else {
-      if (time != record.readings.back().start_time_s)
-        throw core::DataError(
-            field_error(ctx, 1, fields[1],
-                        fmt("%.10g", record.readings.back().start_time_s) +
-                            ": time_s is the reading's start time, the same on all its rows"));
-      if (sample != static_cast<long long>(rows.size()))
-        throw core::DataError(
-            field_error(ctx, 2, fields[2],
-                        std::to_string(rows.size()) + ": samples must be consecutive from 0"));
-    }
-    rows.push_back(std::move(values));
-    reading_last_line = line;
+          key + "='" + token.substr(eq + 1) + "' in the header: expected a number > 0"));
+    const auto seen = header.find(key);
+    if (seen != header.end() && seen->second.value != hv.value)
+      throw core::DataError(core::located(file, line,
+                                          key +
+                                              " given twice with different values (first on line " +
+                                              std::to_string(seen->second.line) + "); keep one"));
+    header[key] = hv;
   }
-  close_reading();
-  if (names.empty())
-    throw core::DataError(core::located(file, line, "no column line: the file holds no data"));
-  if (record.readings.empty())
-    throw core::DataError(core::located(file, line, "no readings after the column line"));
+}
 
+/// Refuses a column line other than reading,time_s,sample,s1_um..s4_um[,s5_um].
+void check_column_line(const std::string& file, int line, const std::vector<std::string>& names) {
+  const bool axial = names.size() == raw_columns.size() + 1;
+  for (std::size_t c = 0; c < std::max(names.size(), raw_columns.size() + 1); ++c) {
+    const std::string want = c < raw_columns.size() ? raw_columns[c] : "s5_um";
+    const std::string got = c < names.size() ? names[c] : "";
+    if ((c < raw_columns.size() || axial) && got != want)
+      throw core::DataError(core::located(
+          file, line,
+          "column " + std::to_string(c + 1) + ": header '" + got + "', expected '" + want +
+              "'; the column line must be reading,time_s,sample,s1_um,s2_um,s3_um,s4_um with "
+              "an optional s5_um"));
+    if (c >= raw_columns.size() && !axial && c < names.size())
+      throw core::DataError(core::located(file, line,
+                                          "column " + std::to_string(c + 1) +
+                                              ": unexpected header '" + names[c] +
+                                              "'; only s5_um may follow s4_um"));
+  }
+}
+
+/// One data row as written in the file (displacements in µm).
+struct RawRow {
+  long long reading = 0;
+  double time_s = 0.0;
+  long long sample = 0;
+  std::vector<double> values_um;
+};
+
+/// The fields of one data row, parsed; every field must match the column line.
+RawRow raw_row(const FieldContext& ctx, const std::vector<std::string>& fields) {
+  const std::vector<std::string>& names = ctx.names;
+  if (fields.size() != names.size())
+    throw core::DataError(core::located(
+        ctx.file, ctx.line,
+        "column " + std::to_string(std::min(fields.size(), names.size()) + 1) + ": " +
+            std::to_string(fields.size()) + " fields, expected " + std::to_string(names.size()) +
+            " (" + (names.size() > raw_columns.size() ? "s1_um..s5_um" : "s1_um..s4_um") + ")"));
+  RawRow row;
+  row.reading = integer_field(ctx, fields, 0, "an integer reading number");
+  row.time_s = number_field(ctx, fields, 1, "a time in seconds");
+  row.sample = integer_field(ctx, fields, 2, "an integer sample index");
+  row.values_um.resize(names.size() - 3);
+  for (std::size_t c = 3; c < names.size(); ++c)
+    row.values_um[c - 3] = number_field(ctx, fields, c, "a displacement in µm");
+  return row;
+}
+
+/// Gathers consecutive rows into readings: a reading's rows are together, its samples numbered
+/// from 0, its start time on every row; reading numbers and start times increase.
+class ReadingAssembler {
+ public:
+  void add(const FieldContext& ctx, const std::vector<std::string>& fields, RawRow row) {
+    if (readings_.empty() || row.reading != reading_id_)
+      start_reading(ctx, fields, row);
+    else
+      check_continues(ctx, fields, row);
+    rows_.push_back(std::move(row.values_um));
+    last_line_ = ctx.line;
+  }
+
+  /// The readings read, and the line of each one's last sample (for length errors).
+  struct Finished {
+    std::vector<Reading> readings;
+    std::vector<int> last_lines;
+  };
+  Finished finished() && {
+    close_reading();
+    return {std::move(readings_), std::move(last_lines_)};
+  }
+
+ private:
+  void start_reading(const FieldContext& ctx, const std::vector<std::string>& fields,
+                     const RawRow& row) {
+    if (!readings_.empty() && row.reading < reading_id_)
+      throw core::DataError(
+          field_error(ctx, 0, fields[0],
+                      "after reading " + std::to_string(reading_id_) +
+                          ": reading numbers must increase, each reading's rows together"));
+    if (!readings_.empty() && !(row.time_s > readings_.back().start_time_s))
+      throw core::DataError(field_error(ctx, 1, fields[1],
+                                        "after the previous reading's start " +
+                                            fmt("%.10g", readings_.back().start_time_s) +
+                                            " s: reading start times must increase"));
+    if (row.sample != 0)
+      throw core::DataError(field_error(ctx, 2, fields[2], "0: every reading starts at sample 0"));
+    close_reading();
+    reading_id_ = row.reading;
+    readings_.push_back(Reading{row.time_s, {}});
+  }
+
+  void check_continues(const FieldContext& ctx, const std::vector<std::string>& fields,
+                       const RawRow& row) const {
+    if (row.time_s != readings_.back().start_time_s)
+      throw core::DataError(
+          field_error(ctx, 1, fields[1],
+                      fmt("%.10g", readings_.back().start_time_s) +
+                          ": time_s is the reading's start time, the same on all its rows"));
+    if (row.sample != static_cast<long long>(rows_.size()))
+      throw core::DataError(
+          field_error(ctx, 2, fields[2],
+                      std::to_string(rows_.size()) + ": samples must be consecutive from 0"));
+  }
+
+  /// Moves the gathered rows (µm) into the last reading's sample matrix (m).
+  void close_reading() {
+    if (rows_.empty()) return;
+    Reading& r = readings_.back();
+    r.samples_m.resize(static_cast<Eigen::Index>(rows_.size()),
+                       static_cast<Eigen::Index>(rows_.front().size()));
+    for (std::size_t j = 0; j < rows_.size(); ++j)
+      for (std::size_t p = 0; p < rows_[j].size(); ++p)
+        r.samples_m(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(p)) =
+            rows_[j][p] * 1e-6;
+    last_lines_.push_back(last_line_);
+    rows_.clear();
+  }
+
+  std::vector<Reading> readings_;
+  std::vector<std::vector<double>> rows_;  // samples of the reading being read, µm
+  long long reading_id_ = 0;
+  int last_line_ = 0;
+  std::vector<int> last_lines_;
+};
+
+/// The record's constants (SI) from the header comment and the options, which must agree.
+void set_constants(const std::string& file, const std::map<std::string, HeaderValue>& header,
+                   const RawCsvConstants& given, ProbeRecord& record) {
   record.speed_rev_per_s = resolved_constant(file, "speed_rpm", header, given.speed_rpm) / 60.0;
   record.sample_rate_hz = resolved_constant(file, "sample_rate_hz", header, given.sample_rate_hz);
   record.probe_distance_m =
@@ -264,7 +288,12 @@ ProbeRecord read_raw_csv(const std::filesystem::path& path, const RawCsvConstant
     if (!(v > 0.0))
       throw core::DataError(
           core::located(file, 0, "speed_rpm, sample_rate_hz and probe_distance_mm must be > 0"));
+}
 
+/// Refuses a reading that does not cover more than one revolution: it may miss the reference
+/// angle. `last_lines` holds the line of each reading's last sample.
+void check_readings_cover_a_revolution(const std::string& file, const ProbeRecord& record,
+                                       const std::vector<int>& last_lines) {
   const double per_rev = record.samples_per_revolution();
   for (std::size_t i = 0; i < record.readings.size(); ++i) {
     const auto n = static_cast<double>(record.readings[i].samples_m.rows());
@@ -278,6 +307,43 @@ ProbeRecord read_raw_csv(const std::filesystem::path& path, const RawCsvConstant
               " Hz: every reading must cover more than one revolution (> " + fmt("%.6g", per_rev) +
               " samples) so that it contains the reference angle; record longer readings"));
   }
+}
+
+}  // namespace
+
+ProbeRecord read_raw_csv(const std::filesystem::path& path, const RawCsvConstants& given) {
+  const std::string file = path.string();
+  std::istringstream in(bounded_text(path, "raw probe CSV"));
+
+  std::map<std::string, HeaderValue> header;
+  std::vector<std::string> names;
+  ReadingAssembler readings;
+  std::string raw_line;
+  int line = 0;
+  while (std::getline(in, raw_line)) {
+    ++line;
+    const std::string text = trimmed(raw_line);
+    if (text.empty()) continue;
+    if (text.front() == '#') {
+      add_header_constants(file, line, text.substr(1), header);
+    } else if (names.empty()) {
+      names = split_fields(text);
+      check_column_line(file, line, names);
+    } else {
+      const std::vector<std::string> fields = split_fields(text);
+      const FieldContext ctx{file, line, names};
+      readings.add(ctx, fields, raw_row(ctx, fields));
+    }
+  }
+  auto assembled = std::move(readings).finished();
+  ProbeRecord record;
+  record.readings = std::move(assembled.readings);
+  if (names.empty())
+    throw core::DataError(core::located(file, line, "no column line: the file holds no data"));
+  if (record.readings.empty())
+    throw core::DataError(core::located(file, line, "no readings after the column line"));
+  set_constants(file, header, given, record);
+  check_readings_cover_a_revolution(file, record, assembled.last_lines);
   return record;
 }
 

@@ -160,11 +160,17 @@ bool read_soup(const std::filesystem::path& file, const std::string& prefix,
   return read;
 }
 
-SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
-                             const std::string& prefix) {
-  // 1. Read the polygon soup and make it a consistently oriented mesh.
+/// A polygon soup in m.
+struct Soup {
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
+};
+
+/// The file's polygons, scaled to m and split into triangles; refuses an unreadable file, bad
+/// indices, coordinates beyond 10 km and polygons that cannot be split.
+Soup triangle_soup(const std::filesystem::path& file, double scale, const std::string& prefix) {
+  Soup soup;
+  auto& [points, polygons] = soup;
   std::string said;
   const bool read = read_soup(file, prefix, points, polygons, said);
   if (!read || polygons.empty()) {
@@ -189,16 +195,21 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
             << " m. Hint: check the file and its length unit.";
         throw core::GeometryError(msg.str());
       }
-  {
-    std::vector<std::array<double, 3>> xyz;
-    xyz.reserve(points.size());
-    for (const auto& p : points) xyz.push_back({p.x(), p.y(), p.z()});
-    Triangulation split = fan_triangulated(xyz, polygons);
-    if (!split.problem.empty())
-      throw core::GeometryError(prefix + split.problem +
-                                ". Hint: export triangles (most exporters have a setting).");
-    polygons = std::move(split.triangles);
-  }
+  std::vector<std::array<double, 3>> xyz;
+  xyz.reserve(points.size());
+  for (const auto& p : points) xyz.push_back({p.x(), p.y(), p.z()});
+  Triangulation split = fan_triangulated(xyz, polygons);
+  if (!split.problem.empty())
+    throw core::GeometryError(prefix + split.problem +
+                              ". Hint: export triangles (most exporters have a setting).");
+  polygons = std::move(split.triangles);
+  return soup;
+}
+
+/// The triangle soup repaired, oriented consistently and made a mesh; refuses a soup that is not
+/// a 2-manifold surface.
+Mesh triangle_mesh(Soup soup, const std::string& prefix) {
+  auto& [points, polygons] = soup;
   PMP::repair_polygon_soup(points, polygons);
   if (!PMP::orient_polygon_soup(points, polygons))
     throw core::GeometryError(prefix +
@@ -215,12 +226,11 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
     throw core::GeometryError(prefix +
                               "internal: the surface is not all triangles after splitting");
   m.collect_garbage();
-  const CGAL::Bbox_3 box = PMP::bbox(m);
-  const double diagonal =
-      std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
-                CGAL::square(box.zmax() - box.zmin()));
+  return m;
+}
 
-  // 2. Closed.
+/// Refuses a mesh that does not bound one solid: open, self-intersecting or of several shells.
+void check_one_closed_shell(Mesh& m, const std::string& prefix) {
   if (!CGAL::is_closed(m)) {
     int border = 0;
     for (auto h : m.halfedges()) border += m.is_border(h) ? 1 : 0;
@@ -228,7 +238,6 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
                               " edges bound only one triangle, expected 0. Hint: close the holes "
                               "(fill the missing faces) before exporting.");
   }
-  // 3. Not self-intersecting.
   if (PMP::does_self_intersect(m)) {
     std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
     PMP::self_intersections(m, std::back_inserter(pairs));
@@ -237,14 +246,24 @@ SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
                               " pairs of triangles cross). Hint: "
                               "union the parts into one solid before exporting.");
   }
-  // 4. One shell: a region point reaches one connected part only.
+  // One shell: a region point reaches one connected part only.
   auto component = m.add_property_map<FaceIndex, std::size_t>("f:component", 0).first;
   const std::size_t shells = PMP::connected_components(m, component);
   if (shells != 1)
     throw core::GeometryError(prefix + "the surface has " + std::to_string(shells) +
                               " separate shells, expected 1. Hint: give each solid its own file "
                               "and body.");
-  // 5. Outward, with positive volume.
+}
+
+SurfaceSolid solid_from_file(const std::filesystem::path& file, double scale,
+                             const std::string& prefix) {
+  Mesh m = triangle_mesh(triangle_soup(file, scale, prefix), prefix);
+  const CGAL::Bbox_3 box = PMP::bbox(m);
+  const double diagonal =
+      std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
+                CGAL::square(box.zmax() - box.zmin()));
+  check_one_closed_shell(m, prefix);
+  // Outward, with positive volume.
   if (!PMP::is_outward_oriented(m)) PMP::reverse_face_orientations(m);
   SurfaceSolid solid;
   solid.volume = PMP::volume(m);

@@ -430,9 +430,8 @@ std::vector<T> array_at(const std::string& bytes, std::size_t offset, std::size_
   return values;
 }
 
-}  // namespace
-
-LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
+/// Refuses limits and quality bounds TetGen cannot run with.
+void check_options(const TetgenOptions& options) {
   if (!(options.time_limit_s > 0) || !(options.memory_limit_GB > 0))
     throw core::MeshError("mesh limits time_limit_s = " + std::to_string(options.time_limit_s) +
                           ", memory_limit_GB = " + std::to_string(options.memory_limit_GB) +
@@ -443,16 +442,12 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
         "mesh quality bounds radius_edge_ratio = " + std::to_string(options.radius_edge_ratio) +
         ", min_dihedral_deg = " + std::to_string(options.min_dihedral_deg) +
         ": need radius_edge_ratio >= 1 and 0 <= min_dihedral_deg <= 18");
-  // Interior points go in as isolated PLC vertices: TetGen keeps every input vertex inside the
-  // domain, and its -i insertion path crashes in 1.5.0.
-  Plc with_points = plc;
-  with_points.vertices.insert(with_points.vertices.end(), plc.interior_points.begin(),
-                              plc.interior_points.end());
-  tetgenio in;
-  fill_input(with_points, in);
-  const std::string switches = switches_for(options);
-  const ChildOutput output = run_isolated(switches, in, options);
+}
 
+/// Throws a MeshError that says what was asked and what TetGen printed unless the child sent a
+/// whole result.
+void require_result(const ChildOutput& output, const Plc& plc, const std::string& switches,
+                    const TetgenOptions& options) {
   if (output.timed_out)
     throw core::MeshError("TetGen with switches '" + switches + "' on a PLC of " +
                           std::to_string(plc.facets.size()) +
@@ -468,8 +463,19 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
         ". Hint: check that bodies do not cross or nearly touch, coarsen circle_segments or relax "
         "the quality bounds.");
   }
+}
+
+/// The arrays of a result (see ResultHeader), checked against the header's counts.
+struct ResultArrays {
+  std::vector<double> points;      /// #points x 3 [m]
+  std::vector<int> corners;        /// #tets x 4
+  std::vector<double> attributes;  /// #tets x attributes_per_tet
+  std::size_t attributes_per_tet = 0;
+};
+
+ResultArrays result_arrays(const std::string& bytes, const std::string& switches) {
   ResultHeader out;
-  std::memcpy(&out, output.result.data(), sizeof out);
+  std::memcpy(&out, bytes.data(), sizeof out);
   if (out.tets == 0 || out.corners != 4)
     throw core::MeshError("TetGen returned no tetrahedra for switches '" + switches + "'");
   if (out.attributes < 1)
@@ -479,25 +485,30 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
   const std::size_t na = static_cast<std::size_t>(out.attributes);
   const std::size_t tets_at = sizeof out + 3 * n_points * sizeof(REAL);
   const std::size_t attributes_at = tets_at + 4 * n_tets * sizeof(int);
-  if (out.points < 4 || output.result.size() != attributes_at + na * n_tets * sizeof(REAL))
-    throw core::MeshError("the TetGen process sent " + std::to_string(output.result.size()) +
+  if (out.points < 4 || bytes.size() != attributes_at + na * n_tets * sizeof(REAL))
+    throw core::MeshError("the TetGen process sent " + std::to_string(bytes.size()) +
                           " bytes for " + std::to_string(out.points) + " points and " +
                           std::to_string(out.tets) + " tets: the result is truncated");
-  const std::vector<double> points = array_at<double>(output.result, sizeof out, 3 * n_points);
-  const std::vector<int> corners = array_at<int>(output.result, tets_at, 4 * n_tets);
-  const std::vector<double> attributes =
-      array_at<double>(output.result, attributes_at, na * n_tets);
+  return {array_at<double>(bytes, sizeof out, 3 * n_points),
+          array_at<int>(bytes, tets_at, 4 * n_tets),
+          array_at<double>(bytes, attributes_at, na * n_tets), na};
+}
 
+/// Positively oriented tets with zero-based regions; refuses a vertex index out of range and a
+/// tet outside every region.
+LinearTets linear_tets(const ResultArrays& r) {
+  const std::size_t n_points = r.points.size() / 3;
+  const std::size_t n_tets = r.corners.size() / 4;
   LinearTets result;
   result.nodes.resize(n_points);
   for (std::size_t i = 0; i < n_points; ++i)
-    result.nodes[i] = {points[3 * i], points[3 * i + 1], points[3 * i + 2]};
+    result.nodes[i] = {r.points[3 * i], r.points[3 * i + 1], r.points[3 * i + 2]};
   result.tets.resize(n_tets);
   result.region.resize(n_tets);
   for (std::size_t t = 0; t < n_tets; ++t) {
     std::array<int, 4> tet;
     for (int k = 0; k < 4; ++k) {
-      tet[k] = corners[4 * t + k];
+      tet[k] = r.corners[4 * t + k];
       if (tet[k] < 0 || static_cast<std::size_t>(tet[k]) >= n_points)
         throw core::MeshError("TetGen returned tetrahedron " + std::to_string(t) + " with vertex " +
                               std::to_string(tet[k]) + " of " + std::to_string(n_points));
@@ -507,7 +518,7 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
         (result.nodes[tet[1]] - a).cross(result.nodes[tet[2]] - a).dot(result.nodes[tet[3]] - a);
     if (orient < 0) std::swap(tet[2], tet[3]);
     result.tets[t] = tet;
-    const int attribute = static_cast<int>(attributes[na * t] + 0.5);
+    const int attribute = static_cast<int>(r.attributes[r.attributes_per_tet * t] + 0.5);
     if (attribute < 1)
       throw core::MeshError("TetGen produced tetrahedron " + std::to_string(t) +
                             " outside every declared body (region attribute " +
@@ -515,6 +526,23 @@ LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
     result.region[t] = attribute - 1;
   }
   return result;
+}
+
+}  // namespace
+
+LinearTets tetrahedralize(const Plc& plc, const TetgenOptions& options) {
+  check_options(options);
+  // Interior points go in as isolated PLC vertices: TetGen keeps every input vertex inside the
+  // domain, and its -i insertion path crashes in 1.5.0.
+  Plc with_points = plc;
+  with_points.vertices.insert(with_points.vertices.end(), plc.interior_points.begin(),
+                              plc.interior_points.end());
+  tetgenio in;
+  fill_input(with_points, in);
+  const std::string switches = switches_for(options);
+  const ChildOutput output = run_isolated(switches, in, options);
+  require_result(output, plc, switches, options);
+  return linear_tets(result_arrays(output.result, switches));
 }
 
 }  // namespace tt::mesh::tetgen
