@@ -286,6 +286,7 @@ int fit_data_command(const FitDataArgs& args) {
       for (const auto& set : network_sensor_sets(*placed, target))
         target_candidates.push_back({set, driver_network_spec(1)});
       target_candidates.push_back(linear_inputs_network(evals.back().model, 1));
+      if (auto c = ridge_skip_network(evals.back(), 1, has_speed)) target_candidates.push_back(*c);
       evals.back() = fitting::blocked_evaluation(groups, pool, test, target, target_candidates);
     }
     const auto& e = evals.back();
