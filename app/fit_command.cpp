@@ -157,14 +157,20 @@ int fit_command(const FitArgs& args) {
     }
     evals.push_back(fitting::evaluation(groups, split, target, at_most_4, specs));
     if (args.network) {
-      // The network on the grey relational sensors and on the chosen linear model's, chosen on
-      // validation beside the linear models.
+      // The network on the grey relational sensors, on the chosen linear model's (that model its
+      // linear skip) and on the best ridge's (that ridge its skip), chosen on validation beside
+      // the linear models.
       const fitting::Candidate linear_inputs = linear_inputs_network(evals.back().model, spec.seed);
       at_most_4.push_back(linear_inputs.sensor_set);
       network_inputs.push_back(linear_inputs.sensor_set);
       std::vector<fitting::ModelSpec> with_network = specs;
       with_network.push_back(driver_network_spec(spec.seed));
       with_network.push_back(linear_inputs.spec);
+      if (auto c =
+              ridge_skip_network(evals.back(), spec.seed, !groups.front().input_names.empty())) {
+        at_most_4.push_back(c->sensor_set);
+        with_network.push_back(c->spec);
+      }
       evals.back() = fitting::evaluation(groups, split, target, at_most_4, with_network);
     }
     std::vector<fitting::SensorSet> all = sensor_sets(placed, target, 6);

@@ -280,12 +280,14 @@ int fit_data_command(const FitDataArgs& args) {
   for (int target = 0; target < static_cast<int>(targets.size()); ++target) {
     evals.push_back(fitting::blocked_evaluation(groups, pool, test, target, candidates));
     if (placed) {
-      // The network on the grey relational sensors and on the inputs of the linear model just
-      // chosen, chosen beside the linear models under the same rule.
+      // The network on the grey relational sensors, on the inputs of the linear model just chosen
+      // (that model its linear skip) and on the best ridge's (that ridge its skip), chosen beside
+      // the linear models under the same rule.
       std::vector<fitting::Candidate> target_candidates = candidates;
       for (const auto& set : network_sensor_sets(*placed, target))
         target_candidates.push_back({set, driver_network_spec(1)});
       target_candidates.push_back(linear_inputs_network(evals.back().model, 1));
+      if (auto c = ridge_skip_network(evals.back(), 1, has_speed)) target_candidates.push_back(*c);
       evals.back() = fitting::blocked_evaluation(groups, pool, test, target, target_candidates);
     }
     const auto& e = evals.back();

@@ -27,8 +27,37 @@ fitting::ModelSpec driver_network_spec(std::uint64_t seed, const std::string& se
 }
 
 fitting::Candidate linear_inputs_network(const fitting::FittedModel& chosen, std::uint64_t seed) {
-  return {fitting::SensorSet{kLinearInputsNetworkMethod, chosen.features.sensors},
-          driver_network_spec(seed, kLinearInputsNetworkMethod, !chosen.features.inputs.empty())};
+  fitting::ModelSpec spec =
+      driver_network_spec(seed, kLinearInputsNetworkMethod, !chosen.features.inputs.empty());
+  // The chosen linear model as the network's skip: its features (lags included) and its ridge
+  // strength; the network learns what it leaves.
+  const auto kind = chosen.spec.kind;
+  if (kind == fitting::ModelKind::least_squares || kind == fitting::ModelKind::ridge ||
+      kind == fitting::ModelKind::distributed_lag) {
+    spec.network.linear_skip = true;
+    spec.ridge_lambda = chosen.spec.ridge_lambda;
+    spec.time_constants = chosen.features.time_constants;
+  }
+  return {fitting::SensorSet{kLinearInputsNetworkMethod, chosen.features.sensors}, spec};
+}
+
+std::optional<fitting::Candidate> ridge_skip_network(const fitting::Evaluation& e,
+                                                     std::uint64_t seed, bool use_inputs) {
+  const fitting::CandidateResult* best = nullptr;
+  for (const auto& c : e.selection.candidates) {
+    const fitting::ModelSpec& s = e.specs[static_cast<std::size_t>(c.spec)];
+    if (!c.model || s.kind != fitting::ModelKind::ridge) continue;
+    const double ms = fitting::mean_square(c.validation);
+    if (std::isfinite(ms) && (!best || ms < fitting::mean_square(best->validation))) best = &c;
+  }
+  if (!best) return std::nullopt;
+  fitting::ModelSpec spec = driver_network_spec(seed, kRidgeSkipNetworkMethod, use_inputs);
+  spec.network.linear_skip = true;
+  spec.ridge_lambda = e.specs[static_cast<std::size_t>(best->spec)].ridge_lambda;
+  return fitting::Candidate{
+      fitting::SensorSet{kRidgeSkipNetworkMethod,
+                         e.sensor_sets[static_cast<std::size_t>(best->sensor_set)].sensors},
+      spec};
 }
 
 std::vector<fitting::SensorSet> network_sensor_sets(const placement::PlacementResult& placed,

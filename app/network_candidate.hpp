@@ -32,7 +32,20 @@ inline constexpr double kNetworkWeightDecay = 0.3;
 
 /// The network candidate on the inputs of the linear model chosen for a target: its sensors as a
 /// set of method kLinearInputsNetworkMethod and a network spec that reads the speed when it does.
+/// When that model is linear (least squares, ridge, distributed lags) it is the network's linear
+/// skip (its lagged features and ridge strength): the network learns what the linear model
+/// leaves, and stays that model when it cannot improve on it on the early-stopping rows.
 fitting::Candidate linear_inputs_network(const fitting::FittedModel& chosen, std::uint64_t seed);
+
+/// Sensor-set method of the network whose linear skip is static: the ridge on the temperature
+/// rises (no lags) that validates best, so that the network's windows carry the dynamics.
+inline constexpr const char* kRidgeSkipNetworkMethod = "ridge_skip_network";
+
+/// The network candidate on the sensors of the ridge candidate (kind ridge) of the lowest mean
+/// validation S² in `e`, with that ridge as its linear skip (the speed read beside, linearly in
+/// the skip and in the windows, when `use_inputs`); nullopt when `e` holds no fitted ridge.
+std::optional<fitting::Candidate> ridge_skip_network(const fitting::Evaluation& e,
+                                                     std::uint64_t seed, bool use_inputs);
 
 /// The grey relational placement's largest set of at most 4 sensors for `target`, renamed
 /// kNetworkSensorMethod; empty when placement ran no grey relational ranking.

@@ -21,13 +21,12 @@ FeatureMap feature_map(const ModelSpec& spec, const Group& group, const std::vec
                             std::to_string(group.sensor_names.size()) + ")");
     map.sensor_names.push_back(group.sensor_names[static_cast<std::size_t>(s)]);
   }
-  if (spec.kind == ModelKind::distributed_lag) {
-    if (spec.time_constants.empty())
-      throw core::DataError(
-          "distributed_lag model with no time constants; expected at least "
-          "one, e.g. {1800} s");
+  if (spec.kind == ModelKind::distributed_lag && spec.time_constants.empty())
+    throw core::DataError(
+        "distributed_lag model with no time constants; expected at least "
+        "one, e.g. {1800} s");
+  if (spec.kind == ModelKind::distributed_lag || spec.kind == ModelKind::cnn_bigru_attention)
     map.time_constants = spec.time_constants;
-  }
   if (spec.use_inputs)
     for (std::size_t c = 0; c < group.input_names.size(); ++c) {
       map.inputs.push_back(static_cast<int>(c));
@@ -51,8 +50,41 @@ int window_stride(const NetworkSettings& settings, const std::vector<Group>& gro
   return std::max(1, static_cast<int>(std::lround(settings.window_span_s / entries / median)));
 }
 
-torchnet::Network network_fit(const torchnet::NetworkOptions& options, const FeatureMap& features,
-                              const std::vector<Group>& groups, const std::vector<int>& targets) {
+/// The network's linear skip: per output, the ridge fit of strength `lambda` on every row of the
+/// fitting and validation sequences (in the network's input and output units).
+torchnet::LinearSkip linear_skip(const torchnet::Sequences& fit,
+                                 const torchnet::Sequences& validation, double lambda) {
+  std::vector<Eigen::MatrixXd> xs = fit.inputs, ys = fit.outputs;
+  xs.insert(xs.end(), validation.inputs.begin(), validation.inputs.end());
+  ys.insert(ys.end(), validation.outputs.begin(), validation.outputs.end());
+  Eigen::Index rows = 0;
+  for (const auto& x : xs) rows += x.rows();
+  Eigen::MatrixXd x(rows, xs.front().cols()), y(rows, ys.front().cols());
+  for (std::size_t g = 0, r = 0; g < xs.size(); r += static_cast<std::size_t>(xs[g].rows()), ++g) {
+    x.middleRows(static_cast<Eigen::Index>(r), xs[g].rows()) = xs[g];
+    y.middleRows(static_cast<Eigen::Index>(r), ys[g].rows()) = ys[g];
+  }
+  torchnet::LinearSkip skip{Eigen::VectorXd(y.cols()), Eigen::MatrixXd(y.cols(), x.cols())};
+  for (Eigen::Index k = 0; k < y.cols(); ++k) {
+    const LinearFit f = linear_fit(x, y.col(k), lambda);
+    skip.intercept(k) = f.intercept;
+    skip.weights.row(k) = f.coefficients.transpose();
+  }
+  return skip;
+}
+
+/// The network of `spec` trained on sequences, with its linear skip when the spec asks for one.
+torchnet::Network trained_on(const ModelSpec& spec, const torchnet::NetworkOptions& options,
+                             const torchnet::Sequences& fit,
+                             const torchnet::Sequences& validation) {
+  if (!spec.network.linear_skip) return torchnet::trained_network(fit, validation, options);
+  return torchnet::trained_network(fit, validation, options,
+                                   linear_skip(fit, validation, spec.ridge_lambda));
+}
+
+torchnet::Network network_fit(const ModelSpec& spec, const torchnet::NetworkOptions& options,
+                              const FeatureMap& features, const std::vector<Group>& groups,
+                              const std::vector<int>& targets) {
   // With three or more groups the last one stops the training early; with fewer, the adapter
   // holds out the last fifth of each group.
   torchnet::Sequences fit, validation;
@@ -65,7 +97,7 @@ torchnet::Network network_fit(const torchnet::NetworkOptions& options, const Fea
       y.col(static_cast<Eigen::Index>(k)) = groups[g].error.col(targets[k]);
     s.outputs.push_back(std::move(y));
   }
-  return torchnet::trained_network(fit, validation, options);
+  return trained_on(spec, options, fit, validation);
 }
 
 Body body_fit(const ModelSpec& spec, const Eigen::MatrixXd& x, const Eigen::VectorXd& y) {
@@ -132,6 +164,12 @@ std::string model_label(const ModelSpec& spec) {
           << ",gru=" << spec.network.options.gru_layers << "x" << spec.network.options.gru_hidden;
       if (spec.network.options.weight_decay > 0.0)
         out << ",wd=" << spec.network.options.weight_decay;
+      if (!spec.time_constants.empty()) {
+        out << ",tau_s=";
+        for (std::size_t t = 0; t < spec.time_constants.size(); ++t)
+          out << (t ? "/" : "") << spec.time_constants[t];
+      }
+      if (spec.network.linear_skip) out << ",linear_skip_lambda=" << spec.ridge_lambda;
       out << ",seed=" << spec.network.options.seed << ")";
       break;
   }
@@ -187,7 +225,8 @@ std::vector<FittedModel> network_models(const ModelSpec& spec, const std::vector
   for (int t : targets) models.push_back(unfitted_model(spec, groups, sensors, t));
   torchnet::NetworkOptions options = spec.network.options;
   options.window_stride = window_stride(spec.network, groups);
-  const torchnet::Network network = network_fit(options, models.front().features, groups, targets);
+  const torchnet::Network network =
+      network_fit(spec, options, models.front().features, groups, targets);
   int samples = 0;
   for (const Group& g : groups) samples += static_cast<int>(g.time.size());
   for (std::size_t k = 0; k < models.size(); ++k) {
@@ -282,7 +321,7 @@ Eigen::VectorXd refitted_prediction(const FittedModel& chosen, const Group& grou
       }
       i = j + 1;
     }
-    return torchnet::trained_network(fit, {}, network->options()).prediction(x).col(0);
+    return trained_on(chosen.spec, network->options(), fit, {}).prediction(x).col(0);
   }
   std::vector<Eigen::Index> rows;
   for (Eigen::Index i = 0; i < x.rows(); ++i)

@@ -40,14 +40,21 @@ struct NetworkSettings {
   /// time an input window spans [s]: the stride between its entries is this over
   /// (window_steps − 1), in samples of the fitting groups' median interval
   double window_span_s = 1800.0;
+  /// the network's output is a ridge fit (the spec's ridge_lambda) on the features of the sample
+  /// predicted, fitted on every row the training is given (its early-stopping rows included) and
+  /// kept fixed, plus the CNN-BiGRU-attention path trained on what that fit leaves
+  /// (torchnet::LinearSkip). With the spec's time_constants the features are a distributed-lag
+  /// model's: the skip is then that model, and the network's windows read its lagged columns too
+  bool linear_skip = false;
 };
 
 /// A model type with its settings: one candidate of the selection.
 struct ModelSpec {
   ModelKind kind = ModelKind::least_squares;
-  /// dimensionless ridge strength (ridge, distributed_lag); see linear_fit
+  /// dimensionless ridge strength (ridge, distributed_lag, a network's linear skip); see linear_fit
   double ridge_lambda = 0.0;
-  /// low-pass time constants of distributed_lag [s]
+  /// low-pass time constants of distributed_lag [s]; of cnn_bigru_attention too (its input
+  /// columns then include the lagged ones)
   std::vector<double> time_constants;
   /// settings of projection_pursuit
   PprOptions ppr;

@@ -99,6 +99,9 @@ json settings_json(const fitting::ModelSpec& spec) {
       s["seed"] = o.seed;
       s["threads"] = o.threads;
       s["sensor_method"] = spec.sensor_method;
+      if (!spec.time_constants.empty()) s["time_constants_s"] = spec.time_constants;
+      s["linear_skip"] = spec.network.linear_skip;
+      if (spec.network.linear_skip) s["ridge_lambda"] = spec.ridge_lambda;
       break;
     }
   }
@@ -213,6 +216,20 @@ json model_json(const FittedModel& model) {
     j["input_scale_K"] = vector_json(network->input_scale());
     j["output_mean_um"] = vector_json(network->output_mean(), um);
     j["output_scale_um"] = vector_json(network->output_scale(), um);
+    if (const auto& skip = network->linear_skip()) {
+      // The fixed linear part: per output, intercept + Σ weight·input at the sample predicted.
+      json outputs = json::array();
+      const std::vector<std::string> names = fitting::feature_names(model.features);
+      for (Eigen::Index k = 0; k < skip->weights.rows(); ++k) {
+        json terms = json::array();
+        for (std::size_t c = 0; c < names.size(); ++c)
+          terms.push_back(
+              {{"name", names[c]},
+               {"um_per_K", number(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
+        outputs.push_back({{"intercept_um", number(skip->intercept(k) * um)}, {"terms", terms}});
+      }
+      j["linear_skip"] = outputs;
+    }
     j["training"] = {{"epochs", r.epochs},
                      {"best_epoch", r.best_epoch},
                      {"validation_loss_standardised", number(r.validation_loss)},
@@ -223,7 +240,9 @@ json model_json(const FittedModel& model) {
     j["note"] =
         "TorchScript forward(x): x float32 batch x window_steps x inputs, the increments dT [K] "
         "of the inputs at rows i - (window_steps-1-j)*window_stride_samples (the first row "
-        "repeated before the group's start); returns batch x 1 error [m]; standardisation inside";
+        "repeated before the group's start); returns batch x 1 error [m]; standardisation inside, "
+        "and the linear skip (buffers skip_w, skip_b; zero without one) applied to the "
+        "window's last row";
     return j;
   }
   const auto& ppr = std::get<fitting::PprModel>(model.body);

@@ -99,6 +99,7 @@ std::string script_source(const NetworkOptions& o, int gru_tensors) {
   std::ostringstream s;
   const int pad = o.kernel_size / 2;
   s << "def forward(self, x: Tensor) -> Tensor:\n"
+    << "    s = torch.linear(x[:, -1, :], self.skip_w, self.skip_b)\n"
     << "    x = (x - self.in_mean) / self.in_scale\n"
     << "    x = x.transpose(1, 2)\n"
     << "    x = torch.relu(torch.conv1d(x, self.conv1_w, self.conv1_b, [1], [" << pad << "]))\n"
@@ -114,7 +115,7 @@ std::string script_source(const NetworkOptions& o, int gru_tensors) {
     << "    c = y[:, -1, :]\n"
     << "    a = torch.softmax(c * torch.linear(c, self.key_w, self.key_b), 1)\n"
     << "    z = torch.linear(a * c * " << 2 * o.gru_hidden << ".0, self.head_w, self.head_b)\n"
-    << "    return z * self.out_scale + self.out_mean\n";
+    << "    return z * self.out_scale + self.out_mean + s\n";
   return s.str();
 }
 
@@ -124,9 +125,16 @@ torch::Tensor float_tensor(const Eigen::VectorXd& v) {
   return t;
 }
 
+torch::Tensor float_tensor(const Eigen::MatrixXd& m) {
+  torch::Tensor t = torch::empty({m.rows(), m.cols()}, torch::kFloat32);
+  for (Eigen::Index i = 0; i < m.rows(); ++i)
+    for (Eigen::Index j = 0; j < m.cols(); ++j) t[i][j] = static_cast<float>(m(i, j));
+  return t;
+}
+
 torch::jit::Module script_module(Net& net, const NetworkOptions& o, const Eigen::VectorXd& in_mean,
                                  const Eigen::VectorXd& in_scale, const Eigen::VectorXd& out_mean,
-                                 const Eigen::VectorXd& out_scale) {
+                                 const Eigen::VectorXd& out_scale, const LinearSkip& skip) {
   torch::jit::Module m("ThermotwinCnnBiGruAttention");
   const auto param = [&](const std::string& name, const torch::Tensor& t) {
     m.register_parameter(name, t.detach().clone(), false);
@@ -135,6 +143,8 @@ torch::jit::Module script_module(Net& net, const NetworkOptions& o, const Eigen:
   m.register_buffer("in_scale", float_tensor(in_scale));
   m.register_buffer("out_mean", float_tensor(out_mean));
   m.register_buffer("out_scale", float_tensor(out_scale));
+  m.register_buffer("skip_w", float_tensor(skip.weights));
+  m.register_buffer("skip_b", float_tensor(skip.intercept));
   m.register_attribute("window_steps", c10::IntType::get(), o.window_steps);
   m.register_attribute("window_stride", c10::IntType::get(), o.window_stride);
   param("conv1_w", net->conv1->weight);
@@ -310,6 +320,7 @@ struct Network::Impl {
   TrainingReport report;
   int inputs = 0, outputs = 0;
   Eigen::VectorXd in_mean, in_scale, out_mean, out_scale;
+  std::optional<LinearSkip> skip;
   /// the trained network as TorchScript: the one inference path, in memory and on file
   torch::jit::Module script;
   std::vector<float> weights;
@@ -340,6 +351,9 @@ Eigen::VectorXd Network::output_mean() const {
 }
 Eigen::VectorXd Network::output_scale() const {
   return impl_->out_scale;
+}
+const std::optional<LinearSkip>& Network::linear_skip() const {
+  return impl_->skip;
 }
 std::vector<float> Network::flat_weights() const {
   return impl_->weights;
@@ -398,27 +412,58 @@ void Network::save_torchscript(const std::filesystem::path& file) const {
   std::filesystem::rename(part, file);
 }
 
-Network trained_network(const Sequences& fit, const Sequences& validation,
-                        const NetworkOptions& o) {
+namespace {
+
+void require_skip(const LinearSkip& skip, int inputs, int outputs) {
+  if (skip.intercept.size() != outputs || skip.weights.rows() != outputs ||
+      skip.weights.cols() != inputs || !skip.intercept.allFinite() || !skip.weights.allFinite())
+    throw core::DataError("network linear skip of " + std::to_string(skip.intercept.size()) +
+                          " intercepts and " + std::to_string(skip.weights.rows()) + "x" +
+                          std::to_string(skip.weights.cols()) + " weights; expected " +
+                          std::to_string(outputs) + " and " + std::to_string(outputs) + "x" +
+                          std::to_string(inputs) + ", finite");
+}
+
+/// The sequences with the skip's prediction taken from the outputs: what the network learns.
+Sequences residual(const Sequences& s, const LinearSkip& skip) {
+  Sequences out = s;
+  for (std::size_t g = 0; g < out.outputs.size(); ++g)
+    out.outputs[g] = (s.outputs[g] - s.inputs[g] * skip.weights.transpose()).rowwise() -
+                     skip.intercept.transpose();
+  return out;
+}
+
+}  // namespace
+
+Network trained_network(const Sequences& fit_given, const Sequences& validation_given,
+                        const NetworkOptions& o, const std::optional<LinearSkip>& skip) {
   require_options(o);
-  if (fit.inputs.empty())
+  if (fit_given.inputs.empty())
     throw core::DataError("network training with no fitting group; expected at least one");
-  const int inputs = static_cast<int>(fit.inputs.front().cols());
-  const int outputs = static_cast<int>(fit.outputs.empty() ? 0 : fit.outputs.front().cols());
+  const int inputs = static_cast<int>(fit_given.inputs.front().cols());
+  const int outputs =
+      static_cast<int>(fit_given.outputs.empty() ? 0 : fit_given.outputs.front().cols());
   if (inputs < 1 || outputs < 1)
     throw core::DataError("network training with " + std::to_string(inputs) + " inputs and " +
                           std::to_string(outputs) + " outputs; expected at least one of each");
-  require_sequences(fit, "network fitting", inputs, outputs);
-  require_sequences(validation, "network validation", inputs, outputs);
+  require_sequences(fit_given, "network fitting", inputs, outputs);
+  require_sequences(validation_given, "network validation", inputs, outputs);
+  if (skip) require_skip(*skip, inputs, outputs);
+  const Sequences fit = skip ? residual(fit_given, *skip) : fit_given;
+  const Sequences validation = skip ? residual(validation_given, *skip) : validation_given;
 
   auto impl = std::make_shared<Network::Impl>();
   impl->options = o;
   impl->inputs = inputs;
   impl->outputs = outputs;
+  impl->skip = skip;
   const Eigen::MatrixXd x_all = stacked(fit.inputs), y_all = stacked(fit.outputs);
   impl->in_mean = x_all.colwise().mean().transpose();
   impl->in_scale = column_scale(x_all, impl->in_mean);
-  impl->out_mean = y_all.colwise().mean().transpose();
+  // With a skip the outputs are its residuals, centred by its intercept over every given row:
+  // no mean is added, so that the untrained network (its last layer zero) is the skip exactly.
+  impl->out_mean = skip ? Eigen::VectorXd::Zero(outputs).eval()
+                        : Eigen::VectorXd(y_all.colwise().mean().transpose());
   impl->out_scale = column_scale(y_all, impl->out_mean);
   if (o.common_output_scale)
     impl->out_scale.setConstant(
@@ -470,6 +515,19 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
                                                   torch::optim::AdamOptions(o.learning_rate));
     std::vector<torch::Tensor> best;
     double best_loss = std::numeric_limits<double>::infinity();
+    const auto keep_if_best = [&](int epoch) {
+      const double loss = mean_squared(net, x_val, y_val);
+      if (!std::isfinite(loss) || loss >= best_loss) return;
+      best_loss = loss;
+      impl->report.best_epoch = epoch;
+      best.clear();
+      for (const auto& p : net->parameters()) best.push_back(p.detach().clone());
+      for (const auto& b : net->buffers()) best.push_back(b.detach().clone());
+    };
+    // With a skip, the linear model alone (the network's last layer zero, so that it adds
+    // nothing) is a candidate of the early stopping too: epoch 0.
+    const double skip_only =
+        skip ? y_val.pow(2).mean().item<double>() : std::numeric_limits<double>::infinity();
     for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
       const torch::Tensor order = torch::randperm(nf, gen, torch::TensorOptions(torch::kLong));
       net->train();
@@ -481,15 +539,8 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
         loss.backward();
         adam->step();
       }
-      const double loss = mean_squared(net, x_val, y_val);
       impl->report.epochs = epoch;
-      if (std::isfinite(loss) && loss < best_loss) {
-        best_loss = loss;
-        impl->report.best_epoch = epoch;
-        best.clear();
-        for (const auto& p : net->parameters()) best.push_back(p.detach().clone());
-        for (const auto& b : net->buffers()) best.push_back(b.detach().clone());
-      }
+      keep_if_best(epoch);
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (seconds > o.time_budget_s) {
@@ -498,15 +549,22 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
       }
       if (epoch - impl->report.best_epoch >= o.patience) break;
     }
-    if (best.empty())
+    if (best.empty() && !skip)
       throw core::DataError(
           "network training gave no finite validation loss; hint: lower learning_rate");
     {
       torch::NoGradGuard no_grad;
       auto params = net->parameters();
       const auto buffers = net->buffers();
-      for (std::size_t i = 0; i < params.size(); ++i) params[i].copy_(best[i]);
-      for (std::size_t i = 0; i < buffers.size(); ++i) buffers[i].copy_(best[params.size() + i]);
+      for (std::size_t i = 0; i < best.size() && i < params.size(); ++i) params[i].copy_(best[i]);
+      for (std::size_t i = 0; i < best.size() && i < buffers.size(); ++i)
+        buffers[i].copy_(best[params.size() + i]);
+      if (skip_only <= best_loss) {
+        net->head->weight.zero_();
+        net->head->bias.zero_();
+        impl->report.best_epoch = 0;
+        best_loss = skip_only;
+      }
       net->eval();
       for (const auto& p : params) {
         const torch::Tensor flat = p.detach().contiguous().view(-1);
@@ -516,7 +574,9 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
     }
     impl->report.validation_loss = best_loss;
     impl->script =
-        script_module(net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale);
+        script_module(net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
+                      skip.value_or(LinearSkip{Eigen::VectorXd::Zero(outputs),
+                                               Eigen::MatrixXd::Zero(outputs, inputs)}));
   } catch (const c10::Error& e) {
     throw core::DataError(std::string("network training failed in libtorch: ") +
                           e.what_without_backtrace());

@@ -2,7 +2,9 @@
 // plain C++ interface: nothing outside fitting/torch/ includes a torch header.
 // Structure: standardised input windows -> two 1-D convolutions (ReLU) -> max pooling by 2 ->
 // batch normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
-// dimension of the last GRU output -> one fully connected layer to every output at once.
+// dimension of the last GRU output -> one fully connected layer to every output at once; with a
+// linear skip (LinearSkip), plus a fixed linear map of the window's last row, so that the network
+// learns only what that linear model leaves.
 // Trained on CPU with Adam (AdamW with weight decay) on the mean squared standardised error, early
 // stopping on validation windows and a time budget. The same seed and thread count give the same
 // weights.
@@ -12,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,9 +64,23 @@ struct Sequences {
   std::vector<Eigen::MatrixXd> outputs;
 };
 
+/// A linear model added to the network's output: output = intercept + weights · x_last + the
+/// CNN-BiGRU-attention path, x_last the window's last row (the sample predicted) in the inputs'
+/// units. It is fitted outside (by the caller, e.g. the ridge fit of the linear model chosen for
+/// the target) and kept fixed: the network trains on what it leaves, and the linear model alone
+/// (the last layer zeroed) is a candidate of the early stopping (reported as epoch 0), so a
+/// network that does not improve on the linear model on the validation windows is that model.
+struct LinearSkip {
+  /// #outputs
+  Eigen::VectorXd intercept;
+  /// #outputs x #inputs
+  Eigen::MatrixXd weights;
+};
+
 struct TrainingReport {
   int epochs = 0;
-  /// epoch (1-based) whose weights were kept
+  /// epoch (1-based) whose weights were kept; 0: the weights before training (with a linear
+  /// skip, the linear model alone)
   int best_epoch = 0;
   /// mean squared standardised error on the validation windows at best_epoch
   double validation_loss = 0.0;
@@ -83,7 +100,8 @@ class Network {
   Eigen::VectorXd window_prediction(const Eigen::MatrixXd& window) const;
   /// The network as TorchScript, with the standardisation inside: forward(x) takes a float32
   /// batch x window_steps x #inputs tensor in the training inputs' units and returns batch x
-  /// #outputs in the outputs' units. Written to a temporary name and renamed.
+  /// #outputs in the outputs' units (the linear skip included: buffers skip_w, skip_b, zero
+  /// without one). Written to a temporary name and renamed.
   void save_torchscript(const std::filesystem::path& file) const;
 
   int inputs() const;
@@ -95,6 +113,8 @@ class Network {
   Eigen::VectorXd input_scale() const;
   Eigen::VectorXd output_mean() const;
   Eigen::VectorXd output_scale() const;
+  /// the fixed linear part, when the network was trained with one
+  const std::optional<LinearSkip>& linear_skip() const;
   /// Every weight in a fixed order: for comparing two trainings.
   std::vector<float> flat_weights() const;
 
@@ -107,9 +127,12 @@ class Network {
 
 /// Trains on the windows of `fit` and stops early on those of `validation`; with no validation
 /// sequences the last fifth of each fitting group's windows validates (and is not trained on).
+/// With a skip the network learns the outputs minus the skip's prediction (standardised on the
+/// fitting rows); the skip is part of the model, in memory and in the TorchScript file.
 /// Throws core::DataError on inconsistent sizes, non-finite values or too few windows.
 Network trained_network(const Sequences& fit, const Sequences& validation,
-                        const NetworkOptions& options);
+                        const NetworkOptions& options,
+                        const std::optional<LinearSkip>& skip = std::nullopt);
 
 /// Loads a file written by save_torchscript with torch::jit::load and runs it on windows (each
 /// window_steps x #inputs): #windows x #outputs. What another program does with the file.

@@ -207,3 +207,48 @@ TEST(NetworkOptions, BadSettingsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("weight_decay"), std::string::npos) << e.what();
   }
 }
+
+TEST(NetworkWithLinearSkip, LearnsWhatTheLinearModelLeavesAndRoundTrips) {
+  // A lagged truth: a static ridge skip misses the lag, the network's windows carry it.
+  const auto groups = campaign(6, 91, lagged_truth, 0.1 * um, 4);
+  const auto fit = group_subset(groups, {0, 1, 2, 3});
+  const auto held_out = group_subset(groups, {4, 5});
+  ModelSpec spec = small_network();
+  spec.network.linear_skip = true;
+  spec.ridge_lambda = 1e-3;
+  ModelSpec ridge;
+  ridge.kind = ModelKind::ridge;
+  ridge.ridge_lambda = 1e-3;
+  ridge.reject_gross_errors = false;
+  const double linear_sm = model_accuracy(fitted_model(ridge, fit, {0, 1, 2, 3}, 0), held_out).sm;
+  const FittedModel a = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const FittedModel b = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  const auto& net = std::get<tt::torchnet::Network>(a.body);
+  ASSERT_TRUE(net.linear_skip().has_value());
+  EXPECT_EQ(net.linear_skip()->weights.cols(), 4);
+  EXPECT_EQ(net.flat_weights(), std::get<tt::torchnet::Network>(b.body).flat_weights());
+  EXPECT_EQ(predicted_error(a, groups[5]), predicted_error(b, groups[5]));
+  const double network_sm = model_accuracy(a, held_out).sm;
+  EXPECT_LT(network_sm, 0.5 * constant_sm(held_out));
+  EXPECT_LT(network_sm, linear_sm)
+      << "network " << network_sm / um << " um, its ridge alone " << linear_sm / um
+      << " um, best epoch " << net.report().best_epoch;
+  EXPECT_NE(model_label(spec).find("linear_skip"), std::string::npos) << model_label(spec);
+  // With lagged features the skip is a distributed-lag model and the windows read the lags too.
+  spec.time_constants = {2400.0};
+  const FittedModel lagged = fitted_model(spec, fit, {0, 1, 2, 3}, 0);
+  EXPECT_EQ(std::get<tt::torchnet::Network>(lagged.body).linear_skip()->weights.cols(), 8);
+  // The skip is inside the TorchScript file.
+  const auto file = std::filesystem::path(TT_BINARY_DIR) / "test_network_skip.pt";
+  net.save_torchscript(file);
+  const Eigen::MatrixXd x = feature_matrix(a.features, groups[5]);
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < x.rows(); i += 11) rows.push_back(i);
+  const Eigen::MatrixXd loaded = tt::torchnet::torchscript_prediction(
+      file,
+      tt::torchnet::windows_at(x, net.options().window_steps, net.options().window_stride, rows));
+  const Eigen::VectorXd in_memory = predicted_error(a, groups[5]);
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    EXPECT_NEAR(loaded(static_cast<Eigen::Index>(k), 0), in_memory(rows[k]), 1e-4 * um);
+  std::filesystem::remove(file);
+}
