@@ -464,7 +464,9 @@ std::vector<Vector2d> faceted_circle(const Vector2d& centre, double r, int n) {
 }
 
 bool body_contains(const Body& body, const Vector3d& p, int circle_segments) {
-  return body_contains_tol(body, p, circle_segments, 1e-9, -1.0);
+  // On the body's surface counts as inside; so does the surface of a void it subtracts: only a
+  // point strictly inside the void (by more than 1 nm) is outside the body.
+  return body_contains_tol(body, p, circle_segments, 1e-9, -1e-9);
 }
 
 double exact_body_volume(const Body& body) {

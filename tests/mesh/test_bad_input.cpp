@@ -72,6 +72,20 @@ TEST(BadInput, NamedPointOutsideEveryBodyIsAGeometryError) {
   expect_has(msg, "outside every body");
 }
 
+TEST(BadInput, NamedPointInsideASubtractedVoidIsOutsideEveryBody) {
+  TempDir dir;
+  const std::string hollow =
+      "[[bodies]]\nname = \"block\"\nmaterial = \"steel\"\nmax_edge = 0.05\n"
+      "add = [ { box = { min = [0.0, 0.0, 0.0], max = [0.1, 0.1, 0.1] } } ]\n"
+      "subtract = [ { box = { min = [0.03, 0.03, 0.03], max = [0.07, 0.07, 0.07] } } ]\n";
+  const auto spec = io::read_case(dir.write(
+      "void.toml", small_case(hollow, "  { id = \"hole\", position = [0.05, 0.05, 0.05] },")));
+  const std::string msg = error_of<core::GeometryError>([&] { mesh_case(spec); });
+  expect_has(msg, "void.toml");
+  expect_has(msg, "'hole'");
+  expect_has(msg, "outside every body");
+}
+
 TEST(BadInput, NamedPointOffTheFaceItNamesIsAGeometryError) {
   TempDir dir;
   // Inside the block, 1 mm below the top face it claims to be on.
