@@ -500,19 +500,13 @@ struct ReducedStepper::Impl {
   const core::CaseSpec& spec;
   ThermalTimings timings;
   StepOperators<Dense> ops;
-  std::vector<double> grid;
   std::map<std::tuple<double, double, double>, Dense> transitions;
-  Impl(const ReducedThermalSystem& s, const core::CaseSpec& c)
-      : sys(s), spec(c), ops(s, timings), grid(time_grid(c, c.thermal.step)) {}
+  Impl(const ReducedThermalSystem& s, const core::CaseSpec& c) : sys(s), spec(c), ops(s, timings) {}
 };
 
 ReducedStepper::ReducedStepper(const ReducedThermalSystem& system, const core::CaseSpec& spec)
     : impl_(std::make_unique<Impl>(system, spec)) {}
 ReducedStepper::~ReducedStepper() = default;
-
-const std::vector<double>& ReducedStepper::grid() const {
-  return impl_->grid;
-}
 
 AffineStep ReducedStepper::step(double t0, double t1, double prev_speed,
                                 const Eigen::VectorXd& state) {

@@ -129,8 +129,6 @@ class ReducedStepper {
   /// first, which restarts Crank–Nicolson as a speed change does). The pointers stay valid as
   /// long as the stepper. Throws SolverError when t1 <= t0 or the factorisation fails.
   AffineStep step(double t0, double t1, double prev_speed, const Eigen::VectorXd& state);
-  /// The case's step ends, as step_thermal walks them [s].
-  const std::vector<double>& grid() const;
 
  private:
   struct Impl;
