@@ -11,7 +11,8 @@
 //                                  what the model lacks on measured runs, before and after;
 //                                  without --case, from the data alone
 //   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
-//   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file)
+//   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file); with
+//                                  --rom DIR instead, through the physics observer
 //   export --model FIT.json --out DIR
 //                                  the compensation in SINUMERIK, TwinCAT, Heidenhain, LinuxCNC
 //                                  form
