@@ -78,9 +78,27 @@ struct ReduceArgs {
   bool quiet = false;
 };
 
-/// compensate --model FIT.json: live compensation (app/compensate_command.cpp).
+/// The physics observer's sensors, noise and consistency test (observe, compensate --rom;
+/// docs/observer.md); app/observer_options.cpp turns them into a solvers::ObserverSetup.
+struct ObserverOptions {
+  std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
+  /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
+  std::vector<double> sensor_sigma_k{0.05};
+  double heat_walk_w = 4.0;            /// random walk of each unknown heat input [W/sqrt(h)]
+  double air_walk_k = 0.5;             /// random walk of the air offset [K/sqrt(h)]
+  double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]
+  /// factor on the reported drift sigma: one value for every target or one per target; empty: 1
+  std::vector<double> drift_sigma_scale;
+  double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
+};
+
+/// compensate --model FIT.json | --rom DIR: live compensation (app/compensate_command.cpp).
 struct CompensateArgs {
   std::filesystem::path model;
+  std::filesystem::path rom;        /// a reduced model: the physics observer instead of a fit
+  std::filesystem::path case_file;  /// with rom: the case it was built from (default: its record)
+  ObserverOptions observer;         /// with rom
+  std::optional<double> initial_temperature_c;  /// with rom: the machine's at t = 0 (the case's)
   std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input
   std::filesystem::path out;  /// empty: standard output
   bool until_eof = false;     /// with in: stop at its end instead of following it
@@ -93,13 +111,7 @@ struct CompensateArgs {
 /// (app/observe_command.cpp, docs/observer.md).
 struct ObserveArgs {
   std::filesystem::path case_file, rom, data, out;
-  std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
-  /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
-  std::vector<double> sensor_sigma_k{0.05};
-  double heat_walk_w = 4.0;            /// random walk of each unknown heat input [W/sqrt(h)]
-  double air_walk_k = 0.5;             /// random walk of the air offset [K/sqrt(h)]
-  double drift_relative_sigma = 0.04;  /// the drift rows' own error, relative to the drift [-]
-  double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
+  ObserverOptions observer;
   bool quiet = false;
 };
 

@@ -1,31 +1,43 @@
-// thermotwin compensate: live compensation from a fitted model. Reads sensor samples as they
-// arrive and writes, per sample, the predicted thermal drift of every target with its uncertainty
-// and a status.
-//   thermotwin compensate --model FIT.json [--in FILE [--until-eof | --idle-s S]] [--out FILE]
-//                         [--flush] [--poll-ms MS]
+// thermotwin compensate: live compensation from a fitted model, or from a reduced model through
+// the physics observer. Reads sensor samples as they arrive and writes, per sample, the predicted
+// thermal drift of every target with its uncertainty and a status.
+//   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [observer options])
+//                         [--in FILE [--until-eof | --idle-s S]] [--out FILE] [--flush]
+//                         [--poll-ms MS]
 // Input: CSV lines in the measured-data format (docs/measured-data.md): a header time_s,<ids...>,
 // then one sample per line; on standard input (to its end) or from FILE, followed as it grows.
 // Output (stdout or FILE): time_s, <target>_predicted_um, <target>_sigma_um per target, status.
 // See docs/compensate.md for the statuses, the stop conditions and what is not covered.
-// 1. The chosen model of each target from fit.json (io::read_deployed_models).
-// 2. The stream's header bound to the models' sensors and inputs by name (fitting::Compensator):
-//    a column a model reads that the header lacks refuses the stream, naming it.
-// 3. Sample by sample: parse, step the models, write one line; output is buffered and flushed when
+// 1. The model: the chosen model of each target from fit.json (io::read_deployed_models), or the
+//    reduced model checked against its case and mesh (as observe does).
+// 2. The stream's header bound to the model by name (fitting::Compensator, or
+//    solvers::LiveObserver on the sensors and speed_rpm): a column the model reads that the header
+//    lacks refuses the stream, naming it.
+// 3. Sample by sample: parse, step the model, write one line; output is buffered and flushed when
 //    the input pauses, per line with --flush or on a terminal.
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 
 #include "app/commands.hpp"
+#include "app/observer_options.hpp"
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "fitting/compensation.hpp"
+#include "io/case_reader.hpp"
 #include "io/fit_model_in.hpp"
+#include "io/reduced_model_io.hpp"
 #include "io/sample_stream.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/observer_live.hpp"
 
 namespace tt::app {
 namespace {
@@ -76,11 +88,16 @@ struct Fd {
   }
 };
 
-}  // namespace
+/// A model bound to a stream's columns: its targets, and its answer to each sample.
+struct BoundModel {
+  std::vector<std::string> targets;
+  std::function<const core::LiveStep&(double, const Eigen::VectorXd&)> next;
+};
 
-int compensate_command(const CompensateArgs& args) {
-  // 1. The models.
-  const std::vector<io::DeployedModel> deployed = io::read_deployed_models(args.model);
+/// fit.json's chosen models, bound to the stream's columns when its header arrives.
+std::function<BoundModel(const std::vector<std::string>&)> fitted_model(
+    const std::filesystem::path& path) {
+  const std::vector<io::DeployedModel> deployed = io::read_deployed_models(path);
   std::vector<fitting::FittedModel> models;
   std::vector<std::string> targets;
   Eigen::VectorXd sigma(static_cast<Eigen::Index>(deployed.size()));
@@ -89,6 +106,67 @@ int compensate_command(const CompensateArgs& args) {
     targets.push_back(deployed[t].model.target_name);
     sigma(static_cast<Eigen::Index>(t)) = deployed[t].uncertainty;
   }
+  return [models, targets, sigma](const std::vector<std::string>& columns) {
+    auto compensator = std::make_shared<fitting::Compensator>(models, columns, sigma);
+    return BoundModel{
+        targets,
+        [compensator](double t,
+                      const Eigen::VectorXd& v) -> const auto& {return compensator->next(t, v);
+  }
+};
+};
+}
+
+/// The reduced model and its case, checked against each other; the observer bound to the stream's
+/// columns (its sensors: --sensors, or every column the model names) when its header arrives.
+std::function<BoundModel(const std::vector<std::string>&)> observed_model(
+    const CompensateArgs& args) {
+  auto rom = std::make_shared<io::ReducedModelFile>(io::read_reduced_model(args.rom));
+  const std::filesystem::path case_file =
+      args.case_file.empty() ? std::filesystem::path(rom->case_file) : args.case_file;
+  if (!std::filesystem::exists(case_file))
+    throw core::DataError((args.rom / "reduced_model.json").string() +
+                          ": the case it was built from, " + case_file.string() +
+                          ", is not there; give it with --case");
+  auto spec = std::make_shared<core::CaseSpec>(io::read_case(case_file));
+  io::check_reduced_model_fits(*rom, io::reduced_model_key(*spec, mesh::mesh_case(*spec)),
+                               args.rom);
+  if (args.initial_temperature_c) spec->thermal.initial_temperature_c = *args.initial_temperature_c;
+  const ObserverOptions options = args.observer;
+  return [rom, spec, options](const std::vector<std::string>& columns) {
+    std::vector<std::string> sensors = options.sensors;
+    if (sensors.empty()) {
+      const auto& names = rom->twin.outputs.names;
+      const auto first = names.begin(), last = first + rom->twin.outputs.temperatures;
+      for (const auto& c : columns)
+        if (std::find(first, last, c) != last) sensors.push_back(c);
+      if (sensors.empty())
+        throw core::DataError(
+            "no column is a named point of the reduced model; name the "
+            "sensors with --sensors");
+    }
+    const solvers::ObserverSetup setup = observer_setup(options, rom->twin, *spec, sensors);
+    auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
+                                                            sensors, columns, "speed_rpm");
+    // The stream's temperatures are in degC (the measured-data format), the observer's in K. The
+    // observer refers to the system and the case: they live as long as it.
+    auto kelvin = std::make_shared<Eigen::VectorXd>();
+    return BoundModel{setup.target_names,
+                      [ observer, rom, spec,
+                        kelvin ](double t, const Eigen::VectorXd& v) -> const auto& {*kelvin = v;
+    for (int c : observer->sensor_columns()) (*kelvin)(c) += core::kCelsiusOffset;
+    return observer->next(t, *kelvin);
+  }
+};
+}
+;
+}
+
+}  // namespace
+
+int compensate_command(const CompensateArgs& args) {
+  // 1. The model.
+  const auto bind = args.rom.empty() ? fitted_model(args.model) : observed_model(args);
 
   // 2. The stream and its header.
   Fd in, out;
@@ -109,9 +187,9 @@ int compensate_command(const CompensateArgs& args) {
   if (!reader.next(line, {}))
     throw core::DataError(in_name + ": no header line; expected time_s and the sensor ids");
   const std::vector<std::string> columns = io::stream_columns(line, in_name);
-  std::optional<fitting::Compensator> compensator;
+  BoundModel model;
   try {
-    compensator.emplace(models, columns);
+    model = bind(columns);
   } catch (const core::DataError& e) {
     throw core::DataError(in_name + ": header refused: " + e.what());
   }
@@ -124,25 +202,29 @@ int compensate_command(const CompensateArgs& args) {
   }
   Output output(out.fd, args.out.empty() ? "standard output" : args.out.string());
   const bool per_line = args.flush || ::isatty(out.fd);
-  output.text = io::output_header(targets);
+  output.text = io::output_header(model.targets);
   output.flush();
 
   // 3. Sample by sample.
   const auto n = static_cast<Eigen::Index>(columns.size());
   Eigen::VectorXd values(n);
-  Eigen::VectorXd last = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(models.size()),
+  Eigen::VectorXd last = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(model.targets.size()),
                                                    std::numeric_limits<double>::quiet_NaN());
+  Eigen::VectorXd last_sigma = last;
   const auto flush_held = [&] { output.flush(); };
   while (reader.next(line, flush_held)) {
     if (line.empty()) continue;
     double time = 0.0;
     if (!io::parsed_sample(line, time, values)) {
       // A torn or foreign line: skipped, the last prediction repeated.
-      io::append_output_line(output.text, time, last, sigma, "malformed");
+      io::append_output_line(output.text, time, last, last_sigma, "malformed");
     } else {
-      const fitting::LiveStep& step = compensator->next(time, values);
-      if (step.status != fitting::SampleStatus::late) last = step.predicted;
-      io::append_output_line(output.text, time, last, sigma, io::status_text(step, columns));
+      const core::LiveStep& step = model.next(time, values);
+      if (step.status != core::SampleStatus::late) {
+        last = step.predicted;
+        last_sigma = step.sigma;
+      }
+      io::append_output_line(output.text, time, last, last_sigma, io::status_text(step, columns));
     }
     if (per_line || output.text.size() >= (std::size_t(1) << 16)) output.flush();
   }

@@ -11,7 +11,8 @@
 //                                  what the model lacks on measured runs, before and after;
 //                                  without --case, from the data alone
 //   probes --in RAW.csv --out DIR  spindle drift and tilt from four non-contact probes
-//   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file)
+//   compensate --model FIT.json    live drift per sensor sample (stdin or a growing file); with
+//                                  --rom DIR instead, through the physics observer
 //   export --model FIT.json --out DIR
 //                                  the compensation in SINUMERIK, TwinCAT, Heidenhain, LinuxCNC
 //                                  form
@@ -30,6 +31,7 @@
 
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
+#include "app/observer_options.hpp"
 #include "app/version.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
@@ -209,11 +211,32 @@ int main(int argc, char** argv) {
 
   CompensateArgs compensate_args;
   auto* compensate = cli.add_subcommand(
-      "compensate", "Live compensation: drift per sample from a fitted model (docs/compensate.md)");
+      "compensate",
+      "Live compensation: drift per sample from a fitted model or, through the physics observer, "
+      "a reduced model (docs/compensate.md)");
+  auto* compensate_model =
+      compensate
+          ->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
+          ->check(CLI::ExistingFile);
+  auto* compensate_rom =
+      compensate
+          ->add_option("--rom", compensate_args.rom,
+                       "a reduced model (thermotwin reduce CASE --out DIR): the physics observer")
+          ->check(CLI::ExistingDirectory)
+          ->excludes(compensate_model);
+  compensate_model->excludes(compensate_rom);
   compensate
-      ->add_option("--model", compensate_args.model, "fit.json of thermotwin fit or fit --data")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->add_option("--case", compensate_args.case_file,
+                   "with --rom: the case it was built from (default: the one it records)")
+      ->check(CLI::ExistingFile)
+      ->needs(compensate_rom);
+  compensate
+      ->add_option("--initial-temperature-c", compensate_args.initial_temperature_c,
+                   "with --rom: the machine's uniform temperature at t = 0 [degC] (default: the "
+                   "case's)")
+      ->check(finite_number())
+      ->needs(compensate_rom);
+  add_observer_options(*compensate, compensate_args.observer);
   auto* compensate_in = compensate->add_option(
       "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
   compensate->add_option("--out", compensate_args.out, "output CSV (default: standard output)");
@@ -277,42 +300,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingDirectory);
   observe->add_option("--out", observe_args.out, "output directory")->required();
-  observe
-      ->add_option("--sensors", observe_args.sensors,
-                   "sensor ids to read (default: every sensor of the run the model names)")
-      ->delimiter(',');
-  observe
-      ->add_option("--sensor-sigma-k", observe_args.sensor_sigma_k,
-                   "white noise of a reading [K]: one value for all sensors or one per sensor, "
-                   "comma-separated (default 0.05)")
-      ->delimiter(',')
-      ->check(positive_number());
-  observe
-      ->add_option("--heat-walk-w", observe_args.heat_walk_w,
-                   "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
-      ->check(CLI::NonNegativeNumber);
-  observe
-      ->add_option("--air-walk-k", observe_args.air_walk_k,
-                   "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
-      ->check(CLI::NonNegativeNumber);
-  observe
-      ->add_option("--drift-relative-sigma", observe_args.drift_relative_sigma,
-                   "error of the drift rows (elastic model) relative to the drift (default "
-                   "0.04)")
-      ->check(CLI::NonNegativeNumber);
-  observe
-      ->add_option("--window-s", observe_args.window_s,
-                   "consistency test: window of the summed NIS [s] (default 1800)")
-      ->check(positive_number());
-  observe
-      ->add_option("--sustain-s", observe_args.sustain_s,
-                   "consistency test: how long an exceedance lasts before recalibrate [s] "
-                   "(default 900)")
-      ->check(CLI::NonNegativeNumber);
-  observe
-      ->add_option("--probability", observe_args.probability,
-                   "consistency test: chi-square quantile of the bound (default 0.999)")
-      ->check(CLI::Range(0.5, 0.999999));
+  add_observer_options(*observe, observe_args.observer);
   observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
 
   CLI11_PARSE(cli, argc, argv);
@@ -364,7 +352,13 @@ int main(int argc, char** argv) {
       return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
                                               : calibrate_command_with_case(calibrate_args);
     }
-    if (*compensate) return compensate_command(compensate_args);
+    if (*compensate) {
+      if (compensate_args.model.empty() == compensate_args.rom.empty())
+        throw tt::core::DataError(
+            "compensate: give a fitted model (--model FIT.json) or a reduced "
+            "model (--rom DIR), one of the two");
+      return compensate_command(compensate_args);
+    }
     if (*exporter) return export_command(export_args);
     if (*observe) return observe_command(observe_args);
     if (*probes) {

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "app/observer_options.hpp"
 #include "calibration/model.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_dir.hpp"
@@ -32,7 +33,7 @@ namespace {
 /// The run's columns of `sensors` (ids), or every sensor of the run that the model names.
 std::vector<std::string> observed_sensors(const ObserveArgs& args, const io::MeasuredRun& run,
                                           const solvers::TwinOutputs& out) {
-  if (!args.sensors.empty()) return args.sensors;
+  if (!args.observer.sensors.empty()) return args.observer.sensors;
   std::vector<std::string> ids;
   const auto first = out.names.begin(), last = first + out.temperatures;
   for (const auto& s : run.sensors)
@@ -57,19 +58,6 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
   return y;
 }
 
-/// One sigma per sensor from --sensor-sigma-k: one value for all, or one each [K].
-Eigen::VectorXd sensor_sigmas(const std::vector<double>& values,
-                              const std::vector<std::string>& sensors) {
-  const auto n = static_cast<Eigen::Index>(sensors.size());
-  if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
-  if (values.size() == sensors.size()) return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
-  std::string ids;
-  for (const auto& s : sensors) ids += (ids.empty() ? "" : ",") + s;
-  throw core::DataError("--sensor-sigma-k: " + std::to_string(values.size()) + " values for " +
-                        std::to_string(sensors.size()) + " sensors (" + ids +
-                        "); expected one value for all or one per sensor in that order");
-}
-
 }  // namespace
 
 int observe_command(const ObserveArgs& args) {
@@ -87,15 +75,7 @@ int observe_command(const ObserveArgs& args) {
   io::check_reduced_model_fits(rom, io::reduced_model_key(declared, mesh), args.rom);
   // 3. The set-up.
   const std::vector<std::string> sensors = observed_sensors(args, run, rom.twin.outputs);
-  solvers::ObserverNoise noise;
-  noise.sensor_sigma_k = sensor_sigmas(args.sensor_sigma_k, sensors);
-  noise.heat_walk_w = args.heat_walk_w;
-  noise.air_walk_k = args.air_walk_k;
-  noise.drift_relative_sigma = args.drift_relative_sigma;
-  solvers::ObserverSetup setup = solvers::twin_observer_setup(rom.twin, spec, sensors, noise);
-  setup.consistency.window_s = args.window_s;
-  setup.consistency.sustain_s = args.sustain_s;
-  setup.consistency.probability = args.probability;
+  const solvers::ObserverSetup setup = observer_setup(args.observer, rom.twin, spec, sensors);
   // 4. The run.
   const solvers::ObserverRun r =
       solvers::observe(rom.twin.model.system, spec, setup, run.time, readings_of(run, sensors));
@@ -132,19 +112,15 @@ int observe_command(const ObserveArgs& args) {
       {"model",
        {{"kind", "reduced"}, {"order", rom.twin.model.states()}, {"rom", args.rom.string()}}},
       {"sensors", sensors},
-      {"noise",
-       {{"sensor_sigma_K",
-         std::vector<double>(noise.sensor_sigma_k.data(),
-                             noise.sensor_sigma_k.data() + noise.sensor_sigma_k.size())},
-        {"heat_walk_W_per_sqrt_h", args.heat_walk_w},
-        {"air_walk_K_per_sqrt_h", args.air_walk_k},
-        {"drift_relative_sigma", args.drift_relative_sigma}}},
+      {"noise", observer_noise_json(setup)},
       {"consistency",
-       {{"window_s", args.window_s},
-        {"sustain_s", args.sustain_s},
-        {"probability", args.probability}}},
+       {{"window_s", setup.consistency.window_s},
+        {"sustain_s", setup.consistency.sustain_s},
+        {"probability", setup.consistency.probability}}},
       {"status", r.recalibrate ? "recalibrate" : "ok"},
-      {"unknown_inputs", unknown}};
+      {"unknown_inputs", unknown},
+      {"recalibrate_since_s", nullptr},
+      {"recalibrate_raised_s", nullptr}};
   if (r.recalibrate) {
     doc["recalibrate_since_s"] = r.recalibrate_since_s;
     doc["recalibrate_raised_s"] = r.recalibrate_at_s;

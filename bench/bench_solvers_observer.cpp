@@ -20,11 +20,15 @@
 //    fitting groups, together. The regression: model type and settings chosen on validation among
 //    fitting::default_model_candidates (as `fit` does), refitted; its sigma is the RMS residual
 //    on the groups it was fitted on.
-// 4. The observer on each test run (the run's declared inputs), and the regression, against the
-//    true (noiseless) drift.
+// 4. The observer's reported sigma calibrated on the training runs (fitting + validation, never
+//    the test runs): solvers::drift_sigma_calibration, the factor per target that makes the mean
+//    normalised squared error against their true drift 1. The observer on each test run (the
+//    run's declared inputs), and the regression, against the true (noiseless) drift; coverage
+//    with the reported sigma and with the calibrated one.
 // 5. The calibration generator's runs (its own finer mesh and step, its sensor noise): CLEAN_RUNS
 //    with no effect and one per effect kind, random duty cycles of GEN_HOURS; the observer is
-//    given the declared case and the run's duty cycle only.
+//    given the declared case and the run's duty cycle only. The effect runs' coverage also with
+//    the sigma calibrated on the generator's clean runs (the machine's own runs before it changed).
 // Prints one line per run and the totals.
 #include <chrono>
 #include <cmath>
@@ -57,23 +61,27 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// Per target (dy, dz): sum of squared errors, samples, samples inside ±2σ.
+/// Per target (dy, dz): sum of squared errors, samples, samples inside ±2σ, and inside ±2σ with
+/// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs).
 struct Score {
-  Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero();
+  Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero(),
+                  inside_calibrated = Eigen::Vector2d::Zero();
   double n = 0;
   void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
-           const Eigen::MatrixXd& truth) {
+           const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones()) {
     for (Eigen::Index i = 1; i < truth.rows(); ++i) {  // t = 0 is the reference, not a prediction
       for (int d = 0; d < 2; ++d) {
         const double e = predicted(i, d) - truth(i, d);
         ss(d) += e * e;
         inside(d) += std::abs(e) <= 2 * sigma(i, d);
+        inside_calibrated(d) += std::abs(e) <= 2 * scale(d) * sigma(i, d);
       }
       n += 1;
     }
   }
   Eigen::Vector2d rms_um() const { return (ss / n).cwiseSqrt() * 1e6; }
   Eigen::Vector2d coverage() const { return inside / n; }
+  Eigen::Vector2d coverage_calibrated() const { return inside_calibrated / n; }
 };
 
 /// Alarms over a set of runs.
@@ -151,6 +159,14 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> regression_on(const Regression& reg,
     s.col(d).setConstant(reg.sigma(d));
   }
   return {p, s};
+}
+
+/// The (dy, dz) truth as the observer's targets: #samples x #targets, NaN but in dy and dz.
+Eigen::MatrixXd as_targets(const Eigen::MatrixXd& dy_dz, Eigen::Index targets) {
+  Eigen::MatrixXd t =
+      Eigen::MatrixXd::Constant(dy_dz.rows(), targets, std::numeric_limits<double>::quiet_NaN());
+  t.middleCols(1, 2) = dy_dz;
+  return t;
 }
 
 /// Observer's (dy, dz) drift and sigma.
@@ -294,22 +310,48 @@ int main(int argc, char** argv) {
                 << "validation, with the probes' 0.3 um noise)\n";
     }
 
-    // 4. Observer and regression on the held-out runs.
+    // 4. Observer and regression on the held-out runs, the observer's sigma calibrated on the
+    //    training runs (fitting + validation: the runs the regression saw) against their true
+    //    drift: the scale that makes the mean normalised squared error 1 there.
     campaign_noise.sensor_sigma_k = Eigen::VectorXd::Constant(
         static_cast<Eigen::Index>(sensors.size()), fitting::SensorNoise{}.temperature_sigma);
+    const auto t_cal = Clock::now();
+    std::vector<solvers::ObserverRun> training;
+    std::vector<Eigen::MatrixXd> training_truth;
+    for (int i : fitted) {
+      const auto& r = runs[static_cast<std::size_t>(i)];
+      const auto& g = noisy_s[static_cast<std::size_t>(i)];
+      training.push_back(
+          solvers::observe(twin.model.system, r.spec,
+                           solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise),
+                           g.time, g.temperature));
+      training_truth.push_back(
+          as_targets(clean[static_cast<std::size_t>(i)].error, training.back().drift.cols()));
+    }
+    const Eigen::VectorXd training_nees =
+        solvers::mean_normalised_squared_error(training, training_truth);
+    const Eigen::VectorXd campaign_scale =
+        solvers::drift_sigma_calibration(training, training_truth);
+    const Eigen::Vector2d scale = campaign_scale.segment(1, 2);
+    std::cout << "calibration on the " << fitted.size()
+              << " training runs: mean normalised squared error dy " << fmt(training_nees(1))
+              << ", dz " << fmt(training_nees(2)) << " -> sigma scale dy " << fmt(scale(0))
+              << ", dz " << fmt(scale(1)) << " (" << fmt(seconds_since(t_cal)) << " s)\n";
     Method held;
     Alarms clean_alarms, effect_alarms;
     double observer_s = 0, observed_h = 0;
     std::cout
         << "\nrun | kind | observer RMS dy, dz [um] | regression RMS dy, dz [um] | "
-           "observer 2σ coverage dy, dz | regression coverage dy, dz | alarm at [s] (since)\n";
+           "observer 2σ coverage dy, dz | calibrated | regression coverage dy, dz | alarm at [s] "
+           "(since)\n";
     const auto line = [&](const std::string& name, const std::string& kind, const Score& o,
                           const Score& r, const solvers::ObserverRun& run) {
       std::cout << name << " | " << kind << " | " << fmt(o.rms_um()(0)) << ", "
                 << fmt(o.rms_um()(1)) << " | " << fmt(r.rms_um()(0)) << ", " << fmt(r.rms_um()(1))
                 << " | " << fmt(100 * o.coverage()(0)) << " %, " << fmt(100 * o.coverage()(1))
-                << " % | " << fmt(100 * r.coverage()(0)) << " %, " << fmt(100 * r.coverage()(1))
-                << " % | "
+                << " % | " << fmt(100 * o.coverage_calibrated()(0)) << " %, "
+                << fmt(100 * o.coverage_calibrated()(1)) << " % | " << fmt(100 * r.coverage()(0))
+                << " %, " << fmt(100 * r.coverage()(1)) << " % | "
                 << (run.recalibrate ? fmt(run.recalibrate_at_s, 5) + " (" +
                                           fmt(run.recalibrate_since_s, 5) + ")"
                                     : std::string("none"))
@@ -328,10 +370,10 @@ int main(int argc, char** argv) {
       observed_h += r.spec.duty_cycle.end / 3600;
       Score o, rr;
       const auto [po, so] = dy_dz(run);
-      o.add(po, so, truth);
+      o.add(po, so, truth, scale);
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
-      held.observer.add(po, so, truth);
+      held.observer.add(po, so, truth, scale);
       held.regression.add(pr, sr, truth);
       add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
       line(r.name, "campaign, held out", o, rr, run);
@@ -339,6 +381,12 @@ int main(int argc, char** argv) {
 
     // 5. The generator's runs (GEN_HOURS = 0: none).
     Method gclean, geffect;
+    // The generator's effect runs also with the sigma calibrated on its clean runs (the machine's
+    // own runs before it changed), beside the campaign's calibration.
+    Score geffect_own;
+    std::vector<solvers::ObserverRun> gen_training;
+    std::vector<Eigen::MatrixXd> gen_training_truth;
+    Eigen::Vector2d own_scale = Eigen::Vector2d::Ones();
     std::size_t effect_runs = 0;
     if (gen_hours > 0) {
       const auto t_gen = Clock::now();
@@ -385,11 +433,27 @@ int main(int argc, char** argv) {
         g.target_names = {"dy", "dz"};
         Score o, rr;
         const auto [po, so] = dy_dz(run);
-        o.add(po, so, true_drift);
+        if (effect.present && !gen_training.empty() && own_scale == Eigen::Vector2d::Ones()) {
+          const Eigen::VectorXd nees =
+              solvers::mean_normalised_squared_error(gen_training, gen_training_truth);
+          own_scale =
+              solvers::drift_sigma_calibration(gen_training, gen_training_truth).segment(1, 2);
+          std::cout << "calibration on the generator's " << gen_training.size()
+                    << " clean runs: mean normalised squared error dy " << fmt(nees(1)) << ", dz "
+                    << fmt(nees(2)) << " -> sigma scale dy " << fmt(own_scale(0)) << ", dz "
+                    << fmt(own_scale(1)) << "\n";
+        }
+        if (!effect.present) {
+          gen_training.push_back(run);
+          gen_training_truth.push_back(as_targets(true_drift, run.drift.cols()));
+        } else {
+          geffect_own.add(po, so, true_drift, own_scale);
+        }
+        o.add(po, so, true_drift, scale);
         const auto [pr, sr] = regression_on(reg, g);
         rr.add(pr, sr, true_drift);
         Method& m = effect.present ? geffect : gclean;
-        m.observer.add(po, so, true_drift);
+        m.observer.add(po, so, true_drift, scale);
         m.regression.add(pr, sr, true_drift);
         add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
         std::string what = kind;
@@ -406,7 +470,9 @@ int main(int argc, char** argv) {
       std::cout << what << ": observer RMS dy " << fmt(m.observer.rms_um()(0)) << " um, dz "
                 << fmt(m.observer.rms_um()(1)) << " um, coverage "
                 << fmt(100 * m.observer.coverage()(0)) << " %, "
-                << fmt(100 * m.observer.coverage()(1)) << " %; regression RMS dy "
+                << fmt(100 * m.observer.coverage()(1)) << " %, calibrated on the campaign "
+                << fmt(100 * m.observer.coverage_calibrated()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %; regression RMS dy "
                 << fmt(m.regression.rms_um()(0)) << " um, dz " << fmt(m.regression.rms_um()(1))
                 << " um, coverage " << fmt(100 * m.regression.coverage()(0)) << " %, "
                 << fmt(100 * m.regression.coverage()(1)) << " %\n";
@@ -414,6 +480,12 @@ int main(int argc, char** argv) {
     total("campaign held-out runs", held);
     total("generator clean runs", gclean);
     total("generator effect runs", geffect);
+    if (geffect_own.n > 0)
+      std::cout
+          << "generator effect runs, observer sigma calibrated on the generator's clean runs: "
+             "coverage "
+          << fmt(100 * geffect_own.coverage_calibrated()(0)) << " %, "
+          << fmt(100 * geffect_own.coverage_calibrated()(1)) << " %\n";
     std::cout << "alarms on clean runs: " << clean_alarms.raised << " in " << clean_alarms.hours
               << " h (" << fmt(clean_alarms.raised / clean_alarms.hours) << " per hour)\n";
     std::cout << "alarms on effect runs: " << effect_alarms.raised << " of " << effect_runs

@@ -6,6 +6,10 @@
 #   bench/compensate_throughput.sh [LINES] [OUT_DIR]
 # Prints lines/s for a file read to its end (--in FILE --until-eof), for a pipe on standard input,
 # and for a pipe with --flush (a write per line), each the best of three.
+# Then the physics observer (compensate --rom): ROM_LINES (default 20000) samples at 1 kHz of the
+# five sensors T17, T18, T16, T53, T54 and the speed through the reduced model of
+# cases/sb1_coarse.toml (built with reduce --quick-validation into OUT_DIR/rom unless there),
+# read from a file to its end, best of three; ROM_LINES=0 skips it.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${THERMOTWIN:-$here/build/thermotwin}
@@ -63,3 +67,22 @@ done
 cmp -s "$out/live.csv" "$out/live_pipe.csv" && cmp -s "$out/live.csv" "$out/live_flush.csv" ||
   { echo "outputs differ between the modes" >&2; exit 1; }
 echo "statuses: $(cut -d, -f6 "$out/live.csv" | sort | uniq -c | tr '\n' ' ')"
+rom_lines=${ROM_LINES:-20000}
+[ "$rom_lines" -gt 0 ] || exit 0
+if [ ! -f "$out/rom/reduced_model.json" ]; then
+  "$bin" reduce "$here/cases/sb1_coarse.toml" --out "$out/rom" --quick-validation --quiet
+fi
+awk -v n="$rom_lines" 'BEGIN {
+  print "time_s,speed_rpm,T17,T18,T16,T53,T54";
+  for (i = 0; i < n; i++) {
+    t = i * 0.001;
+    printf "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", t, (i % 6000 < 4000) ? 4000 : 0,
+      20 + 0.0001 * i + 0.01 * sin(t), 20 + 0.00005 * i, 20 + 0.00008 * i, 20 + 0.00002 * i,
+      20 + 0.00001 * i
+  }
+}' > "$out/stream_rom.csv"
+rom_run() { "$bin" compensate --rom "$out/rom" --in "$out/stream_rom.csv" --until-eof --out "$out/live_rom.csv"; }
+t=$(best rom_run)
+printf '%-5s %d lines in %.3f s: %.0f lines/s\n' "rom" "$rom_lines" "$t" \
+  "$(/usr/bin/python3 -c "print($rom_lines / $t)")"
+echo "statuses (rom): $(awk -F, 'NR > 1 { print $NF }' "$out/live_rom.csv" | sort | uniq -c | tr '\n' ' ')"

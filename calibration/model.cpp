@@ -200,22 +200,11 @@ core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRu
   const Eigen::Index col = it - run.inputs.begin();
   core::CaseSpec spec = declared;
   spec.duty_cycle.segments.clear();
-  double last = std::nan("");
-  for (Eigen::Index i = 0; i < run.time.size(); ++i) {
-    double v = run.input_values(i, col);
-    if (!std::isfinite(v)) continue;  // a missing speed keeps the previous one
-    v = std::max(v, 0.0);
-    if (spec.duty_cycle.segments.empty()) {
-      spec.duty_cycle.segments.push_back({0.0, v});
-      last = v;
-    } else if (v != last) {
-      spec.duty_cycle.segments.push_back({run.time(i), v});
-      last = v;
-    }
-  }
+  // Sample by sample, as a live stream is read (solvers::LiveObserver).
+  for (Eigen::Index i = 0; i < run.time.size(); ++i)
+    solvers::extend_duty_cycle(spec.duty_cycle, run.time(i), run.input_values(i, col));
   if (spec.duty_cycle.segments.empty())
     throw core::DataError("measured run '" + run.run + "': the speed_rpm column has no reading");
-  spec.duty_cycle.end = run.time(run.time.size() - 1);
   if (run.initial_temperature_c) spec.thermal.initial_temperature_c = *run.initial_temperature_c;
   spec.thermal.output_interval = spec.thermal.step;
   spec.outputs.fields = false;

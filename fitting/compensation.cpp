@@ -30,13 +30,13 @@ double body_value(const FittedModel& model, const Eigen::VectorXd& x) {
 
 }  // namespace
 
-std::string status_name(SampleStatus status) {
-  return std::string(core::name_in(kSampleStatusNames, status));
-}
-
 Compensator::Compensator(const std::vector<FittedModel>& models,
-                         const std::vector<std::string>& columns) {
+                         const std::vector<std::string>& columns, const Eigen::VectorXd& sigma) {
   if (models.empty()) throw core::DataError("compensator: no model to step");
+  if (sigma.size() != 0 && sigma.size() != static_cast<Eigen::Index>(models.size()))
+    throw core::DataError("compensator: " + std::to_string(sigma.size()) + " sigmas for " +
+                          std::to_string(models.size()) + " models");
+  step_.sigma = sigma;
   for (const FittedModel& model : models) {
     const bool linear = std::holds_alternative<LinearFit>(model.body);
     if (!linear && !std::holds_alternative<PprModel>(model.body))

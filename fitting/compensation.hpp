@@ -7,45 +7,15 @@
 #include <string>
 #include <vector>
 
+#include "core/live_step.hpp"
 #include "fitting/features.hpp"
 #include "fitting/models.hpp"
 
 namespace tt::fitting {
 
-/// What became of one sample.
-enum class SampleStatus {
-  /// every reading the models use was there
-  ok,
-  /// some readings were missing or not finite: their last good values were used (`held`)
-  held,
-  /// its time was not after the last sample used (or not finite): skipped, the last prediction
-  /// repeated
-  late,
-  /// no sample with every reading yet: the increments have no reference, nothing is predicted
-  waiting,
-};
-
-/// The statuses' names in compensate's output.
-inline constexpr std::array<core::Named<SampleStatus>, 4> kSampleStatusNames{{
-    {SampleStatus::ok, "ok"},
-    {SampleStatus::held, "held"},
-    {SampleStatus::late, "late"},
-    {SampleStatus::waiting, "waiting"},
-}};
-static_assert(core::one_to_one(kSampleStatusNames));
-
-/// The status's name in kSampleStatusNames.
-std::string status_name(SampleStatus status);
-
-/// The models' answer to one sample.
-struct LiveStep {
-  SampleStatus status = SampleStatus::waiting;
-  /// #models predicted errors [m]; NaN while waiting
-  Eigen::VectorXd predicted;
-  /// columns (indices into the stream's columns) held at their last good reading, or still
-  /// missing while waiting
-  std::vector<int> held;
-};
+using core::LiveStep;
+using core::SampleStatus;
+using core::status_name;
 
 /// Fitted models bound by name to the columns of a stream and stepped sample by sample.
 class Compensator {
@@ -53,8 +23,10 @@ class Compensator {
   /// models: linear kinds (no_compensation, least_squares, ridge, distributed_lag) or
   /// projection_pursuit, their features named (sensor_names, input_names); columns: the names of
   /// a sample's values, sensors and inputs alike. Throws DataError naming the first column a model
-  /// reads that `columns` lacks, or a model kind it cannot step (cnn_bigru_attention).
-  Compensator(const std::vector<FittedModel>& models, const std::vector<std::string>& columns);
+  /// reads that `columns` lacks, or a model kind it cannot step (cnn_bigru_attention). sigma:
+  /// #models standard deviations of the predictions [m], given with every step (empty: none).
+  Compensator(const std::vector<FittedModel>& models, const std::vector<std::string>& columns,
+              const Eigen::VectorXd& sigma = {});
 
   /// The models on the next sample: time [s] and one value per column (temperatures [K] or °C,
   /// speed [rpm]), NaN where a reading is missing.

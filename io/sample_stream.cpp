@@ -167,11 +167,12 @@ std::string output_header(const std::vector<std::string>& targets) {
   return h + ",status\n";
 }
 
-std::string status_text(const fitting::LiveStep& step, const std::vector<std::string>& columns) {
-  std::string s = fitting::status_name(step.status);
+std::string status_text(const core::LiveStep& step, const std::vector<std::string>& columns) {
+  std::string s = core::status_name(step.status);
   for (std::size_t k = 0; k < step.held.size(); ++k)
     s += (k ? ";" : ":") + columns[static_cast<std::size_t>(step.held[k])];
-  return s;
+  if (!step.recalibrate) return s;
+  return step.status == core::SampleStatus::ok ? "recalibrate" : "recalibrate|" + s;
 }
 
 void append_output_line(std::string& out, double time, const Eigen::VectorXd& predicted,

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "fitting/compensation.hpp"
+#include "core/live_step.hpp"
 
 namespace tt::io {
 
@@ -65,8 +65,9 @@ bool parsed_sample(std::string_view line, double& time, Eigen::Ref<Eigen::Vector
 std::string output_header(const std::vector<std::string>& targets);
 
 /// The status field of a step: "ok", "late", "held:T07;T08" or "waiting:T07" (the columns held
-/// or still missing, by name). columns: the stream's columns.
-std::string status_text(const fitting::LiveStep& step, const std::vector<std::string>& columns);
+/// or still missing, by name); once the model says recalibrate, "recalibrate" in place of "ok"
+/// and before any other ("recalibrate|held:T07"). columns: the stream's columns.
+std::string status_text(const core::LiveStep& step, const std::vector<std::string>& columns);
 
 /// Appends one output line: the time, predicted errors and their 1-σ [µm] (empty fields where
 /// predicted is NaN, as while waiting), and the status. predicted, sigma: #targets [m].

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "core/errors.hpp"
@@ -109,6 +110,31 @@ std::vector<double> switch_times(const core::CaseSpec& spec) {
   std::sort(s.begin(), s.end());
   s.erase(std::unique(s.begin(), s.end()), s.end());
   return s;
+}
+
+double next_switch(const core::CaseSpec& spec, double t) {
+  double next = std::numeric_limits<double>::infinity();
+  // Segment starts and table points are ascending: the first after t in each.
+  const auto first_after = [&](const auto& list, auto time_of) {
+    const auto it = std::upper_bound(list.begin(), list.end(), t,
+                                     [&](double v, const auto& e) { return v < time_of(e); });
+    if (it != list.end()) next = std::min(next, time_of(*it));
+  };
+  first_after(spec.duty_cycle.segments, [](const auto& seg) { return seg.start; });
+  first_after(spec.feed_axis.segments, [](const auto& seg) { return seg.start; });
+  for (const auto& c : spec.thermal.convection)
+    if (c.sink.time.size() > 1) first_after(c.sink.time, [](double v) { return v; });
+  return next;
+}
+
+void extend_duty_cycle(core::DutyCycle& cycle, double t, double speed_rpm) {
+  cycle.end = t;
+  if (!std::isfinite(speed_rpm)) return;
+  const double v = std::max(speed_rpm, 0.0);
+  if (cycle.segments.empty())
+    cycle.segments.push_back({0.0, v});
+  else if (v != cycle.segments.back().speed_rpm)
+    cycle.segments.push_back({t, v});
 }
 
 namespace {

@@ -37,6 +37,15 @@ double table_value(const core::TimeTable& table, double t);
 /// the table points of every time-varying sink, inside (0, end).
 std::vector<double> switch_times(const core::CaseSpec& spec);
 
+/// The first time after `t` at which the load can change (as switch_times, whatever the end),
+/// +inf when none: for stepping a duty cycle that is still being read.
+double next_switch(const core::CaseSpec& spec, double t);
+
+/// A speed read at time t [s] [rpm] added to a duty cycle read sample by sample: it holds from t
+/// to the next reading (a new segment where it changes; the first segment at 0 takes the first
+/// reading), a negative speed is 0, a missing (non-finite) one keeps the last; end becomes t.
+void extend_duty_cycle(core::DutyCycle& cycle, double t, double speed_rpm);
+
 /// Step end times t_1 < ... < t_N = end: every switch is a step end; between switches the steps
 /// are equal and no longer than `max_step`. Throws SolverError beyond core::limits::kTimeSteps.
 std::vector<double> time_grid(const core::CaseSpec& spec, double max_step);

@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/units.hpp"
+#include "solvers/loads.hpp"
 
 namespace tt::solvers {
 
@@ -174,6 +175,12 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                    n.drift_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
+  const Eigen::VectorXd& scale = n.drift_sigma_scale;
+  if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
+                            !(scale.array() > 0).all() || !scale.allFinite()))
+    fail("drift sigma scale: " + std::to_string(scale.size()) + " values for " +
+         std::to_string(setup_.target_rows.rows()) +
+         " targets; expected none or one finite factor > 0 per target");
   const auto& conv = spec.thermal.convection;
   for (int c : setup_.air_entries)
     if (c < 0 || c >= static_cast<int>(conv.size()) ||
@@ -236,7 +243,6 @@ void KalmanObserver::step(double t1) {
 }
 
 void KalmanObserver::advance_to(double t) {
-  const auto& grid = stepper_.grid();
   const double end = spec_.duty_cycle.end, eps = 1e-9 * std::max(1.0, end);
   if (t < t_ - eps)
     throw core::SolverError("observer: a reading at t = " + number(t) +
@@ -246,10 +252,13 @@ void KalmanObserver::advance_to(double t) {
     throw core::SolverError("observer: a reading at t = " + number(t) +
                             " s is beyond the duty cycle's end (" + number(end) +
                             " s): the inputs are not known there");
+  // Steps of at most the case's step, equal between the load's switches and the reading, each
+  // from what is known by then: a duty cycle read as the samples come steps as the whole run.
+  const double max_step = spec_.thermal.step;
   while (t_ < t - eps) {
-    while (next_grid_ < grid.size() && grid[next_grid_] <= t_ + eps) ++next_grid_;
-    const double g = next_grid_ < grid.size() ? grid[next_grid_] : end;
-    step(std::min(g, t));
+    const double b = std::min(t, next_switch(spec_, t_ + eps));
+    const double k = std::max(1.0, std::ceil((b - t_) / max_step - 1e-9));
+    step(k > 1 ? t_ + (b - t_) / k : b);
   }
 }
 
@@ -300,6 +309,8 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
                    (rel * e.drift.array()).square())
                       .sqrt()
                       .matrix();
+  if (setup_.noise.drift_sigma_scale.size() != 0)
+    e.drift_sigma.array() *= setup_.noise.drift_sigma_scale.array();
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
   e.recalibrate_since_s = monitor_.since_s();
   return e;
@@ -348,6 +359,54 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
     }
   }
   return run;
+}
+
+Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& runs,
+                                              const std::vector<Eigen::MatrixXd>& truths,
+                                              double truth_sigma_m) {
+  if (runs.size() != truths.size() || runs.empty())
+    throw core::SolverError("observer calibration: " + std::to_string(runs.size()) + " runs and " +
+                            std::to_string(truths.size()) +
+                            " truths; expected as many, at least 1");
+  const Eigen::Index nt = runs.front().drift.cols();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(nt), count = Eigen::VectorXd::Zero(nt);
+  const double truth_var = truth_sigma_m * truth_sigma_m;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const ObserverRun& run = runs[k];
+    const Eigen::MatrixXd& truth = truths[k];
+    if (truth.rows() != run.drift.rows() || truth.cols() != nt || run.drift.cols() != nt)
+      throw core::SolverError(
+          "observer calibration: run " + std::to_string(k) + " has " +
+          std::to_string(run.drift.rows()) + " x " + std::to_string(run.drift.cols()) +
+          " estimates and " + std::to_string(truth.rows()) + " x " + std::to_string(truth.cols()) +
+          " truths; expected " + std::to_string(nt) + " targets each and as many samples");
+    for (Eigen::Index i = 0; i < truth.rows(); ++i)
+      for (Eigen::Index t = 0; t < nt; ++t) {
+        const double sigma = run.drift_sigma(i, t), e = run.drift(i, t) - truth(i, t);
+        if (!(sigma > 0) || !std::isfinite(e)) continue;
+        sum(t) += (e * e - truth_var) / (sigma * sigma);
+        count(t) += 1;
+      }
+  }
+  return (count.array() > 0)
+      .select(sum.array() / count.array(), std::numeric_limits<double>::quiet_NaN())
+      .matrix();
+}
+
+Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
+                                        const std::vector<Eigen::MatrixXd>& truths,
+                                        double truth_sigma_m,
+                                        const Eigen::VectorXd& observed_with) {
+  const Eigen::VectorXd nees = mean_normalised_squared_error(runs, truths, truth_sigma_m);
+  if (observed_with.size() != 0 && observed_with.size() != nees.size())
+    throw core::SolverError("observer calibration: " + std::to_string(observed_with.size()) +
+                            " scales for " + std::to_string(nees.size()) + " targets");
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(nees.size());
+  for (Eigen::Index t = 0; t < nees.size(); ++t) {
+    if (nees(t) > 0) scale(t) = std::sqrt(nees(t));  // NaN and <= 0 (noise only) keep 1
+    if (observed_with.size() != 0) scale(t) *= observed_with(t);
+  }
+  return scale;
 }
 
 Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,

@@ -41,6 +41,10 @@ struct ObserverNoise {
   /// Error of the drift rows themselves (the elastic model's discretisation, its material
   /// values), relative to the predicted drift [-]: added to the drift's variance as (e d)^2.
   double drift_relative_sigma = 0;
+  /// Per target: a factor on the reported standard deviation of the drift, calibrated on runs
+  /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
+  /// alarm) as it is. Empty: 1 for every target.
+  Eigen::VectorXd drift_sigma_scale;
 };
 
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
@@ -120,8 +124,10 @@ struct ObserverEstimate {
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// The filter. Steps the case's grid (the case's duty cycle, feed axis, sinks and fluxes are its
-/// inputs) and assimilates readings as they come.
+/// The filter. Steps the case's loads (its duty cycle, feed axis, sinks and fluxes are its inputs)
+/// in steps of at most the case's step, equal between the load's switches and the readings, and
+/// assimilates readings as they come. It looks no further ahead than the next reading: the duty
+/// cycle may grow as samples arrive (LiveObserver).
 class KalmanObserver {
  public:
   /// `system` and `spec` must outlive the observer. Throws SolverError when the rows do not have r
@@ -129,7 +135,7 @@ class KalmanObserver {
   /// convection entry of `spec`.
   KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                  const ObserverSetup& setup);
-  /// Steps to time t (a time not on the grid cuts a step there) and assimilates `readings`
+  /// Steps to time t (a step ends there) and assimilates `readings`
   /// (#sensors [K], NaN: missing). Throws SolverError for t before the last assimilation or
   /// beyond the duty cycle's end, or readings of another size.
   ObserverEstimate assimilate(double t, const Eigen::VectorXd& readings);
@@ -155,7 +161,6 @@ class KalmanObserver {
   Eigen::VectorXd x_, z0_;
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
-  std::size_t next_grid_ = 0;
   InnovationMonitor monitor_;
 };
 
@@ -179,11 +184,31 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
                     const ObserverSetup& setup, const Eigen::VectorXd& times,
                     const Eigen::MatrixXd& readings);
 
+/// The mean normalised squared error of the reported drift per target over runs whose true drift
+/// is known (training runs): mean over samples of ((estimate - truth)^2 - truth_sigma^2) / sigma^2,
+/// 1 when the reported sigma is right, below 1 when it is too wide. `truths[k]`: #samples x
+/// #targets [m] of runs[k]'s samples, NaN where a target's truth is not known; truth_sigma_m: the
+/// white noise of a measured truth (probes), whose variance is taken out. Samples whose sigma is 0
+/// (t = 0: the start is known) are left out. Throws SolverError when the sizes differ. #targets
+/// (NaN where no sample counted).
+Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& runs,
+                                              const std::vector<Eigen::MatrixXd>& truths,
+                                              double truth_sigma_m = 0);
+
+/// The factor on the reported sigma that makes the runs' mean normalised squared error 1: per
+/// target sqrt(mean_normalised_squared_error) times the scale the runs were observed with
+/// (`observed_with`, empty: 1); 1 where no sample counted or the error is not above the truth's
+/// noise. For ObserverNoise::drift_sigma_scale.
+Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
+                                        const std::vector<Eigen::MatrixXd>& truths,
+                                        double truth_sigma_m = 0,
+                                        const Eigen::VectorXd& observed_with = {});
+
 /// The observer's posterior variance of each target's drift [m^2], averaged over readings every
 /// `sample_s` on each of `runs` (their duty cycles) and over the runs. The Kalman covariance does
 /// not depend on the readings' values, only on which sensors read and their noise, so this is
 /// known before any sensor is placed. setup.noise.drift_relative_sigma, which scales with the
-/// predicted drift, is left out. #targets.
+/// predicted drift, is left out; drift_sigma_scale is kept. #targets.
 Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
                                     const std::vector<core::CaseSpec>& runs,
                                     const ObserverSetup& setup, double sample_s);

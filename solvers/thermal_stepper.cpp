@@ -250,6 +250,12 @@ class StepOperators {
     return *factors_.emplace(key, std::move(f)).first->second;
   }
 
+  /// Forgets every stiffness and factor (references to them end here).
+  void forget() {
+    factors_.clear();
+    stiffness_.clear();
+  }
+
  private:
   const LinearThermalSystem<Matrix>& sys_;
   ThermalTimings& timings_;
@@ -500,19 +506,13 @@ struct ReducedStepper::Impl {
   const core::CaseSpec& spec;
   ThermalTimings timings;
   StepOperators<Dense> ops;
-  std::vector<double> grid;
   std::map<std::tuple<double, double, double>, Dense> transitions;
-  Impl(const ReducedThermalSystem& s, const core::CaseSpec& c)
-      : sys(s), spec(c), ops(s, timings), grid(time_grid(c, c.thermal.step)) {}
+  Impl(const ReducedThermalSystem& s, const core::CaseSpec& c) : sys(s), spec(c), ops(s, timings) {}
 };
 
 ReducedStepper::ReducedStepper(const ReducedThermalSystem& system, const core::CaseSpec& spec)
     : impl_(std::make_unique<Impl>(system, spec)) {}
 ReducedStepper::~ReducedStepper() = default;
-
-const std::vector<double>& ReducedStepper::grid() const {
-  return impl_->grid;
-}
 
 AffineStep ReducedStepper::step(double t0, double t1, double prev_speed,
                                 const Eigen::VectorXd& state) {
@@ -520,6 +520,13 @@ AffineStep ReducedStepper::step(double t0, double t1, double prev_speed,
   if (!(t1 > t0))
     throw core::SolverError("reduced step from t = " + std::to_string(t0) + " s to " +
                             std::to_string(t1) + " s: the end must be after the start");
+  // A stream's steps and speeds need not repeat (jittered times, a measured speed): the kept
+  // operators are bounded, forgotten all at once when there are this many.
+  constexpr std::size_t kKept = 64;
+  if (m.transitions.size() >= kKept) {
+    m.transitions.clear();
+    m.ops.forget();
+  }
   const double dt = t1 - t0;
   const double t0_k = m.spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const StepPlan p = step_plan(m.spec, m.sys, t0, t1, prev_speed, state, t0_k);

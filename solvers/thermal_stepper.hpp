@@ -118,7 +118,9 @@ struct AffineStep {
 };
 
 /// Steps a reduced system one step at a time under `spec`'s loads, with step_thermal's loads,
-/// restarts and factors (one per step size, speed and scheme weight, kept for the next steps).
+/// restarts and factors (one per step size, speed and scheme weight, kept for the next steps; at
+/// most 64, then forgotten all at once, so that a stream's steps that never repeat do not grow
+/// them without bound).
 class ReducedStepper {
  public:
   ReducedStepper(const ReducedThermalSystem& system, const core::CaseSpec& spec);
@@ -126,11 +128,9 @@ class ReducedStepper {
   ReducedStepper(const ReducedStepper&) = delete;
   ReducedStepper& operator=(const ReducedStepper&) = delete;
   /// The step [t0, t1] from `state`; `prev_speed` is the speed of the step before (NaN for the
-  /// first, which restarts Crank–Nicolson as a speed change does). The pointers stay valid as
-  /// long as the stepper. Throws SolverError when t1 <= t0 or the factorisation fails.
+  /// first, which restarts Crank–Nicolson as a speed change does). The pointers stay valid until
+  /// the next step. Throws SolverError when t1 <= t0 or the factorisation fails.
   AffineStep step(double t0, double t1, double prev_speed, const Eigen::VectorXd& state);
-  /// The case's step ends, as step_thermal walks them [s].
-  const std::vector<double>& grid() const;
 
  private:
   struct Impl;

@@ -17,6 +17,7 @@
 #include "core/rng.hpp"
 #include "fitting/features.hpp"
 #include "io/measured_data.hpp"
+#include "tests/common/csv_rows.hpp"
 #include "tests/reliability/process.hpp"
 
 namespace fs = std::filesystem;
@@ -64,27 +65,7 @@ io::MeasuredRun spindle_run(double hours, std::uint64_t stream) {
   return r;
 }
 
-/// Rows of a CSV with a header, as maps from column to text.
-std::vector<std::map<std::string, std::string>> csv_rows(const fs::path& file) {
-  std::istringstream in(read_text(file));
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  std::stringstream h(line);
-  for (std::string c; std::getline(h, c, ',');) header.push_back(c);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    std::map<std::string, std::string> row;
-    std::stringstream s(line);
-    std::string cell;
-    for (std::size_t c = 0; c < header.size(); ++c) {
-      if (!std::getline(s, cell, ',')) cell.clear();
-      row[header[c]] = cell;
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
+using tt::test::csv_rows;
 
 /// A fitted model of a training run, and a held-out run of one speed cycle (one test group,
 /// re-zeroed at the run's start as compensate's increments are).

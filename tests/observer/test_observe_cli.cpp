@@ -2,17 +2,23 @@
 // calibration generator (the case's own mesh and step) with an offset of 0.6 K on one sensor,
 // written in the measured-data format. The observer writes its CSV and JSON, raises
 // `recalibrate` with its start, and refuses a sensor the model does not name, writing nothing.
+// The same run streamed through `compensate --rom` gives the offline observer's predictions, sigmas
+// and alarm sample by sample; a stream without the observer's sensor columns is refused.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <sstream>
 
 #include "calibration/generator.hpp"
 #include "core/rng.hpp"
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
+#include "tests/common/csv_rows.hpp"
 #include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
@@ -68,7 +74,61 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
-  // 3. A sensor the model does not name: refused, naming it; nothing written.
+  // 3. The recorded run streamed through compensate --rom: the offline observer's figures.
+  const io::MeasuredRun measured = io::read_measured_run(data);
+  const fs::path live = dir / "live.csv", live_log = dir / "live.log";
+  std::vector<std::string> live_args{"compensate",
+                                     "--rom",
+                                     rom.string(),
+                                     "--case",
+                                     rt::kCoarseCase.string(),
+                                     "--in",
+                                     (data / "data.csv").string(),
+                                     "--until-eof",
+                                     "--out",
+                                     live.string(),
+                                     "--sensor-sigma-k",
+                                     "0.04"};
+  if (measured.initial_temperature_c) {
+    std::ostringstream t0;
+    t0 << std::setprecision(17) << *measured.initial_temperature_c;
+    live_args.insert(live_args.end(), {"--initial-temperature-c", t0.str()});
+  }
+  ASSERT_EQ(rt::run(live_args, {}, live_log), 0) << rt::read_text(live_log);
+  const auto offline = tt::test::csv_rows(out / "observer.csv");
+  const auto streamed = tt::test::csv_rows(live);
+  ASSERT_EQ(streamed.size(), offline.size());
+  double largest = 0, worst = 0;
+  std::size_t alarms = 0;
+  for (std::size_t i = 0; i < offline.size(); ++i) {
+    for (const char* d : {"dx", "dy", "dz"})
+      for (const char* what : {"_predicted_um", "_sigma_um"}) {
+        const std::string key = std::string(d) + what;
+        const double a = std::stod(offline[i].at(key)), b = std::stod(streamed[i].at(key));
+        largest = std::max(largest, std::abs(a));
+        worst = std::max(worst, std::abs(a - b));
+      }
+    const bool raised = offline[i].at("status") == "recalibrate";
+    EXPECT_EQ(streamed[i].at("status").rfind("recalibrate", 0) == 0, raised) << "sample " << i;
+    alarms += raised;
+  }
+  EXPECT_GT(largest, 0.5);           // microns of drift were compared
+  EXPECT_LE(worst, 1e-7 * largest);  // observer.csv holds 9 digits
+  EXPECT_GT(alarms, 0u);
+  // A stream without one of the observer's sensors is refused, naming the column.
+  const fs::path cut = dir / "cut.csv", cut_log = dir / "cut.log";
+  {
+    std::ofstream f(cut);
+    f << "time_s,speed_rpm,T02\n0,1000,20\n";
+  }
+  EXPECT_NE(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
+                     "--in", cut.string(), "--until-eof", "--sensors", "T02,T08"},
+                    {}, cut_log),
+            0);
+  EXPECT_NE(rt::read_text(cut_log).find("header refused: column 'T08' is missing"),
+            std::string::npos)
+      << rt::read_text(cut_log);
+  // 4. A sensor the model does not name: refused, naming it; nothing written.
   const fs::path bad = dir / "bad", bad_log = dir / "bad.log";
   EXPECT_NE(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
                      data.string(), "--out", bad.string(), "--sensors", "T02,NOPE", "--quiet"},

@@ -5,12 +5,14 @@
 // raises `recalibrate` on a run with an undeclared heat input and stays quiet on a clean run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <limits>
 #include <random>
 
 #include "calibration/generator.hpp"
+#include "calibration/model.hpp"
 #include "core/errors.hpp"
 #include "core/rng.hpp"
 #include "core/units.hpp"
@@ -18,6 +20,7 @@
 #include "mesh/mesher.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/observer.hpp"
+#include "solvers/observer_live.hpp"
 #include "solvers/twin.hpp"
 
 namespace tt::observer_test {
@@ -199,6 +202,82 @@ TEST_F(Observer, MissingReadingsAreLeftOutOfTheUpdate) {
   EXPECT_GE(cov(1), 0.85);
   EXPECT_GE(cov(2), 0.85);
   EXPECT_FALSE(run.recalibrate);
+}
+
+TEST_F(Observer, CalibratedSigmaMakesTheTrainingErrorsNormalAndLeavesTheFilter) {
+  // The scale from a run's normalised squared errors, applied, makes their mean 1 on that run;
+  // the estimates, innovations and alarm do not move.
+  const core::CaseSpec c = run_spec();
+  const solvers::ObserverSetup plain = setup(default_noise());
+  const std::vector<solvers::ObserverRun> runs{
+      solvers::observe(s_->twin.model.system, c, plain, s_->clean.time, s_->clean.temperature)};
+  Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(runs[0].drift.rows(), runs[0].drift.cols(),
+                                                    std::numeric_limits<double>::quiet_NaN());
+  truth.leftCols(3) = s_->clean_truth.displacement.leftCols(3);  // the TCP's: known
+  const std::vector<Eigen::MatrixXd> truths{truth};
+  const Eigen::VectorXd nees = solvers::mean_normalised_squared_error(runs, truths);
+  const Eigen::VectorXd scale = solvers::drift_sigma_calibration(runs, truths);
+  std::cerr << "normalised squared error dx " << nees(0) << " dy " << nees(1) << " dz " << nees(2)
+            << "\n";
+  ASSERT_EQ(scale.size(), truth.cols());
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(scale(d), std::sqrt(nees(d)), 1e-12);
+  for (Eigen::Index d = 3; d < truth.cols(); ++d) EXPECT_EQ(scale(d), 1.0);  // no truth: kept
+  solvers::ObserverSetup calibrated = plain;
+  calibrated.noise.drift_sigma_scale = scale;
+  const std::vector<solvers::ObserverRun> again{solvers::observe(
+      s_->twin.model.system, c, calibrated, s_->clean.time, s_->clean.temperature)};
+  const Eigen::VectorXd after = solvers::mean_normalised_squared_error(again, truths);
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(after(d), 1.0, 1e-9) << "direction " << d;
+  EXPECT_EQ(again[0].drift, runs[0].drift);
+  EXPECT_EQ(again[0].nis, runs[0].nis);
+  EXPECT_EQ(again[0].recalibrate, runs[0].recalibrate);
+  // A known noise on the truth is taken out; sizes that differ are refused.
+  const Eigen::VectorXd noisy = solvers::mean_normalised_squared_error(runs, truths, 0.01e-6);
+  EXPECT_LT(noisy(1), nees(1));
+  EXPECT_THROW(solvers::mean_normalised_squared_error(runs, {truths[0].leftCols(2)}),
+               core::SolverError);
+  calibrated.noise.drift_sigma_scale = Eigen::VectorXd::Ones(truth.cols() + 1);
+  EXPECT_THROW(solvers::KalmanObserver(s_->twin.model.system, c, calibrated), core::SolverError);
+}
+
+TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
+  // The run sample by sample, its speed column read as it comes and two readings missing, gives
+  // what the observer gives on the whole recorded run (its duty cycle from the same column).
+  io::MeasuredRun run = s_->clean;
+  run.temperature(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  run.temperature(40, 3) = std::numeric_limits<double>::quiet_NaN();
+  const core::CaseSpec c = calibration::case_for_run(s_->spec, run);
+  const solvers::ObserverSetup set = setup(default_noise());
+  const solvers::ObserverRun offline =
+      solvers::observe(s_->twin.model.system, c, set, run.time, run.temperature);
+  const auto speed = std::find(run.inputs.begin(), run.inputs.end(), "speed_rpm");
+  ASSERT_NE(speed, run.inputs.end());
+  std::vector<std::string> columns{"speed_rpm", "ignored"};
+  columns.insert(columns.end(), kSensors.rbegin(), kSensors.rend());  // any order
+  core::CaseSpec declared = s_->spec;
+  if (run.initial_temperature_c)
+    declared.thermal.initial_temperature_c = *run.initial_temperature_c;
+  solvers::LiveObserver live(s_->twin.model.system, declared, set, kSensors, columns, "speed_rpm");
+  const auto m = static_cast<Eigen::Index>(kSensors.size());
+  Eigen::VectorXd v(2 + m);
+  double worst = 0;
+  for (Eigen::Index i = 0; i < run.time.size(); ++i) {
+    v(0) = run.input_values(i, speed - run.inputs.begin());
+    v(1) = 1e9;
+    for (Eigen::Index k = 0; k < m; ++k) v(2 + k) = run.temperature(i, m - 1 - k);
+    const core::LiveStep& step = live.next(run.time(i), v);
+    ASSERT_EQ(step.status, (i == 5 || i == 40) ? core::SampleStatus::held : core::SampleStatus::ok)
+        << "sample " << i;
+    worst =
+        std::max(worst, (step.predicted - offline.drift.row(i).transpose()).cwiseAbs().maxCoeff());
+    worst = std::max(worst,
+                     (step.sigma - offline.drift_sigma.row(i).transpose()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-12 * offline.drift.cwiseAbs().maxCoeff());
+  EXPECT_EQ(live.next(run.time(3), v).status, core::SampleStatus::late);
+  EXPECT_THROW(solvers::LiveObserver(s_->twin.model.system, declared, set, kSensors,
+                                     {"speed_rpm", "T02"}, "speed_rpm"),
+               core::DataError);
 }
 
 TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) {

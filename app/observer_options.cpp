@@ -1,0 +1,102 @@
+#include "app/observer_options.hpp"
+
+#include "app/cli_numbers.hpp"
+#include "core/errors.hpp"
+
+namespace tt::app {
+namespace {
+
+/// One value per name from an option: one value for all, or one each.
+Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<std::string>& names,
+                         const std::string& option, const std::string& what) {
+  const auto n = static_cast<Eigen::Index>(names.size());
+  if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
+  if (values.size() == names.size()) return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
+  std::string ids;
+  for (const auto& s : names) ids += (ids.empty() ? "" : ",") + s;
+  throw core::DataError(option + ": " + std::to_string(values.size()) + " values for " +
+                        std::to_string(names.size()) + " " + what + " (" + ids +
+                        "); expected one value for all or one per " + what + " in that order");
+}
+
+std::vector<double> as_vector(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+}  // namespace
+
+void add_observer_options(CLI::App& command, ObserverOptions& o) {
+  command
+      .add_option("--sensors", o.sensors,
+                  "sensor ids to read (default: every sensor of the run the model names)")
+      ->delimiter(',');
+  command
+      .add_option("--sensor-sigma-k", o.sensor_sigma_k,
+                  "white noise of a reading [K]: one value for all sensors or one per sensor, "
+                  "comma-separated (default 0.05)")
+      ->delimiter(',')
+      ->check(positive_number());
+  command
+      .add_option("--heat-walk-w", o.heat_walk_w,
+                  "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--air-walk-k", o.air_walk_k,
+                  "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--drift-relative-sigma", o.drift_relative_sigma,
+                  "error of the drift rows (elastic model) relative to the drift (default 0.04)")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--drift-sigma-scale", o.drift_sigma_scale,
+                  "factor on the reported drift sigma, calibrated on training runs: one value for "
+                  "all targets or one per target, comma-separated (default 1)")
+      ->delimiter(',')
+      ->check(positive_number());
+  command
+      .add_option("--window-s", o.window_s,
+                  "consistency test: window of the summed NIS [s] (default 1800)")
+      ->check(positive_number());
+  command
+      .add_option("--sustain-s", o.sustain_s,
+                  "consistency test: how long an exceedance lasts before recalibrate [s] "
+                  "(default 900)")
+      ->check(CLI::NonNegativeNumber);
+  command
+      .add_option("--probability", o.probability,
+                  "consistency test: chi-square quantile of the bound (default 0.999)")
+      ->check(CLI::Range(0.5, 0.999999));
+}
+
+solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
+                                      const core::CaseSpec& spec,
+                                      const std::vector<std::string>& sensors) {
+  solvers::ObserverNoise noise;
+  noise.sensor_sigma_k = per_name(o.sensor_sigma_k, sensors, "--sensor-sigma-k", "sensors");
+  noise.heat_walk_w = o.heat_walk_w;
+  noise.air_walk_k = o.air_walk_k;
+  noise.drift_relative_sigma = o.drift_relative_sigma;
+  solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
+  if (!o.drift_sigma_scale.empty())
+    setup.noise.drift_sigma_scale =
+        per_name(o.drift_sigma_scale, setup.target_names, "--drift-sigma-scale", "targets");
+  setup.consistency.window_s = o.window_s;
+  setup.consistency.sustain_s = o.sustain_s;
+  setup.consistency.probability = o.probability;
+  return setup;
+}
+
+nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
+  const solvers::ObserverNoise& n = setup.noise;
+  const Eigen::VectorXd scale = n.drift_sigma_scale.size() != 0
+                                    ? n.drift_sigma_scale
+                                    : Eigen::VectorXd::Ones(setup.target_rows.rows());
+  return {{"sensor_sigma_K", as_vector(n.sensor_sigma_k)},
+          {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
+          {"air_walk_K_per_sqrt_h", n.air_walk_k},
+          {"drift_relative_sigma", n.drift_relative_sigma},
+          {"drift_sigma_scale", as_vector(scale)}};
+}
+
+}  // namespace tt::app

@@ -1,0 +1,31 @@
+// The physics observer's command-line options, shared by `observe` and `compensate --rom`: the
+// flags, and the solvers::ObserverSetup they give on a reduced model (docs/observer.md).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "core/case_spec.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/twin.hpp"
+
+namespace tt::app {
+
+/// --sensors, --sensor-sigma-k, --heat-walk-w, --air-walk-k, --drift-relative-sigma,
+/// --drift-sigma-scale, --window-s, --sustain-s, --probability on `command`.
+void add_observer_options(CLI::App& command, ObserverOptions& options);
+
+/// The set-up on `twin` for `sensors` (ids): the noise and the consistency test of `options`.
+/// Throws DataError when --sensor-sigma-k or --drift-sigma-scale has neither one value nor one
+/// per sensor (target), naming them.
+solvers::ObserverSetup observer_setup(const ObserverOptions& options, const solvers::Twin& twin,
+                                      const core::CaseSpec& spec,
+                                      const std::vector<std::string>& sensors);
+
+/// The noise model and consistency test of a set-up, for a result file.
+nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup);
+
+}  // namespace tt::app

@@ -1,0 +1,78 @@
+#include "solvers/observer_live.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+#include "solvers/loads.hpp"
+
+namespace tt::solvers {
+
+namespace {
+
+int column_of(const std::string& name, const std::vector<std::string>& columns, const char* what) {
+  const auto it = std::find(columns.begin(), columns.end(), name);
+  if (it != columns.end()) return static_cast<int>(it - columns.begin());
+  std::string listed;
+  for (const std::string& c : columns) listed += (listed.empty() ? "" : ", ") + c;
+  throw core::DataError("column '" + name + "' is missing: the observer reads " + what + " '" +
+                        name + "'; the stream has " + (listed.empty() ? "none" : listed));
+}
+
+}  // namespace
+
+LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
+                           const ObserverSetup& setup, const std::vector<std::string>& sensors,
+                           const std::vector<std::string>& columns, const std::string& speed_column)
+    : spec_(std::make_unique<core::CaseSpec>(declared)), target_names_(setup.target_names) {
+  if (static_cast<Eigen::Index>(sensors.size()) != setup.sensor_rows.rows())
+    throw core::SolverError("live observer: " + std::to_string(sensors.size()) +
+                            " sensor ids for " + std::to_string(setup.sensor_rows.rows()) +
+                            " sensor rows");
+  for (const std::string& s : sensors) sensor_columns_.push_back(column_of(s, columns, "sensor"));
+  speed_column_ = column_of(speed_column, columns, "the spindle speed");
+  spec_->duty_cycle.segments.clear();
+  spec_->duty_cycle.end = 0;
+  spec_->duty_cycle.csv.clear();
+  filter_ = std::make_unique<KalmanObserver>(system, *spec_, setup);
+  readings_.resize(static_cast<Eigen::Index>(sensors.size()));
+  const auto nt = static_cast<Eigen::Index>(target_names_.size());
+  step_.predicted = Eigen::VectorXd::Constant(nt, std::numeric_limits<double>::quiet_NaN());
+  step_.sigma = step_.predicted;
+}
+
+LiveObserver::~LiveObserver() = default;
+
+const core::LiveStep& LiveObserver::next(double time,
+                                         const Eigen::Ref<const Eigen::VectorXd>& values) {
+  step_.held.clear();
+  if (!std::isfinite(time) || (started_ && !(time > last_time_)) || time < 0) {
+    step_.status = started_ ? core::SampleStatus::late : core::SampleStatus::waiting;
+    return step_;
+  }
+  const double speed = values(speed_column_);
+  if (spec_->duty_cycle.segments.empty() && !std::isfinite(speed)) {
+    step_.held.push_back(speed_column_);
+    step_.status = core::SampleStatus::waiting;
+    return step_;
+  }
+  extend_duty_cycle(spec_->duty_cycle, time, speed);
+  if (!std::isfinite(speed)) step_.held.push_back(speed_column_);
+  for (std::size_t k = 0; k < sensor_columns_.size(); ++k) {
+    const double v = values(sensor_columns_[k]);
+    readings_(static_cast<Eigen::Index>(k)) = v;
+    if (!std::isfinite(v)) step_.held.push_back(sensor_columns_[k]);
+  }
+  std::sort(step_.held.begin(), step_.held.end());
+  const ObserverEstimate e = filter_->assimilate(time, readings_);
+  started_ = true;
+  last_time_ = time;
+  step_.predicted = e.drift;
+  step_.sigma = e.drift_sigma;
+  step_.recalibrate = e.recalibrate;
+  step_.status = step_.held.empty() ? core::SampleStatus::ok : core::SampleStatus::held;
+  return step_;
+}
+
+}  // namespace tt::solvers

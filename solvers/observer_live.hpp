@@ -1,0 +1,56 @@
+// The physics observer on a stream of samples (thermotwin compensate --rom): the stream's header
+// bound by name to the observer's sensors and the spindle speed, the duty cycle extended sample by
+// sample (the speed read at a sample holds to the next one, as calibration::case_for_run reads a
+// recorded run: solvers::extend_duty_cycle), and one KalmanObserver::assimilate per sample. The
+// observer steps no further than the sample at hand, so a recorded run streamed through it gives
+// what solvers::observe gives on the whole run.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "core/live_step.hpp"
+#include "solvers/observer.hpp"
+
+namespace tt::solvers {
+
+class LiveObserver {
+ public:
+  /// `declared`: the case (sinks, sources, films, feed axis, initial temperature); its duty cycle
+  /// is the stream's. `sensors`: the setup's sensors (ids), in its order; columns: the stream's
+  /// columns after time_s. Throws DataError naming the first column it reads (a sensor, or
+  /// `speed_column`) that `columns` lacks, and the columns the stream has.
+  LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
+               const ObserverSetup& setup, const std::vector<std::string>& sensors,
+               const std::vector<std::string>& columns, const std::string& speed_column);
+  ~LiveObserver();
+  LiveObserver(const LiveObserver&) = delete;
+  LiveObserver& operator=(const LiveObserver&) = delete;
+
+  /// The observer on the next sample: time [s] and one value per column (sensors [K], speed
+  /// [rpm]), NaN where missing. `late` for a time not after the last sample used; `waiting` until
+  /// a speed has been read; `held` with the columns whose readings were missing (sensors left out
+  /// of the update, the speed held). Predicted drift and sigma per target [m] (the setup's
+  /// targets); recalibrate once the innovation test raised it.
+  const core::LiveStep& next(double time, const Eigen::Ref<const Eigen::VectorXd>& values);
+
+  const std::vector<std::string>& target_names() const { return target_names_; }
+  /// The stream's columns of the setup's sensors, in its order.
+  const std::vector<int>& sensor_columns() const { return sensor_columns_; }
+
+ private:
+  std::unique_ptr<core::CaseSpec> spec_;  /// the duty cycle read so far; the filter refers to it
+  std::unique_ptr<KalmanObserver> filter_;
+  std::vector<int> sensor_columns_;
+  int speed_column_ = -1;
+  std::vector<std::string> target_names_;
+  Eigen::VectorXd readings_;
+  core::LiveStep step_;
+  double last_time_ = 0;
+  bool started_ = false;
+};
+
+}  // namespace tt::solvers
