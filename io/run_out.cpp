@@ -90,7 +90,7 @@ void write_fields(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
     next = th.times[t] + spec.outputs.fields_interval;
     const Eigen::VectorXd temp = th.temperature.col(static_cast<Eigen::Index>(t));
     std::vector<NamedField> point{{"temperature_degC", 1, temp.array() - core::kCelsiusOffset},
-                                      {"temperature_rise_K", 1, temp.array() - t0_k}};
+                                  {"temperature_rise_K", 1, temp.array() - t0_k}};
     if (run.elastic) {
       const Eigen::VectorXd u = run.elastic->displacement.col(static_cast<Eigen::Index>(t));
       point.push_back({"displacement_m", 3, u});
@@ -195,8 +195,7 @@ void write_mesh_files(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
   write_mesh_vtu(mesh, dir / "mesh.vtu");
   write_boundary_vtp(mesh, dir / "boundary.vtp");
   write_points_vtp(mesh, dir / "points.vtp");
-  write_json(dir / "mesh_report.json",
-                 mesh_report_json(mesh, mesh::mesh_report(mesh, spec)));
+  write_json(dir / "mesh_report.json", mesh_report_json(mesh, mesh::mesh_report(mesh, spec)));
   write_file_atomically(dir / "case.resolved.toml", resolved_case_toml(spec));
 }
 
