@@ -26,8 +26,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "app/cli_numbers.hpp"
 #include "app/commands.hpp"
@@ -37,23 +40,36 @@
 #include "io/atomic_dir.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 
-int main(int argc, char** argv) {
-  using namespace tt::app;
-  CLI::App cli{"thermotwin: thermal twin of a machine tool"};
-  cli.require_subcommand(1);
-  const std::string git = tt::app::kGitDescribe;
-  cli.set_version_flag("--version", std::string("thermotwin ") + tt::app::kVersion +
-                                        (git.empty() ? "" : " (git " + git + ")"));
+namespace {
 
-  MeshArgs mesh_args;
+using namespace tt::app;
+
+/// A subcommand and what runs it once the command line is parsed (its arguments checked there).
+struct Command {
+  CLI::App* subcommand;
+  std::function<int()> run;
+};
+
+/// `mesh CASE --out DIR`.
+Command mesh_line(CLI::App& cli) {
+  auto args = std::make_shared<MeshArgs>();
+  MeshArgs& mesh_args = *args;
   auto* mesh =
       cli.add_subcommand("mesh", "Mesh a case and write the mesh, its boundary and named points");
   mesh->add_option("case", mesh_args.case_file, "case file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
   mesh->add_option("--out", mesh_args.out, "output directory")->required();
+  return {mesh, [args] {
+            const MeshArgs& a = *args;
+            return mesh_command(a);
+          }};
+}
 
-  RunArgs run_args;
+/// `run CASE --out DIR`.
+Command run_line(CLI::App& cli) {
+  auto args = std::make_shared<RunArgs>();
+  RunArgs& run_args = *args;
   auto* run =
       cli.add_subcommand("run", "Simulate a case: heat transfer, thermo-elasticity, thermal error");
   run->add_option("case", run_args.case_file, "case file (TOML)")
@@ -83,8 +99,16 @@ int main(int argc, char** argv) {
       ->check(positive_number());
   run->add_option("--stop-after-steps", run_args.stop_after_steps)->group("");
   run->add_option("--dump", run_args.dump)->group("");
+  return {run, [args] {
+            const RunArgs& a = *args;
+            return run_command(a);
+          }};
+}
 
-  ReduceArgs reduce_args;
+/// `reduce CASE --out DIR`.
+Command reduce_line(CLI::App& cli) {
+  auto args = std::make_shared<ReduceArgs>();
+  ReduceArgs& reduce_args = *args;
   auto* reduce = cli.add_subcommand(
       "reduce", "Build the reduced-order twin of a case and validate it against the full model");
   reduce->add_option("case", reduce_args.case_file, "case file (TOML)")
@@ -94,8 +118,16 @@ int main(int argc, char** argv) {
   reduce->add_flag("--quick-validation", reduce_args.quick_validation,
                    "validate on the case's own duty cycle only (default: three more cycles)");
   reduce->add_flag("--quiet", reduce_args.quiet, "no progress on stderr");
+  return {reduce, [args] {
+            const ReduceArgs& a = *args;
+            return reduce_command(a);
+          }};
+}
 
-  ProbesArgs probes_args;
+/// `probes --in RAW.csv | --from-run RUNDIR --out DIR`.
+Command probes_line(CLI::App& cli) {
+  auto args = std::make_shared<ProbesArgs>();
+  ProbesArgs& probes_args = *args;
   auto* probes =
       cli.add_subcommand("probes", "Spindle drift and tilt from four non-contact probes");
   auto* probes_in =
@@ -121,8 +153,18 @@ int main(int argc, char** argv) {
       ->add_option("--probe-distance-mm", probes_args.probe_distance_mm,
                    "D when the file does not say")
       ->check(positive_number());
+  return {probes, [args] {
+            const ProbesArgs& a = *args;
+            if (a.in.empty() && a.from_run.empty())
+              throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");
+            return probes_command(a);
+          }};
+}
 
-  PlaceArgs place_args;
+/// `place CASE --out DIR` or `place --from RUNDIR --out DIR`.
+Command place_line(CLI::App& cli) {
+  auto args = std::make_shared<PlaceArgs>();
+  PlaceArgs& place_args = *args;
   auto* place = cli.add_subcommand(
       "place", "Sensor placement: the patent's MI + GA method and stronger criteria");
   auto* place_case =
@@ -146,11 +188,22 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   place->add_flag("--full", place_args.full,
                   "simulate in full order (default: a reduced model built on the fly)");
+  return {place, [args] {
+            const PlaceArgs& a = *args;
+            if (a.case_file.empty() && a.from_run.empty())
+              throw tt::core::CaseError("place: give a case file or --from RUNDIR");
+            return place_command(a);
+          }};
+}
 
-  FitArgs fit_args;
+/// `fit CASE --out DIR` or `fit --data RUN... --out DIR`.
+Command fit_line(CLI::App& cli) {
+  auto args = std::make_shared<FitArgs>();
+  auto data_args = std::make_shared<FitDataArgs>();
+  FitArgs& fit_args = *args;
+  FitDataArgs& fit_data_args = *data_args;
   auto* fit = cli.add_subcommand(
       "fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
-  FitDataArgs fit_data_args;
   auto* fit_case =
       fit->add_option("case", fit_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
   auto* fit_data = fit->add_option("--data", fit_data_args.runs,
@@ -184,8 +237,25 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   fit->add_flag("--full", fit_args.full,
                 "the campaign in full order (default: a reduced model built on the fly)");
+  return {fit, [args, data_args] {
+            if (!data_args->runs.empty()) {
+              FitDataArgs d = *data_args;
+              d.out = args->out;
+              d.quick = args->quick;
+              d.network = args->network;
+              d.quiet = args->quiet;
+              return fit_data_command(d);
+            }
+            if (args->case_file.empty())
+              throw tt::core::CaseError("fit: give a case file or --data RUN...");
+            return fit_command(*args);
+          }};
+}
 
-  CalibrateArgs calibrate_args;
+/// `calibrate [--case CASE] --train RUN... --test RUN... --out DIR`.
+Command calibrate_line(CLI::App& cli) {
+  auto args = std::make_shared<CalibrateArgs>();
+  CalibrateArgs& calibrate_args = *args;
   auto* calibrate = cli.add_subcommand(
       "calibrate", "Close the loop on measured runs: what the model lacks, before/after");
   calibrate
@@ -208,8 +278,26 @@ int main(int argc, char** argv) {
                       "updated model by Gauss-Newton where that predicts held-out runs better: "
                       "docs/calibration.md)");
   calibrate->add_flag("--quiet", calibrate_args.quiet, "no progress on stderr");
+  return {calibrate, [args] {
+            const CalibrateArgs& a = *args;
+            if (a.case_file.empty() && a.no_refit)
+              throw tt::core::CaseError(
+                  "calibrate: --no-refit concerns the claims on the model of "
+                  "--case; "
+                  "without --case there is no model. Hint: give --case CASE");
+            if (a.case_file.empty() && a.full)
+              throw tt::core::CaseError(
+                  "calibrate: --full chooses the model of calibrate --case; without "
+                  "--case there is no model to reduce. Hint: drop --full or give "
+                  "--case CASE");
+            return a.case_file.empty() ? calibrate_data_command(a) : calibrate_command_with_case(a);
+          }};
+}
 
-  CompensateArgs compensate_args;
+/// `compensate --model FIT.json | --rom DIR`.
+Command compensate_line(CLI::App& cli) {
+  auto args = std::make_shared<CompensateArgs>();
+  CompensateArgs& compensate_args = *args;
   auto* compensate = cli.add_subcommand(
       "compensate",
       "Live compensation: drift per sample from a fitted model or, through the physics observer, "
@@ -258,8 +346,20 @@ int main(int argc, char** argv) {
   compensate->add_flag("--flush", compensate_args.flush,
                        "flush after every line (default: when the input pauses; always on a "
                        "terminal)");
+  return {compensate, [args] {
+            const CompensateArgs& a = *args;
+            if (a.model.empty() == a.rom.empty())
+              throw tt::core::DataError(
+                  "compensate: give a fitted model (--model FIT.json) or a reduced "
+                  "model (--rom DIR), one of the two");
+            return compensate_command(a);
+          }};
+}
 
-  ExportArgs export_args;
+/// `export --model FIT.json --out DIR`.
+Command export_line(CLI::App& cli) {
+  auto args = std::make_shared<ExportArgs>();
+  ExportArgs& export_args = *args;
   auto* exporter = cli.add_subcommand(
       "export",
       "The compensation in the CNC's own formats, with the error of each controller's "
@@ -283,8 +383,16 @@ int main(int argc, char** argv) {
       ->add_option("--grid", export_args.grid,
                    "positions over the travel where the laws are judged (default 1001)")
       ->check(CLI::Range(2, 1000000));
+  return {exporter, [args] {
+            const ExportArgs& a = *args;
+            return export_command(a);
+          }};
+}
 
-  ObserveArgs observe_args;
+/// `observe CASE --rom DIR --data RUN --out DIR`.
+Command observe_line(CLI::App& cli) {
+  auto args = std::make_shared<ObserveArgs>();
+  ObserveArgs& observe_args = *args;
   auto* observe = cli.add_subcommand("observe",
                                      "Physics observer on a measured run: a Kalman filter on the "
                                      "reduced model (docs/observer.md)");
@@ -302,6 +410,25 @@ int main(int argc, char** argv) {
   observe->add_option("--out", observe_args.out, "output directory")->required();
   add_observer_options(*observe, observe_args.observer);
   observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
+  return {observe, [args] {
+            const ObserveArgs& a = *args;
+            return observe_command(a);
+          }};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"thermotwin: thermal twin of a machine tool"};
+  cli.require_subcommand(1);
+  const std::string git = tt::app::kGitDescribe;
+  cli.set_version_flag("--version", std::string("thermotwin ") + tt::app::kVersion +
+                                        (git.empty() ? "" : " (git " + git + ")"));
+
+  const std::vector<Command> commands{mesh_line(cli),      run_line(cli),        reduce_line(cli),
+                                      probes_line(cli),    place_line(cli),      fit_line(cli),
+                                      calibrate_line(cli), compensate_line(cli), export_line(cli),
+                                      observe_line(cli)};
 
   CLI11_PARSE(cli, argc, argv);
   // OpenBLAS chose kernels slower than this CPU allows (cholmod_factor.hpp, better_blas_core):
@@ -318,54 +445,8 @@ int main(int argc, char** argv) {
   const char* blas = std::getenv("TT_BLAS_THREADS");
   tt::solvers::cholmod::set_blas_threads(blas ? std::max(1, std::atoi(blas)) : 1);
   try {
-    if (*mesh) return mesh_command(mesh_args);
-    if (*run) return run_command(run_args);
-    if (*reduce) return reduce_command(reduce_args);
-    if (*place) {
-      if (place_args.case_file.empty() && place_args.from_run.empty())
-        throw tt::core::CaseError("place: give a case file or --from RUNDIR");
-      return place_command(place_args);
-    }
-    if (*fit) {
-      if (!fit_data_args.runs.empty()) {
-        fit_data_args.out = fit_args.out;
-        fit_data_args.quick = fit_args.quick;
-        fit_data_args.network = fit_args.network;
-        fit_data_args.quiet = fit_args.quiet;
-        return fit_data_command(fit_data_args);
-      }
-      if (fit_args.case_file.empty())
-        throw tt::core::CaseError("fit: give a case file or --data RUN...");
-      return fit_command(fit_args);
-    }
-    if (*calibrate) {
-      if (calibrate_args.case_file.empty() && calibrate_args.no_refit)
-        throw tt::core::CaseError(
-            "calibrate: --no-refit concerns the claims on the model of "
-            "--case; "
-            "without --case there is no model. Hint: give --case CASE");
-      if (calibrate_args.case_file.empty() && calibrate_args.full)
-        throw tt::core::CaseError(
-            "calibrate: --full chooses the model of calibrate --case; without "
-            "--case there is no model to reduce. Hint: drop --full or give "
-            "--case CASE");
-      return calibrate_args.case_file.empty() ? calibrate_data_command(calibrate_args)
-                                              : calibrate_command_with_case(calibrate_args);
-    }
-    if (*compensate) {
-      if (compensate_args.model.empty() == compensate_args.rom.empty())
-        throw tt::core::DataError(
-            "compensate: give a fitted model (--model FIT.json) or a reduced "
-            "model (--rom DIR), one of the two");
-      return compensate_command(compensate_args);
-    }
-    if (*exporter) return export_command(export_args);
-    if (*observe) return observe_command(observe_args);
-    if (*probes) {
-      if (probes_args.in.empty() && probes_args.from_run.empty())
-        throw tt::core::DataError("probes: give --in RAW.csv or --from-run RUNDIR");
-      return probes_command(probes_args);
-    }
+    for (const auto& command : commands)
+      if (*command.subcommand) return command.run();
   } catch (const tt::core::Error& e) {
     std::cerr << "thermotwin: error: " << e.what() << "\n";
     return 1;
