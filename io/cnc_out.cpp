@@ -299,13 +299,21 @@ std::string lower(const char* axis) {
   return std::string(1, static_cast<char>(std::tolower(static_cast<unsigned char>(axis[0]))));
 }
 
-std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::PolynomialLaw& law,
-                                    const std::string& source) {
-  const std::vector<BasisTerm> terms = basis_terms(m);
-  const std::vector<int> dirs = acting_directions(m);
+/// The HAL components a file loads, by kind, and the order the servo thread runs them in.
+struct HalComponents {
   std::vector<std::string> sum2, mult2, lowpass, scale, conv, order;
-  HalNets nets;
-  // Basis functions: increments reading - reference, and their low-pass filtered versions.
+  /// Adds `name` to `kind` and to the thread's order; returns it.
+  std::string add(std::vector<std::string>& kind, const std::string& name) {
+    kind.push_back(name);
+    order.push_back(name);
+    return name;
+  }
+};
+
+/// The basis functions' output pins: increments reading - reference, and their low-pass filtered
+/// versions.
+std::vector<std::string> basis_pins(const std::vector<BasisTerm>& terms, HalComponents& comps,
+                                    HalNets& nets) {
   std::vector<std::string> pin(terms.size());
   nets.text
       << "# Basis: the increments since the reference readings (set each tt-ref-* to the\n"
@@ -314,88 +322,90 @@ std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::P
   for (std::size_t j = 0; j < terms.size(); ++j) {
     const std::string src = hal_name(terms[j].source);
     if (terms[j].tau == 0.0) {
-      const std::string c = "tt-rise-" + src;
-      sum2.push_back(c);
-      order.push_back(c);
+      const std::string c = comps.add(comps.sum2, "tt-rise-" + src);
       nets.text << "net tt-in-" << src << " => " << c << ".in0\n"
                 << "net tt-ref-" << src << " => " << c << ".in1\n"
                 << "sets tt-ref-" << src << " 20.0\n"
                 << "setp " << c << ".gain1 -1\n";
       pin[j] = c + ".out";
     } else {
-      const std::string c = hal_name("tt-lp" + num(terms[j].tau) + "-" + src);
-      lowpass.push_back(c);
-      order.push_back(c);
+      const std::string c =
+          comps.add(comps.lowpass, hal_name("tt-lp" + num(terms[j].tau) + "-" + src));
       nets.connect("tt-rise-" + src + ".out", c + ".in");
       nets.text << "# gain = 1 - exp(-period/tau), period the servo thread's [s] (1 ms here)\n"
                 << "setp " << c << ".gain " << num(1.0 - std::exp(-1e-3 / terms[j].tau)) << "\n";
       pin[j] = c + ".out";
     }
   }
-  const std::string position = "axis." + lower(kAxisLetters[m.feed_direction]) + ".pos-cmd";
-  for (int d : dirs) {
-    const std::string ax = lower(kAxisLetters[d]);
-    const Eigen::MatrixXd& c = law.coefficients[static_cast<std::size_t>(d)];
-    nets.text << "\n# " << kAxisLetters[d] << ": c_k = sum_j C[k][j] b[j] [mm / mm^k], offset = "
-              << "c_0 + p (c_1 + p (c_2 + ...)), p = " << position << " [mm]\n";
-    std::vector<std::string> coefficient_pin;
-    for (Eigen::Index k = 0; k < c.rows(); ++k) {
-      const double to_mm = kMm / std::pow(kMm, static_cast<double>(k));  // m/m^k -> mm/mm^k
-      std::vector<std::size_t> used;  // basis functions with a coefficient
-      for (std::size_t j = 0; j < terms.size(); ++j)
-        if (c(k, static_cast<Eigen::Index>(j + 1)) != 0.0) used.push_back(j);
-      // A chain of sum2, two basis functions each; the first takes the constant as its offset.
-      std::string prev;
-      std::size_t u = 0;
-      for (int link = 0; link == 0 || u < used.size(); ++link) {
-        const std::string sname =
-            "tt-" + ax + "-c" + std::to_string(k) + "-" + std::to_string(link);
-        sum2.push_back(sname);
-        order.push_back(sname);
-        for (const char* slot : {"0", "1"}) {
-          if (slot[0] == '0' && !prev.empty()) {
-            nets.connect(prev + ".out", sname + ".in0");
-            continue;
-          }
-          if (u == used.size()) break;
-          nets.connect(pin[used[u]], sname + ".in" + slot);
-          nets.text << "setp " << sname << ".gain" << slot << " "
-                    << num(c(k, static_cast<Eigen::Index>(used[u] + 1)) * to_mm) << "\n";
-          ++u;
-        }
-        if (prev.empty())
-          nets.text << "setp " << sname << ".offset " << num(c(k, 0) * to_mm) << "\n";
-        prev = sname;
+  return pin;
+}
+
+/// Coefficient k of axis `ax` (row k of `c`, in m/m^k): a chain of sum2, two basis functions
+/// each, the first taking the constant as its offset; returns the chain's output pin.
+std::string coefficient_chain(const std::string& ax, Eigen::Index k, const Eigen::MatrixXd& c,
+                              const std::vector<std::string>& pin, HalComponents& comps,
+                              HalNets& nets) {
+  const double to_mm = kMm / std::pow(kMm, static_cast<double>(k));  // m/m^k -> mm/mm^k
+  std::vector<std::size_t> used;  // basis functions with a coefficient
+  for (std::size_t j = 0; j < pin.size(); ++j)
+    if (c(k, static_cast<Eigen::Index>(j + 1)) != 0.0) used.push_back(j);
+  std::string prev;
+  std::size_t u = 0;
+  for (int link = 0; link == 0 || u < used.size(); ++link) {
+    const std::string sname =
+        comps.add(comps.sum2, "tt-" + ax + "-c" + std::to_string(k) + "-" + std::to_string(link));
+    for (const char* slot : {"0", "1"}) {
+      if (slot[0] == '0' && !prev.empty()) {
+        nets.connect(prev + ".out", sname + ".in0");
+        continue;
       }
-      coefficient_pin.push_back(prev + ".out");
+      if (u == used.size()) break;
+      nets.connect(pin[used[u]], sname + ".in" + slot);
+      nets.text << "setp " << sname << ".gain" << slot << " "
+                << num(c(k, static_cast<Eigen::Index>(used[u] + 1)) * to_mm) << "\n";
+      ++u;
     }
-    // Horner: v = c_n; v = v p + c_k.
-    std::string v = coefficient_pin.back();
-    for (Eigen::Index k = c.rows() - 2; k >= 0; --k) {
-      const std::string mul = "tt-" + ax + "-h" + std::to_string(k) + "-mul";
-      const std::string add = "tt-" + ax + "-h" + std::to_string(k) + "-add";
-      mult2.push_back(mul);
-      sum2.push_back(add);
-      order.push_back(mul);
-      order.push_back(add);
-      nets.connect(v, mul + ".in0");
-      nets.connect(position, mul + ".in1");
-      nets.connect(mul + ".out", add + ".in0");
-      nets.connect(coefficient_pin[static_cast<std::size_t>(k)], add + ".in1");
-      v = add + ".out";
-    }
-    const std::string sc = "tt-" + ax + "-counts", cv = "tt-" + ax + "-s32";
-    scale.push_back(sc);
-    conv.push_back(cv);
-    order.push_back(sc);
-    order.push_back(cv);
-    nets.connect(v, sc + ".in");
-    nets.text << "setp " << sc << ".gain " << num(1.0 / kLinuxcncScaleMm) << "\n";
-    nets.connect(sc + ".out", cv + ".in");
-    nets.connect(cv + ".out", "axis." + ax + ".eoffset-counts");
-    nets.text << "setp axis." << ax << ".eoffset-scale " << num(kLinuxcncScaleMm) << "\n"
-              << "setp axis." << ax << ".eoffset-enable 1\n";
+    if (prev.empty()) nets.text << "setp " << sname << ".offset " << num(c(k, 0) * to_mm) << "\n";
+    prev = sname;
   }
+  return prev + ".out";
+}
+
+/// Axis `d`'s offset: its coefficients, Horner's scheme in the feed position, then counts.
+void axis_offset(const fitting::CncModel& m, const fitting::PolynomialLaw& law, int d,
+                 const std::vector<std::string>& pin, HalComponents& comps, HalNets& nets) {
+  const std::string position = "axis." + lower(kAxisLetters[m.feed_direction]) + ".pos-cmd";
+  const std::string ax = lower(kAxisLetters[d]);
+  const Eigen::MatrixXd& c = law.coefficients[static_cast<std::size_t>(d)];
+  nets.text << "\n# " << kAxisLetters[d] << ": c_k = sum_j C[k][j] b[j] [mm / mm^k], offset = "
+            << "c_0 + p (c_1 + p (c_2 + ...)), p = " << position << " [mm]\n";
+  std::vector<std::string> coefficient_pin;
+  for (Eigen::Index k = 0; k < c.rows(); ++k)
+    coefficient_pin.push_back(coefficient_chain(ax, k, c, pin, comps, nets));
+  // Horner: v = c_n; v = v p + c_k.
+  std::string v = coefficient_pin.back();
+  for (Eigen::Index k = c.rows() - 2; k >= 0; --k) {
+    const std::string mul = comps.add(comps.mult2, "tt-" + ax + "-h" + std::to_string(k) + "-mul");
+    const std::string add = comps.add(comps.sum2, "tt-" + ax + "-h" + std::to_string(k) + "-add");
+    nets.connect(v, mul + ".in0");
+    nets.connect(position, mul + ".in1");
+    nets.connect(mul + ".out", add + ".in0");
+    nets.connect(coefficient_pin[static_cast<std::size_t>(k)], add + ".in1");
+    v = add + ".out";
+  }
+  const std::string sc = comps.add(comps.scale, "tt-" + ax + "-counts");
+  const std::string cv = comps.add(comps.conv, "tt-" + ax + "-s32");
+  nets.connect(v, sc + ".in");
+  nets.text << "setp " << sc << ".gain " << num(1.0 / kLinuxcncScaleMm) << "\n";
+  nets.connect(sc + ".out", cv + ".in");
+  nets.connect(cv + ".out", "axis." + ax + ".eoffset-counts");
+  nets.text << "setp axis." << ax << ".eoffset-scale " << num(kLinuxcncScaleMm) << "\n"
+            << "setp axis." << ax << ".eoffset-enable 1\n";
+}
+
+/// The HAL file: its header, the components loaded and added to the servo thread, the nets.
+std::string hal_text(const fitting::CncModel& m, const std::string& source,
+                     const HalComponents& comps, const HalNets& nets) {
   std::ostringstream hal;
   hal << header_lines("#", "LinuxCNC external offsets (HAL)", source, m)
       << "# The offset is counts * eoffset-scale: truncated to " << num(kLinuxcncScaleMm)
@@ -406,14 +416,24 @@ std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::P
     for (std::size_t i = 0; i < names.size(); ++i) hal << (i ? "," : "") << names[i];
     hal << "\n";
   };
-  load("sum2", sum2);
-  load("mult2", mult2);
-  load("lowpass", lowpass);
-  load("scale", scale);
-  load("conv_float_s32", conv);
+  load("sum2", comps.sum2);
+  load("mult2", comps.mult2);
+  load("lowpass", comps.lowpass);
+  load("scale", comps.scale);
+  load("conv_float_s32", comps.conv);
   hal << "\n# In data-flow order: the increments, the filters, then per axis its chain.\n";
-  for (const auto& f : order) hal << "addf " << f << " servo-thread\n";
+  for (const auto& f : comps.order) hal << "addf " << f << " servo-thread\n";
   hal << "\n" << nets.text.str();
+  return hal.str();
+}
+
+std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::PolynomialLaw& law,
+                                    const std::string& source) {
+  HalComponents comps;
+  HalNets nets;
+  const std::vector<std::string> pin = basis_pins(basis_terms(m), comps, nets);
+  const std::vector<int> dirs = acting_directions(m);
+  for (int d : dirs) axis_offset(m, law, d, pin, comps, nets);
   std::ostringstream ini;
   ini << "# thermotwin export: INI entries for the external offsets of thermotwin_eoffset.hal\n"
       << "[HAL]\nHALFILE = thermotwin_eoffset.hal\n";
@@ -421,7 +441,8 @@ std::vector<CncFile> linuxcnc_files(const fitting::CncModel& m, const fitting::P
     ini << "\n[AXIS_" << kAxisLetters[d] << "]\n"
         << "# fraction of MAX_VELOCITY and MAX_ACCELERATION kept for the external offset\n"
         << "OFFSET_AV_RATIO = 0.1\n";
-  return {{"thermotwin_eoffset.hal", hal.str()}, {"thermotwin_eoffset.ini", ini.str()}};
+  return {{"thermotwin_eoffset.hal", hal_text(m, source, comps, nets)},
+          {"thermotwin_eoffset.ini", ini.str()}};
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -493,18 +494,79 @@ FieldSeriesWriter::FieldSeriesWriter(const mesh::TetMesh& mesh, fs::path dir, st
 
 FieldSeriesWriter::~FieldSeriesWriter() = default;
 
-fs::path FieldSeriesWriter::add_step(double time_s, const std::vector<NamedField>& point_fields,
-                                     const std::vector<NamedField>& cell_fields) {
+namespace {
+
+/// A point field as a VTK array over every node: a field given at the corners only (a linear
+/// field on an order-2 mesh) gets its mid-edge values halfway along each edge (`edge_corners`).
+vtkSmartPointer<vtkDoubleArray> point_field_array(
+    const NamedField& field, Eigen::Index node_count, Eigen::Index corner_count,
+    const std::vector<std::array<int, 2>>& edge_corners) {
+  const int c = field.components;
+  const bool full = c >= 1 && field.values.size() == node_count * c;
+  const bool corners_only = c >= 1 && corner_count > 0 && field.values.size() == corner_count * c;
+  if (!full && !corners_only) {
+    throw core::DataError(
+        "point field '" + field.name + "' has " + str(field.values.size()) + " values with " +
+        str(c) + " components: expected #nodes * components = " + str(node_count * c) +
+        (corner_count > 0 ? " (or #corners * components = " + str(corner_count * c) + ")"
+                          : std::string()) +
+        "; hint: values are entity-major (x0 y0 z0 x1 ...)");
+  }
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(field.name.c_str());
+  array->SetNumberOfComponents(c);
+  array->SetNumberOfTuples(node_count);
+  double* out = array->GetPointer(0);
+  std::copy(field.values.data(), field.values.data() + field.values.size(), out);
+  if (!full) {
+    for (std::size_t m = 0; m < edge_corners.size(); ++m) {
+      const auto [a, b] = edge_corners[m];
+      for (int k = 0; k < c; ++k) {
+        out[(corner_count + m) * c + k] = 0.5 * (out[a * c + k] + out[b * c + k]);
+      }
+    }
+  }
+  return array;
+}
+
+/// A cell field as a VTK array over every tet.
+vtkSmartPointer<vtkDoubleArray> cell_field_array(const NamedField& field, Eigen::Index tet_count) {
+  const int c = field.components;
+  if (field.name == "region") {
+    throw core::DataError(
+        "cell field 'region' clashes with the region ids every step carries; hint: rename it");
+  }
+  if (c < 1 || field.values.size() != tet_count * c) {
+    throw core::DataError("cell field '" + field.name + "' has " + str(field.values.size()) +
+                          " values with " + str(c) + " components: expected #tets * " +
+                          "components = " + str(tet_count * std::max(c, 1)));
+  }
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(field.name.c_str());
+  array->SetNumberOfComponents(c);
+  array->SetNumberOfTuples(tet_count);
+  std::copy(field.values.data(), field.values.data() + field.values.size(), array->GetPointer(0));
+  return array;
+}
+
+/// Throws DataError unless `time_s` is finite and after `previous_s` (when there is one).
+void check_step_time(double time_s, std::optional<double> previous_s) {
   if (!std::isfinite(time_s)) {
     throw core::DataError("field series step time = " + round_trip_text(time_s) +
                           " s: expected a finite time");
   }
-  if (!steps_.empty() && !(time_s > steps_.back().time_s)) {
+  if (previous_s && !(time_s > *previous_s)) {
     throw core::DataError("field series step time = " + round_trip_text(time_s) +
                           " s: expected a time after the previous step (" +
-                          round_trip_text(steps_.back().time_s) +
-                          " s); hint: add steps in increasing time");
+                          round_trip_text(*previous_s) + " s); hint: add steps in increasing time");
   }
+}
+
+}  // namespace
+
+fs::path FieldSeriesWriter::add_step(double time_s, const std::vector<NamedField>& point_fields,
+                                     const std::vector<NamedField>& cell_fields) {
+  check_step_time(time_s, steps_.empty() ? std::nullopt : std::optional(steps_.back().time_s));
   check_field_names(point_fields, "point");
   check_field_names(cell_fields, "cell");
   const Geometry& g = *geometry_;
@@ -520,55 +582,11 @@ fs::path FieldSeriesWriter::add_step(double time_s, const std::vector<NamedField
   time_value->InsertNextValue(time_s);
   field_data->AddArray(time_value);
   grid->SetFieldData(field_data);
-
-  for (const NamedField& field : point_fields) {
-    const int c = field.components;
-    const bool full = c >= 1 && field.values.size() == g.node_count * c;
-    const bool corners_only =
-        c >= 1 && g.corner_count > 0 && field.values.size() == g.corner_count * c;
-    if (!full && !corners_only) {
-      throw core::DataError(
-          "point field '" + field.name + "' has " + str(field.values.size()) + " values with " +
-          str(c) + " components: expected #nodes * components = " + str(g.node_count * c) +
-          (g.corner_count > 0 ? " (or #corners * components = " + str(g.corner_count * c) + ")"
-                              : std::string()) +
-          "; hint: values are entity-major (x0 y0 z0 x1 ...)");
-    }
-    vtkNew<vtkDoubleArray> array;
-    array->SetName(field.name.c_str());
-    array->SetNumberOfComponents(c);
-    array->SetNumberOfTuples(g.node_count);
-    double* out = array->GetPointer(0);
-    std::copy(field.values.data(), field.values.data() + field.values.size(), out);
-    if (!full) {
-      // A linear field on an order-2 mesh: mid-edge values lie halfway along their edge.
-      for (std::size_t m = 0; m < g.edge_corners.size(); ++m) {
-        const auto [a, b] = g.edge_corners[m];
-        for (int k = 0; k < c; ++k) {
-          out[(g.corner_count + m) * c + k] = 0.5 * (out[a * c + k] + out[b * c + k]);
-        }
-      }
-    }
-    grid->GetPointData()->AddArray(array);
-  }
-  for (const NamedField& field : cell_fields) {
-    const int c = field.components;
-    if (field.name == "region") {
-      throw core::DataError(
-          "cell field 'region' clashes with the region ids every step carries; hint: rename it");
-    }
-    if (c < 1 || field.values.size() != g.tet_count * c) {
-      throw core::DataError("cell field '" + field.name + "' has " + str(field.values.size()) +
-                            " values with " + str(c) + " components: expected #tets * " +
-                            "components = " + str(g.tet_count * std::max(c, 1)));
-    }
-    vtkNew<vtkDoubleArray> array;
-    array->SetName(field.name.c_str());
-    array->SetNumberOfComponents(c);
-    array->SetNumberOfTuples(g.tet_count);
-    std::copy(field.values.data(), field.values.data() + field.values.size(), array->GetPointer(0));
-    grid->GetCellData()->AddArray(array);
-  }
+  for (const NamedField& field : point_fields)
+    grid->GetPointData()->AddArray(
+        point_field_array(field, g.node_count, g.corner_count, g.edge_corners));
+  for (const NamedField& field : cell_fields)
+    grid->GetCellData()->AddArray(cell_field_array(field, g.tet_count));
 
   std::array<char, 16> number{};
   std::snprintf(number.data(), number.size(), "%04zu", steps_.size());
