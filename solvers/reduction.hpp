@@ -50,11 +50,22 @@ struct ReductionOptions {
   /// singular value exceeds this [-] (fewer states where many inputs act alike, as the slices of
   /// a moving source do).
   double compression_tolerance = 0;
-  /// Width of the slices along the axis into which a moving source's pieces are grouped, as a
-  /// fraction of its window [-]. A quarter: half a window reads 0.011 K on the error indicator
-  /// of GM-1 (all nodes; true error 0.0053 K near the screw), above its 0.005 K tolerance
+  /// Spacing of the moving source's input columns along the axis, as a fraction of its window
+  /// [-]: the width of box slices, the largest distance between hats' centres. 0.375 with hats:
+  /// on GM-1 coarse, error indicator 2.2e-3 K and 1.1e-3 K at every node at order 579, where box
+  /// slices of a quarter window read 2.4e-3 and 1.3e-3 K at order 753; hats at half a window
+  /// read 3.5e-3 K (order 486), boxes of half a window 0.011 K, above the 0.005 K tolerance
   /// (docs/reduced-order.md).
-  double moving_slice_fraction = 0.25;
+  double moving_slice_fraction = 0.375;
+  /// How a moving source's pieces are weighted into its input columns. box: slices of width
+  /// moving_slice_fraction x window, each piece in one slice (piecewise-constant power densities
+  /// along the axis). hat (the default): piecewise-linear hats whose centres are at most that far
+  /// apart, a piece shared between the two hats around it by its position (their sum is every
+  /// piece's volume: a partition of unity). A window's edge falls inside a slice or a hat; hats
+  /// also hold the linear part of the power density there, so the error the edge leaves grows
+  /// more slowly with the spacing.
+  enum class SliceShape { box, hat };
+  SliceShape moving_slice_shape = SliceShape::hat;
   /// Output rows transposed, #nodes x #outputs (e.g. sensors' interpolation rows, probes'
   /// influence vectors), whose Krylov vectors (K(h) + s C)^{-1} L^T join the basis at every film
   /// state and shift. The system is symmetric, so a Galerkin basis that holds them matches the
