@@ -417,12 +417,14 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   return v.take();
 }
 
-ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis) {
-  if (basis.rows() != full.states())
-    throw core::SolverError("reduction: the basis has " + std::to_string(basis.rows()) +
-                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+namespace {
+
+/// The Galerkin projection on `basis` with the reduced capacity V^T C V already known.
+ReducedThermalSystem projected_with_capacity(const FullThermalSystem& full,
+                                             const Eigen::MatrixXd& basis,
+                                             Eigen::MatrixXd capacity) {
   ReducedThermalSystem r;
-  r.capacity = symmetric_projection(full.capacity, basis);
+  r.capacity = std::move(capacity);
   r.conduction = symmetric_projection(full.conduction, basis);
   for (const auto& f : full.film) r.film.push_back(symmetric_projection(f, basis));
   const auto project = [&](const std::vector<Eigen::VectorXd>& in) {
@@ -444,13 +446,26 @@ ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen
   return with_moving_prefix(std::move(r));
 }
 
+}  // namespace
+
+ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis) {
+  if (basis.rows() != full.states())
+    throw core::SolverError("reduction: the basis has " + std::to_string(basis.rows()) +
+                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+  return projected_with_capacity(full, basis, symmetric_projection(full.capacity, basis));
+}
+
 ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& spec,
                            const ReductionOptions& options) {
   const auto t0 = Clock::now();
   ReducedModel m;
   m.basis = reduction_basis(full, spec, options, &m.stats);
   const auto projection_start = Clock::now();
-  m.system = projected_system(full, m.basis);
+  // The basis was made C-orthonormal against this capacity (Gram-Schmidt twice), so V^T C V is I
+  // to rounding (ReductionBasis.IsCapacityOrthonormalAndHoldsTheUniformField: within 1e-10);
+  // forming it would cost a pass over n x r^2, about 40 % of the projection on GM-1.
+  m.system =
+      projected_with_capacity(full, m.basis, Eigen::MatrixXd::Identity(m.states(), m.states()));
   m.stats.projection_s = std::chrono::duration<double>(Clock::now() - projection_start).count();
   m.stats.build_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return m;

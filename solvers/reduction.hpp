@@ -91,7 +91,7 @@ struct ReductionStats {
 };
 
 struct ReducedModel {
-  ReducedThermalSystem system;  /// T = V z; capacity = I up to rounding
+  ReducedThermalSystem system;  /// T = V z; capacity = I (V^T C V to rounding, not formed)
   Eigen::MatrixXd basis;        /// V: #nodes x r, V^T C V = I
   ReductionStats stats;
   int states() const { return static_cast<int>(basis.cols()); }
@@ -113,7 +113,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
 /// The Galerkin projection of every operator and vector on `basis` (moving pieces kept).
 ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis);
 
-/// Basis and projection in one call.
+/// Basis and projection in one call; the reduced capacity is I, which the basis's Gram-Schmidt
+/// makes V^T C V to rounding.
 ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& spec,
                            const ReductionOptions& options = {});
 
