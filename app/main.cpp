@@ -431,13 +431,22 @@ int main(int argc, char** argv) {
                                       observe_line(cli)};
 
   CLI11_PARSE(cli, argc, argv);
-  // OpenBLAS chose kernels slower than this CPU allows (cholmod_factor.hpp, better_blas_core):
-  // start again with OPENBLAS_CORETYPE set; a value the user set is kept. If exec fails, go on.
+  // Two settings that the libraries read only when they are loaded, so the program starts again,
+  // once, with them set (a value the user set is kept; if exec fails, go on):
+  // - OpenBLAS chose kernels slower than this CPU allows (cholmod_factor.hpp, better_blas_core):
+  //   OPENBLAS_CORETYPE.
+  // - OMP_WAIT_POLICY=passive: between the many short parallel regions of the reduced basis's
+  //   dense products, an idle OpenMP thread otherwise spins; on the shared 2-core machine that
+  //   was 17 % of the samples of a GM-1 coarse twin build, and the build used 10 to 20 % less CPU
+  //   time without it (docs/benchmarks.md).
+  bool again = false;
   if (!std::getenv("OPENBLAS_CORETYPE")) {
     const std::string core = tt::solvers::cholmod::better_blas_core();
-    if (!core.empty() && setenv("OPENBLAS_CORETYPE", core.c_str(), 1) == 0)
-      execv("/proc/self/exe", argv);
+    again = !core.empty() && setenv("OPENBLAS_CORETYPE", core.c_str(), 1) == 0;
   }
+  if (!std::getenv("OMP_WAIT_POLICY"))
+    again = setenv("OMP_WAIT_POLICY", "passive", 1) == 0 || again;
+  if (again) execv("/proc/self/exe", argv);
   // Ctrl-C or a kill (SIGINT, SIGTERM, SIGHUP) while a command works removes its DIR.partial and
   // DIR.lock; DIR keeps the previous result and DIR.checkpoint stays for --resume.
   tt::io::clean_up_outputs_on_signals();

@@ -6,11 +6,13 @@
 //
 // Run:   bench_solvers_reduction [case=cases/sb1_coarse.toml] [top_speed_rpm=6000]
 //                                [compression=0 (> 0: add the default basis compressed)]
-//                                [only | build | twin] [slice_fraction=0.25]
+//                                [only | build | twin | twin-build] [slice_fraction=0.25]
 //                                [moving_moments=1 (2: the slices' second moment too)]
+//                                [slice_shape=box | hat (ReductionOptions::moving_slice_shape)]
 // "only": the default basis (and its compressed variant) only; "build": the same, and stop after
 // the build (order, build time; run under /usr/bin/time -v for the peak memory against mesh size).
 // The slice fraction (ReductionOptions::moving_slice_fraction) applies to every Krylov basis.
+// "twin-build": the twin's build only (outputs, then basis), timed.
 // "twin": the basis with the given compression tolerance and moving slice fraction only, as the
 // twin of the case (TCP and axis-point influence rows), validated against the full model on
 // solvers::validation_runs (the case's own cycle, a 6 h staircase, an 8 h irregular cycle): per
@@ -183,6 +185,10 @@ int main(int argc, char** argv) {
     const double slice_fraction = argc > 5 ? std::atof(argv[5]) : defaults.moving_slice_fraction;
     const bool moving_second_moment =
         argc > 6 ? std::atoi(argv[6]) == 2 : defaults.moving_second_moment;
+    const auto slice_shape =
+        argc > 7 ? (std::string(argv[7]) == "hat" ? s::ReductionOptions::SliceShape::hat
+                                                  : s::ReductionOptions::SliceShape::box)
+                 : defaults.moving_slice_shape;
     // 1. The case, its mesh and the full system.
     tt::core::CaseSpec spec = tt::io::read_case(case_file);
     auto t = Clock::now();
@@ -197,25 +203,31 @@ int main(int argc, char** argv) {
     for (const auto& p : spec.points) points.push_back(tt::mesh::named_node(mesh, p.id));
     const double t0_k = spec.thermal.initial_temperature_c + tt::core::kCelsiusOffset;
 
-    if (mode == "twin") {
+    if (mode == "twin" || mode == "twin-build") {
       // The twin of the case under these options, validated as `thermotwin reduce` does.
       s::ReductionOptions o;
       o.compression_tolerance = compression;
       o.moving_slice_fraction = slice_fraction;
+      o.moving_slice_shape = slice_shape;
       o.moving_second_moment = moving_second_moment;
       o.speeds_rpm = {0.0, top_speed};
+      t = Clock::now();
       const tt::solvers::ElasticModel elastic(mesh, spec);
       const s::TwinOutputs outputs = s::full_outputs(mesh, spec, &elastic);
+      std::printf("outputs (stiffness factor %.2f s, influence rows): %.2f s\n",
+                  elastic.timings().factor_s, seconds_since(t));
       s::Twin twin;
       twin.model = s::reduced_model(full, spec, o);
       twin.outputs = s::projected_outputs(outputs, twin.model.basis);
       const auto& st = twin.model.stats;
       std::printf(
-          "twin compression %g, slices %g of a window, %d moments of the slices: r = %d, build "
+          "twin compression %g, %s slices %g of a window, %d moments of the slices: r = %d, build "
           "%.2f s (%d input "
           "columns; solves %.2f s, orthogonalisation %.2f s, projection %.2f s)\n",
-          compression, slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(),
-          st.build_s, st.input_columns, st.solve_s, st.orthogonalise_s, st.projection_s);
+          compression, slice_shape == s::ReductionOptions::SliceShape::hat ? "hat" : "box",
+          slice_fraction, moving_second_moment ? 2 : 1, twin.model.states(), st.build_s,
+          st.input_columns, st.solve_s, st.orthogonalise_s, st.projection_s);
+      if (mode == "twin-build") return 0;
       const auto table = s::validate_twin(full, outputs, twin, s::validation_runs(spec, spec.seed));
       for (const auto& c : table) {
         Eigen::Index worst = 0;
@@ -239,6 +251,7 @@ int main(int argc, char** argv) {
       s::ReductionOptions o;
       o.compression_tolerance = compress;
       o.moving_slice_fraction = slice_fraction;
+      o.moving_slice_shape = slice_shape;
       o.moving_second_moment = moving_second_moment;
       o.speeds_rpm = {0.0, top_speed};
       o.shifts_per_s = std::move(shifts);

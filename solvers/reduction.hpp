@@ -50,11 +50,22 @@ struct ReductionOptions {
   /// singular value exceeds this [-] (fewer states where many inputs act alike, as the slices of
   /// a moving source do).
   double compression_tolerance = 0;
-  /// Width of the slices along the axis into which a moving source's pieces are grouped, as a
-  /// fraction of its window [-]. A quarter: half a window reads 0.011 K on the error indicator
-  /// of GM-1 (all nodes; true error 0.0053 K near the screw), above its 0.005 K tolerance
+  /// Spacing of the moving source's input columns along the axis, as a fraction of its window
+  /// [-]: the width of box slices, the largest distance between hats' centres. 0.375 with hats:
+  /// on GM-1 coarse, error indicator 2.2e-3 K and 1.1e-3 K at every node at order 579, where box
+  /// slices of a quarter window read 2.4e-3 and 1.3e-3 K at order 753; hats at half a window
+  /// read 3.5e-3 K (order 486), boxes of half a window 0.011 K, above the 0.005 K tolerance
   /// (docs/reduced-order.md).
-  double moving_slice_fraction = 0.25;
+  double moving_slice_fraction = 0.375;
+  /// How a moving source's pieces are weighted into its input columns. box: slices of width
+  /// moving_slice_fraction x window, each piece in one slice (piecewise-constant power densities
+  /// along the axis). hat (the default): piecewise-linear hats whose centres are at most that far
+  /// apart, a piece shared between the two hats around it by its position (their sum is every
+  /// piece's volume: a partition of unity). A window's edge falls inside a slice or a hat; hats
+  /// also hold the linear part of the power density there, so the error the edge leaves grows
+  /// more slowly with the spacing.
+  enum class SliceShape { box, hat };
+  SliceShape moving_slice_shape = SliceShape::hat;
   /// Output rows transposed, #nodes x #outputs (e.g. sensors' interpolation rows, probes'
   /// influence vectors), whose Krylov vectors (K(h) + s C)^{-1} L^T join the basis at every film
   /// state and shift. The system is symmetric, so a Galerkin basis that holds them matches the
@@ -80,7 +91,7 @@ struct ReductionStats {
 };
 
 struct ReducedModel {
-  ReducedThermalSystem system;  /// T = V z; capacity = I up to rounding
+  ReducedThermalSystem system;  /// T = V z; capacity = I (V^T C V to rounding, not formed)
   Eigen::MatrixXd basis;        /// V: #nodes x r, V^T C V = I
   ReductionStats stats;
   int states() const { return static_cast<int>(basis.cols()); }
@@ -102,7 +113,8 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
 /// The Galerkin projection of every operator and vector on `basis` (moving pieces kept).
 ReducedThermalSystem projected_system(const FullThermalSystem& full, const Eigen::MatrixXd& basis);
 
-/// Basis and projection in one call.
+/// Basis and projection in one call; the reduced capacity is I, which the basis's Gram-Schmidt
+/// makes V^T C V to rounding.
 ReducedModel reduced_model(const FullThermalSystem& full, const core::CaseSpec& spec,
                            const ReductionOptions& options = {});
 

@@ -197,10 +197,11 @@ TEST(TwinCampaign, MatchesTheFullCampaignOnGm1CoarseWithItsFeedAxis) {
 }
 
 TEST(TwinValidation, Gm1CoarseAxisPointsFollowTheFullModelOnCyclesNotUsedToBuildIt) {
-  // The default basis (moving slices of a quarter window, their first moment only) on the cycles
-  // `reduce` validates: the case's own, a 6 h staircase and an 8 h irregular cycle, the feed axis
-  // moving as the case says. Every named point within 0.01 K; the TCP's and each axis point's
-  // drift within 1 % of its peak or 0.02 um (measured: at most 0.13 of the limit, at A11 dz).
+  // The default basis (the moving sources' pieces under hats 0.375 of a window apart, their first
+  // moment only) on the cycles `reduce` validates: the case's own, a 6 h staircase and an 8 h
+  // irregular cycle, the feed axis moving as the case says. Every named point within 0.01 K; the
+  // TCP's and each axis point's drift within 1 % of its peak or 0.02 um (measured: at most 0.34
+  // of the limit, at A11 dz; 0.13 with the earlier boxes of a quarter window, order 753 -> 579).
   const core::CaseSpec spec = io::read_case(fs::path(TT_SOURCE_DIR) / "cases" / "gm1_coarse.toml");
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const solvers::FullThermalSystem full = solvers::thermal_system(mesh, spec);
