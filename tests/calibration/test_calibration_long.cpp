@@ -8,7 +8,9 @@
 //   SB-1, not cases/sb1.toml): 40 draws, per kind two single effects, two in several places at
 //   once and one with a second effect of another kind; plus ten clean runs. Prints the matrix of
 //   true kind against first claimed kind, the ambiguous and clean-claimed counts and after/before
-//   where right, and checks issue 16's targets.
+//   where right, and checks issue 16's targets. TT_CONFUSION_DRAWS="8,11" runs only those draws
+//   (no clean runs); a right draw over 0.3 prints the declared model's own floor for it (the
+//   declared case with the truth's effects declared exactly, against the noise-free truth).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
