@@ -299,15 +299,27 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
   // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
   // grids around the best ones, and the choice made again with those candidates, so that the
   // noise rule and the ranking see them too.
+  // A heat input that is not the first claim is refined too (when the first has nothing to
+  // refine); its places are scored with the other claims' fits removed, so that an offset sensor
+  // or an air does not pull them.
   std::optional<Catalogue> refined;
   if (!res.selection.claimed.empty()) {
-    const Candidate& first = train.candidates[res.selection.claimed.front().candidate];
-    if (first.kind == EffectKind::heat_input && o.heat_refine_levels > 0)
-      refined = with_refined_heat_inputs(model, train, o);
-    else if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
+    const std::vector<EffectFit>& claimed = res.selection.claimed;
+    const Candidate& first = train.candidates[claimed.front().candidate];
+    const auto heat = std::find_if(claimed.begin(), claimed.end(), [&](const EffectFit& f) {
+      return f.kind == EffectKind::heat_input;
+    });
+    const bool heat_first = first.kind == EffectKind::heat_input;
+    if (first.kind == EffectKind::sensor_lag && o.lag_refine_steps > 1)
       refined = with_refined_lag(train, first.sensor, first.time_constant, o);
     else if (first.kind == EffectKind::speed_dependent_convection && !o.speed_exponent_grid.empty())
-      refined = with_speed_exponents(model, train, res.selection.claimed.front().candidate, o);
+      refined = with_speed_exponents(model, train, claimed.front().candidate, o);
+    else if ((heat_first || heat != claimed.end()) && o.heat_refine_levels > 0) {
+      std::vector<EffectFit> others;
+      for (auto it = claimed.begin(); it != claimed.end(); ++it)
+        if (it != heat) others.push_back(*it);
+      refined = with_refined_heat_inputs(model, train, o, others);
+    }
     if (refined) res.selection = select_effects(*refined, o, resizer(*refined));
   }
   const Catalogue& cat = refined ? *refined : train;

@@ -933,6 +933,32 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
   return fits;
 }
 
+/// The whitened residuals `ys` with the in-sample fit of each claim in `fits` removed, in order: a
+/// shared claim at its fitted parameters, a per-run air fitted again on what is left of each run,
+/// a lag at its amplitude 1.
+std::vector<Eigen::VectorXd> without_fits(const Catalogue& cat, const std::vector<Whitened>& ws,
+                                          std::vector<Eigen::VectorXd> ys,
+                                          const Eigen::VectorXd& sigma,
+                                          const std::vector<EffectFit>& fits,
+                                          const CalibrationOptions& o) {
+  for (const EffectFit& f : fits) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+      const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sigma);
+      Eigen::VectorXd th;
+      if (c.fixed)
+        th = Eigen::VectorXd::Ones(1);
+      else if (c.per_run)
+        th = per_run_theta(c, cat.runs[ri], a.transpose() * a, a.transpose() * ys[ri], o);
+      else
+        th = Eigen::Map<const Eigen::VectorXd>(f.parameters.data(),
+                                               static_cast<Eigen::Index>(f.parameters.size()));
+      ys[ri] -= a * th;
+    }
+  }
+  return ys;
+}
+
 /// sqrt(#runs) x the standard deviation of the per-run held-out gain differences of a and b: how
 /// much their score difference could change with other runs. With two runs it exceeds the
 /// difference exactly when b gains more than a on one of them.
@@ -1032,10 +1058,33 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
     if (static_cast<int>(pool.size()) >= o.pair_pool) break;
   }
   std::vector<PairFit> pairs;
+  std::set<std::pair<int, int>> scored;
+  auto add_pair = [&](int a, int b) {
+    if (a == b || !scored.insert({std::min(a, b), std::max(a, b)}).second) return;
+    pairs.push_back(pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)],
+                             fits[static_cast<size_t>(b)], sel.null_score, o));
+  };
   for (size_t x = 0; x < pool.size(); ++x)
-    for (size_t y = x + 1; y < pool.size(); ++y)
-      pairs.push_back(pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(pool[x])],
-                               fits[static_cast<size_t>(pool[y])], sel.null_score, o));
+    for (size_t y = x + 1; y < pool.size(); ++y) add_pair(pool[x], pool[y]);
+  // Each pool member's best partner over the whole catalogue, found on the residual with the
+  // member's fit removed: a partner that the first round ranks low because another candidate took
+  // part of the member's signal (a heat input at its true place, behind patches near an offset
+  // sensor that explain the offset as heat) is scored with it jointly too.
+  for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
+    const int a = pool[x];
+    std::vector<EffectFit> given =
+        score_all(cat, ws, without_fits(cat, ws, ys, sel.sigma, {fits[static_cast<size_t>(a)]}, o),
+                  sel.sigma, o, true);
+    int best_partner = -1;
+    for (const EffectFit& f : given) {
+      const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+      if (f.candidate == a || c.per_run || c.fixed || f.score <= 0) continue;
+      if (best_partner >= 0 && f.score <= given[static_cast<size_t>(best_partner)].score) continue;
+      if (!unphysical_reason(c, f.parameters, {}, cat.runs, o).empty()) continue;
+      best_partner = f.candidate;
+    }
+    if (best_partner >= 0) add_pair(a, best_partner);
+  }
   std::sort(pairs.begin(), pairs.end(),
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
   const auto best =
@@ -1093,13 +1142,15 @@ void distinguishing_channel(const Catalogue& cat, const Eigen::VectorXd& sigma, 
 }  // namespace
 
 Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat,
-                                   const CalibrationOptions& o) {
+                                   const CalibrationOptions& o,
+                                   const std::vector<EffectFit>& others) {
   Catalogue out = cat;
   if (out.runs.empty()) return out;
   const core::CaseSpec& spec = out.runs.front().spec;
   const mesh::TetMesh& m = model.mesh();
   const Eigen::VectorXd sigma = noise_sigma(out.runs, out.readout.sensors, o);
-  const auto [ws, ys] = whitened_runs(out.runs, sigma);
+  const auto [ws, all] = whitened_runs(out.runs, sigma);
+  const std::vector<Eigen::VectorXd> ys = without_fits(out, ws, all, sigma, others, o);
   const ExteriorFaces ext = exterior_faces(m);
   const double half = o.patch_half_size * o.heat_refine_half_scale;
   std::set<std::pair<std::string, std::vector<int>>> seen;
@@ -1259,11 +1310,14 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
   }
   std::vector<Eigen::VectorXd> current = ys;
   const double total = sel.residual_ss;
-  std::vector<EffectFit> first_fits;
-  std::vector<int> first_order;
-  for (int round = 0; round < o.max_effects; ++round) {
-    std::vector<EffectFit> fits = score_all(cat, ws, current, sel.sigma, o, true);
+  // Every candidate scored on the residual `left_of` (what the claims so far leave), with its
+  // floor and physical check; `order` ranks them by score.
+  std::vector<int> order;
+  auto evaluate = [&](const std::vector<Eigen::VectorXd>& left_of) {
+    std::vector<EffectFit> fits = score_all(cat, ws, left_of, sel.sigma, o, true);
     mark(fits);
+    double left = 0;
+    for (const auto& y : left_of) left += y.squaredNorm();
     for (auto& f : fits) {
       const Candidate& c = cat.candidates[f.candidate];
       const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
@@ -1271,16 +1325,25 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       for (const auto& w : ws)
         for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? allowance(ch) : 0.0;
       // explained_fraction relative to the whole training residual, not what is left of it.
-      double left = 0;
-      for (const auto& y : current) left += y.squaredNorm();
       f.explained_fraction *= total > 0 ? left / total : 0;
       f.unphysical =
           unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
     }
-    std::vector<int> order(fits.size());
+    order.resize(fits.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
     std::sort(order.begin(), order.end(),
               [&](int a, int b) { return fits[a].score > fits[b].score; });
+    return fits;
+  };
+  // The best physical candidate, claimed when it beats noise and floor and no candidate of
+  // another kind that would be claimed too comes within the spread of their per-run gains.
+  auto claimable = [&](const EffectFit& f) {
+    return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
+  };
+  std::vector<EffectFit> first_fits;
+  std::vector<int> first_order;
+  for (int round = 0; round < o.max_effects; ++round) {
+    std::vector<EffectFit> fits = evaluate(current);
     if (round == 0) {
       first_fits = fits;
       first_order = order;
@@ -1293,11 +1356,6 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
         if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
       }
     }
-    // The best physical candidate, claimed when it beats noise and floor and no candidate of
-    // another kind that would be claimed too comes within the spread of their per-run gains.
-    auto claimable = [&](const EffectFit& f) {
-      return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
-    };
     const auto best_at =
         std::find_if(order.begin(), order.end(), [&](int i) { return fits[i].unphysical.empty(); });
     if (best_at == order.end() || !claimable(fits[*best_at])) break;
@@ -1317,19 +1375,50 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     }
     sel.claimed.push_back(best);
     // Remove the claimed effect's in-sample fit before looking for the next one.
-    const Candidate& c = cat.candidates[best.candidate];
-    for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
-      const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sel.sigma);
-      Eigen::VectorXd th;
-      if (c.fixed)
-        th = Eigen::VectorXd::Ones(1);
-      else if (c.per_run)
-        th = per_run_theta(c, cat.runs[ri], a.transpose() * a, a.transpose() * current[ri], o);
-      else
-        th = Eigen::Map<const Eigen::VectorXd>(best.parameters.data(),
-                                               static_cast<Eigen::Index>(best.parameters.size()));
-      current[ri] -= a * th;
+    current = without_fits(cat, ws, std::move(current), sel.sigma, {best}, o);
+  }
+  // Backfitting: each claim's place and size chosen again among the candidates of its kind on the
+  // training residual with the other claims' fits removed, until no claim changes. A claim that
+  // took part of a later one's signal (a heat input placed where an offset sensor pulls it) is
+  // then placed where the rest of the data puts it, and every claim is sized beside the others,
+  // not before them. A claim is replaced only when its replacement scores above it by more than
+  // the noise threshold and the spread of their per-run gains (the ambiguity rule's margin). The
+  // kinds stay the one-after-the-other choice's: letting them change made claims of kinds that
+  // share a signal (an air, a heat law, a conductivity) swap from sweep to sweep, and put a
+  // conductivity first where an air and a heat law were true (docs/calibration.md, §3).
+  std::set<std::vector<int>> visited;
+  for (int sweep = 0; sweep < o.backfit_sweeps && sel.claimed.size() >= 2; ++sweep) {
+    bool changed = false;
+    std::vector<int> state;
+    for (const auto& f : sel.claimed) state.push_back(f.candidate);
+    if (!visited.insert(state).second) break;  // a cycle: keep where it is
+    for (size_t i = 0; i < sel.claimed.size(); ++i) {
+      std::vector<EffectFit> others;
+      for (size_t j = 0; j < sel.claimed.size(); ++j)
+        if (j != i) others.push_back(sel.claimed[j]);
+      const std::vector<EffectFit> fits = evaluate(without_fits(cat, ws, ys, sel.sigma, others, o));
+      const auto best_at = std::find_if(order.begin(), order.end(), [&](int k) {
+        return fits[static_cast<size_t>(k)].kind == sel.claimed[i].kind &&
+               claimable(fits[static_cast<size_t>(k)]) &&
+               std::none_of(others.begin(), others.end(), [&](const EffectFit& f) {
+                 return f.candidate == fits[static_cast<size_t>(k)].candidate;
+               });
+      });
+      if (best_at == order.end()) continue;  // nothing beats noise under the others: kept
+      const EffectFit* chosen = &fits[static_cast<size_t>(*best_at)];
+      const EffectFit& now = fits[static_cast<size_t>(sel.claimed[i].candidate)];
+      if (chosen->candidate != now.candidate && claimable(now) &&
+          chosen->score - now.score <=
+              std::max(sel.null_score, gain_spread(chosen->fold_gains, now.fold_gains)))
+        chosen = &now;
+      const EffectFit& best = *chosen;
+      if (best.candidate != sel.claimed[i].candidate) {
+        sel.backfit_replaced.push_back({sel.claimed[i].name, best.name});
+        changed = true;
+      }
+      sel.claimed[i] = best;
     }
+    if (!changed) break;
   }
   if (o.max_effects >= 2 && !first_fits.empty())
     choose_pair(cat, ws, ys, first_fits, first_order, sel, o);

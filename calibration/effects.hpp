@@ -8,6 +8,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calibration/model.hpp"
@@ -65,13 +66,20 @@ struct CalibrationOptions {
   double displacement_tolerance_m = 0.1e-6;  /// ... plus this [m]
   double noise_floor_K = 0.005, noise_floor_m = 0.01e-6;  /// least noise assumed per channel
   int null_trials = 10;                                   /// fits to pure noise for the threshold
-  int max_effects = 2;
+  int max_effects = 3;
+  /// Sweeps of backfitting after the one-after-the-other choice: each claim chosen again with
+  /// the other claims' fits removed from the training residual, until no claim changes.
+  int backfit_sweeps = 3;
   /// Candidates of the first round reported (best per kind and place): the several-places
   /// candidates and the pairs' pool need more than the eight that one place each gave.
   int ranking_size = 12;
   /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
   /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
   int pair_pool = 8, pair_pool_per_kind = 3;
+  /// ... and each of the first `pair_partner_searches` pool members with its best partner over
+  /// the whole catalogue on the residual the member leaves (one more scoring of the catalogue
+  /// each).
+  int pair_partner_searches = 8;
   std::uint64_t seed = 20260107;
   // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
   // that needs a value outside these to fit is reported as unphysical and never claimed.
@@ -174,12 +182,6 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
                     const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& options,
                     bool ambient_only = false, const solvers::Progress& progress = {});
 
-/// `cat` with heat-input candidates added on finer grids around its best heat-input places (scored
-/// on the training residual as select_effects scores them), marched like the catalogue's own: the
-/// grid's spacing bounds how well a place can be found, and a finer grid everywhere costs too much.
-Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat,
-                                   const CalibrationOptions& options);
-
 /// `cat` with lag candidates of `sensor` at `lag_refine_steps` time constants spaced
 /// geometrically between the grid values either side of `tau` [s]: the grid's step (up to 1.7x)
 /// leaves much of a lag's signal unexplained.
@@ -257,10 +259,21 @@ struct Selection {
   /// when the claims are the best admissible pair rather than the greedy choice.
   std::vector<PairFit> pairs;
   bool by_pair = false;
+  /// Claims that backfitting replaced (chosen again with the other claims' fits removed): the
+  /// one-after-the-other claim and what replaced it, in the order it happened.
+  std::vector<std::pair<std::string, std::string>> backfit_replaced;
   double null_score = 0;   /// best score over fits to pure noise
   Eigen::VectorXd sigma;   /// per channel noise estimate [K | m]
   double residual_ss = 0;  /// training residual, whitened
 };
+
+/// `cat` with heat-input candidates added on finer grids around its best heat-input places (scored
+/// on the training residual as select_effects scores them, with the in-sample fits of `others`,
+/// claims of `cat` beside the heat input, removed first), marched like the catalogue's own: the
+/// grid's spacing bounds how well a place can be found, and a finer grid everywhere costs too much.
+Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat,
+                                   const CalibrationOptions& options,
+                                   const std::vector<EffectFit>& others = {});
 
 /// Per channel white-noise level from second differences of the residuals (robust, pooled).
 Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,

@@ -380,7 +380,8 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
   const mesh::TetMesh own = relabel ? mesh::mesh_case(truth) : mesh::TetMesh{};
   const mesh::TetMesh& m = relabel ? own : mesh_in;
   const solvers::FullThermalSystem ops = solvers::thermal_system(m, truth);
-  const solvers::ThermalHistory th = solvers::thermal_history(m, truth, ops);
+  const solvers::ThermalHistory th =
+      solvers::thermal_history(m, truth, ops, {}, {}, {o.source_tolerance_K});
   io::MeasuredRun run;
   run.machine = truth.machine;
   // The mesh's extent: readers check every position against it (meta.json machine_box_m).

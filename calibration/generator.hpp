@@ -6,7 +6,8 @@
 // 0.8 (0.5-0.9 in several places), magnitudes are drawn from ranges that reach down to the
 // detection limit, and a mechanism may act in several places at once with its own size and law
 // in each, or two mechanisms at once. Heat that grows with temperature is simulated as such:
-// the stepper takes each source's power at its mean temperature of the step before.
+// each step is solved again with the sources' powers at the step's end until their mean
+// temperatures settle (GeneratorOptions::source_tolerance_K), not lagged by a step.
 #pragma once
 
 #include <Eigen/Core>
@@ -54,6 +55,10 @@ struct GeneratorOptions {
   double drift_temperature_K = 0.01;      /// slow correlated part (first-order, 600 s)
   double noise_displacement_m = 0.08e-6;  /// white noise per reading
   double quantum_temperature_K = 0.01, quantum_displacement_m = 0.01e-6;
+  /// Heat that grows with temperature, iterated within each step until no source's mean
+  /// temperature moves by more than this between two solves [K] (solvers::SourceIteration; 0:
+  /// lagged by one step, as `run` steps it).
+  double source_tolerance_K = 1e-6;
 };
 
 /// A random effect of `kind` on `declared` (sizes drawn by `rng` from the ranges of

@@ -202,9 +202,10 @@ FullThermalSystem thermal_system(const mesh::TetMesh& mesh, const core::CaseSpec
 
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                const FullThermalSystem& system, const Progress& progress,
-                               const Checkpointing& checkpointing) {
+                               const Checkpointing& checkpointing, const SourceIteration& sources) {
   StepperRequest request;
   request.record_times = output_times(spec);
+  request.sources = sources;
   SteppedHistory stepped = step_thermal(system, spec, request, progress, checkpointing);
   ThermalHistory hist;
   hist.times = std::move(stepped.times);

@@ -62,12 +62,26 @@ struct Checkpointing {
   const ThermalCheckpoint* resume = nullptr;
 };
 
+/// Heat that grows with temperature (a source's temperature_coefficient) within one step: by
+/// default (tolerance 0) each source's power is taken at its mean temperature at the step's
+/// start, i.e. lagged by one step. With a tolerance, the step is solved again with the powers at
+/// the step's end (and, for Crank–Nicolson, at its start for the start's half) until no source's
+/// mean temperature moves by more than `tolerance_K` between two solves (a fixed point on the
+/// step's factor: one back-substitution per iteration); more than `max_iterations` solves is a
+/// SolverError.
+struct SourceIteration {
+  double tolerance_K = 0;  /// 0: lagged by one step
+  int max_iterations = 30;
+};
+
 /// Integrates the transient from the uniform initial temperature (or from `checkpointing.resume`)
-/// to the duty cycle's end. Throws SolverError when the resume state does not fit the mesh and
-/// the case's time grid.
+/// to the duty cycle's end; heat that grows with temperature is lagged by one step unless
+/// `sources` asks for it to be iterated within each step (SourceIteration). Throws SolverError
+/// when the resume state does not fit the mesh and the case's time grid.
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                const FullThermalSystem& system, const Progress& progress = {},
-                               const Checkpointing& checkpointing = {});
+                               const Checkpointing& checkpointing = {},
+                               const SourceIteration& sources = {});
 
 /// Heat stored in the mesh at `temperature` relative to the uniform initial temperature [J]:
 /// quadrature of rho c (T - T0) over the elements.

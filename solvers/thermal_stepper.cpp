@@ -1,6 +1,7 @@
 #include "solvers/thermal_stepper.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -142,6 +143,48 @@ StepPlan step_plan(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>
   return p;
 }
 
+/// The step solved again with each temperature-dependent source's power at the step's end state
+/// (SourceIteration): a fixed point on the step's factor, since only the load moves. `rhs` is the
+/// right-hand side `next` was solved from; `p.s_new.power` ends at the powers of the last solve.
+/// Returns the number of solves (1 when no source depends on temperature).
+template <class Matrix>
+int iterate_sources(const core::CaseSpec& spec, const LinearThermalSystem<Matrix>& sys,
+                    const SourceIteration& it, const StepFactor<Matrix>& factor, double t_prev,
+                    double t, double t0_k, Eigen::VectorXd rhs, StepPlan& p,
+                    Eigen::VectorXd& next) {
+  const double dt = t - t_prev, weight = p.theta * dt;
+  const auto& sources = spec.thermal.sources;
+  const bool any = std::any_of(sources.begin(), sources.end(), [](const core::HeatSource& s) {
+    return s.temperature_coefficient != 0;
+  });
+  if (!any) return 1;
+  for (int solves = 1;; ++solves) {
+    const LoadState s = load_state(spec, sys, 0.5 * (t_prev + t), t, next, t0_k);
+    Eigen::VectorXd previous = next;
+    for (size_t k = 0; k < s.power.size(); ++k)
+      rhs += (weight * (s.power[k] - p.s_new.power[k])) * sys.source_shape[k];
+    p.s_new.power = s.power;
+    next = rhs;
+    factor.solve_in_place(next);
+    double moved = 0;
+    for (size_t k = 0; k < sources.size(); ++k)
+      if (sources[k].temperature_coefficient != 0)
+        moved = std::max(moved, std::abs(sys.source_shape[k].dot(next - previous)));
+    if (moved <= it.tolerance_K) return solves + 1;
+    if (solves + 1 >= it.max_iterations) {
+      std::ostringstream o;
+      o << spec.source.string() << ": the heat that grows with temperature did not settle within "
+        << it.max_iterations << " solves of the step ending at t = " << t
+        << " s (a source's mean temperature still moved by " << moved << " K, tolerance "
+        << it.tolerance_K
+        << " K). Hint: a temperature_coefficient_per_K times the source's power beyond what the "
+           "films and the step can carry away makes the heat run away; check the coefficient or "
+           "shorten thermal.step_s";
+      throw core::SolverError(o.str());
+    }
+  }
+}
+
 /// Heat rate leaving through every film [W]: h (int T dA - T_sink int dA).
 template <class Matrix>
 double convected_rate(const LinearThermalSystem<Matrix>& sys, const std::vector<double>& area,
@@ -210,6 +253,11 @@ void check_request(const LinearThermalSystem<Matrix>& sys, const StepperRequest&
       throw core::SolverError("thermal stepper: record time " + std::to_string(q.record_times[k]) +
                               " s is not after the one before it or beyond the end (" +
                               std::to_string(end) + " s): expected ascending times in (0, end]");
+  if (!(q.sources.tolerance_K >= 0) || q.sources.max_iterations < 2)
+    throw core::SolverError(
+        "thermal stepper: the sources' iteration needs a tolerance >= 0 K (got " +
+        std::to_string(q.sources.tolerance_K) + ") and at least 2 solves (got " +
+        std::to_string(q.sources.max_iterations) + ")");
   for (const auto& c : q.shape_columns)
     if (c.shape.size() != n || !c.law)
       throw core::SolverError("thermal stepper: a shape column has " +
@@ -428,8 +476,7 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
   Dense block_new;
   for (size_t i = first_step; i < grid.size(); ++i) {
     const double t = grid[i], dt = t - t_prev;
-    const StepPlan p =
-        step_plan(spec, sys, t_prev, t, i == 0 ? std::nan("") : prev_speed, temp, t0_k);
+    StepPlan p = step_plan(spec, sys, t_prev, t, i == 0 ? std::nan("") : prev_speed, temp, t0_k);
     const LoadState& s_new = p.s_new;
     const bool cn = p.theta != 1;
     const double theta = p.theta;
@@ -443,6 +490,10 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
     Eigen::VectorXd next = rhs;
     factor.solve_in_place(next);
+    if (q.sources.tolerance_K > 0 && next.allFinite())
+      hist.source_iterations =
+          std::max(hist.source_iterations,
+                   iterate_sources(spec, sys, q.sources, factor, t_prev, t, t0_k, rhs, p, next));
     if (!next.allFinite()) throw non_finite_temperature(spec, s_new, next, i, t);
 
     if (nc > 0)

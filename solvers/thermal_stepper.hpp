@@ -59,6 +59,7 @@ struct StepperRequest {
   std::vector<ShapeColumn> shape_columns;  /// responses, first in `responses`
   std::vector<LoadCallback> load_columns;  /// responses, after the shape columns
   StateReadout column_readout;             /// rows read from every response column
+  SourceIteration sources;                 /// heat that grows with temperature within a step
 };
 
 /// The stepper's result.
@@ -71,6 +72,8 @@ struct SteppedHistory {
   double heat_in = 0;                      /// from the step loads over the steps [J]
   double lost = 0;                         /// through the films over the steps [J]
   ThermalTimings timings;                  /// assemble_s stays 0
+  /// Most solves of one step with request.sources' iteration (1: no source moved the step).
+  int source_iterations = 0;
 };
 
 /// Steps `system` under `spec`'s duty cycle, feed axis, sinks and fluxes from the uniform

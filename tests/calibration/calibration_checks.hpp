@@ -18,6 +18,7 @@ struct Outcome {
   double before = 0, after = 0;  /// test-run RMS against the noise-free truth [um, or K]
   std::string units;
   CalibrationResult result;
+  io::MeasuredRun truth;  /// the test run's noise-free readings
 };
 
 /// Generates the draw `effects` (the first is the one judged for place), calibrates with them
@@ -51,6 +52,11 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
         res.selection.ranking[k].floor, res.selection.ranking[k].explained_fraction,
         res.selection.ranking[k].parameters.empty() ? 0.0 : res.selection.ranking[k].parameters[0],
         res.selection.ranking[k].unphysical.c_str());
+  for (const auto& c : res.selection.claimed)
+    std::printf("[calibration]   claimed: %s score %.1f floor %.1f p0 %.4g\n", c.name.c_str(),
+                c.score, c.floor, c.parameters.empty() ? 0.0 : c.parameters[0]);
+  for (const auto& [was, now] : res.selection.backfit_replaced)
+    std::printf("[calibration]   backfit: %s replaced by %s\n", was.c_str(), now.c_str());
   for (const auto& a : res.selection.ambiguous)
     std::printf("[calibration]   ambiguous: %s / %s (difference %.1f, spread %.1f)\n",
                 a.first.name.c_str(), a.second.name.c_str(), a.difference, a.spread);
@@ -82,7 +88,32 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   out.after = after;
   out.units = sensor_kind ? "K" : "um";
   out.result = res;
+  out.truth = truth;
   return out;
+}
+
+/// The declared model's own floor for a draw: the test run simulated by the declared case (its
+/// mesh and step) with the truth's effects declared exactly, against the noise-free truth, as a
+/// share of the declared case without them (RMS at the TCP, or over the sensors for sensor kinds).
+/// No claim of the right kind and size can be expected below it.
+inline double floor_ratio(const Study& s, const InjectedEffects& effects,
+                          const io::MeasuredRun& truth_run, bool sensor_kind) {
+  const Readout& r = s.train.readout;
+  core::CaseSpec with = truth_case(s.declared, effects, s.duties[2], 2);
+  core::CaseSpec without = truth_case(s.declared, InjectedEffects{}, s.duties[2], 2);
+  with.thermal.output_interval = without.thermal.output_interval = s.declared.thermal.step;
+  const Eigen::MatrixXd truth = measured_channels(truth_run, r);
+  const auto rms = [&](const io::MeasuredRun& run) {
+    const RmsFigures f = rms_figures({truth}, {measured_channels(run, r)}, r.sensors);
+    return sensor_kind ? f.temperature_rms_K : f.displacement_rms_um;
+  };
+  const double at = rms(clean_run(s.mesh, with, effects, s.inst, s.gopt, "floor"));
+  const double before = rms(clean_run(s.mesh, without, InjectedEffects{}, s.inst, s.gopt, "none"));
+  std::printf(
+      "[calibration] declared model with the truth's effects: %.4g against %.4g without "
+      "(floor after/before %.3f)\n",
+      at, before, before > 0 ? at / before : 0.0);
+  return before > 0 ? at / before : 0.0;
 }
 
 /// One effect kind: generate, calibrate with it undeclared, check kind, place and the test-run RMS

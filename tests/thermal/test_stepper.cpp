@@ -4,6 +4,7 @@
 // moves with the feed axis and a feed_power source.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -12,6 +13,7 @@
 #include "mesh/mesher.hpp"
 #include "solvers/loads.hpp"
 #include "solvers/thermal_stepper.hpp"
+#include "tests/common/case_toml.hpp"
 #include "tests/common/gantry_bar.hpp"
 
 namespace tt::solvers {
@@ -102,6 +104,66 @@ TEST(Stepper, RefusesRecordTimesOutOfOrderAndColumnsOfAnotherSize) {
   EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
   q.shape_columns.clear();
   EXPECT_EQ(step_thermal(sys, spec, q).times, (std::vector<double>{0.0, 60.0}));
+}
+
+/// A steel block heated by a 20 W source whose heat grows by 2 %/K with its mean temperature
+/// (about 25 K in 20 min: the heat grows by half).
+core::CaseSpec warming_block(const std::string& scheme) {
+  std::string t = test_toml::header("warming block") + test_toml::steel();
+  t += test_toml::box_body("block", "steel", "0.025", "[0.0, 0.0, 0.0]", "[0.1, 0.05, 0.05]");
+  t += "[mesh]\norder = 1\n[mechanical]\nenabled = false\n";
+  t += "[[boundary]]\nname = \"all\"\nrest = true\nselect = [ {} ]\n";
+  t += "[thermal]\nscheme = \"" + scheme + "\"\nstep_s = 20.0\noutput_interval_s = 60.0\n";
+  t += "[[thermal.convection]]\ngroup = \"all\"\nh_W_m2K = 10.0\nsink_degC = 20.0\n";
+  t += "[[thermal.heat_sources]]\nname = \"bearing\"\nbody = \"block\"\nlaw = \"constant\"\n"
+       "power_ref_W = 20.0\ntemperature_coefficient_per_K = 0.02\n";
+  t += "[duty_cycle]\nend_s = 1200.0\nsegments = [ { start_s = 0.0, speed_rpm = 0.0 } ]\n";
+  return io::case_from_toml(t, "block.toml");
+}
+
+// Heat that grows with temperature, iterated to consistency within each step (SourceIteration):
+// it settles in a few solves, and differs from the step-lagged law by a first-order amount (half
+// at half the step), small against the source's rise and of the sign of the lag (the lagged
+// power is the cooler step's, so the lagged block stays cooler).
+TEST(Stepper, HeatGrowingWithTemperatureIteratedWithinTheStep) {
+  for (const char* scheme : {"backward_euler", "crank_nicolson"}) {
+    core::CaseSpec spec = warming_block(scheme);
+    const mesh::TetMesh m = mesh::mesh_case(spec);
+    const FullThermalSystem sys = thermal_system(m, spec);
+    const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
+    int most_solves = 0;
+    const auto rise = [&](double step, double tolerance) {
+      spec.thermal.step = step;
+      StepperRequest q;
+      q.record_times = {spec.duty_cycle.end};
+      q.sources.tolerance_K = tolerance;
+      const SteppedHistory h = step_thermal(sys, spec, q);
+      if (tolerance > 0) most_solves = std::max(most_solves, h.source_iterations);
+      return sys.source_shape[0].dot(h.final_state) - t0_k;
+    };
+    const double lagged20 = rise(20, 0), iterated20 = rise(20, 1e-9);
+    const double lagged10 = rise(10, 0), iterated10 = rise(10, 1e-9);
+    const double d20 = iterated20 - lagged20, d10 = iterated10 - lagged10;
+    std::printf(
+        "[stepper] %s: source's rise %.4f K iterated, %.4f K lagged at 20 s (difference %.2e K), "
+        "%.2e K at 10 s; at most %d solves a step\n",
+        scheme, iterated20, lagged20, d20, d10, most_solves);
+    EXPECT_GT(iterated20, 15) << scheme;
+    EXPECT_GT(d20, 0) << scheme;
+    EXPECT_LT(d20, 0.03 * iterated20) << scheme;
+    EXPECT_NEAR(d10 / d20, 0.5, 0.1) << scheme;
+    EXPECT_GE(most_solves, 2) << scheme;
+    EXPECT_LE(most_solves, 8) << scheme;
+  }
+  // A step that has not settled within the solves allowed is an error, not a silent result.
+  core::CaseSpec spec = warming_block("backward_euler");
+  const mesh::TetMesh m = mesh::mesh_case(spec);
+  const FullThermalSystem sys = thermal_system(m, spec);
+  StepperRequest q;
+  q.sources = {1e-300, 2};
+  EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
+  q.sources = {-1, 30};
+  EXPECT_THROW(step_thermal(sys, spec, q), core::SolverError);
 }
 
 }  // namespace
