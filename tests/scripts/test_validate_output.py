@@ -34,6 +34,7 @@ for schema in sorted((root / "docs" / "schemas").glob("*.schema.json")):
 observer = {"case": "c", "consistency": {"probability": 0.999, "sustain_s": 900.0, "window_s": 1800.0},
             "model": {"kind": "reduced", "order": 84, "rom": "rom"},
             "noise": {"air_walk_K_per_sqrt_h": 0.5, "drift_relative_sigma": 0.04,
+                      "drift_sigma_scale": [1.0, 1.0, 1.0],
                       "heat_walk_W_per_sqrt_h": 4.0, "sensor_sigma_K": [0.04]},
             "recalibrate_raised_s": None, "recalibrate_since_s": None, "run": "r",
             "sensors": ["T02"], "status": "ok",
