@@ -16,6 +16,7 @@
 #include "app/study.hpp"
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/csv_out.hpp"
@@ -25,13 +26,11 @@
 #include "solvers/twin.hpp"
 
 namespace tt::app {
+
+using core::seconds_since;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 std::string file_name(const std::string& run) {
   std::string s;

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "app/commands.hpp"
+#include "core/timing.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/csv_out.hpp"
@@ -21,13 +22,11 @@
 #include "solvers/twin.hpp"
 
 namespace tt::app {
+
+using core::seconds_since;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 nlohmann::json validation_json(const std::vector<solvers::TwinComparison>& table) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& c : table) {

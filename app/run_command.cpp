@@ -7,6 +7,7 @@
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/checkpoint.hpp"
@@ -16,13 +17,11 @@
 #include "studies/virtual_run.hpp"
 
 namespace tt::app {
+
+using core::seconds_since;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
 }  // namespace
 
 void report_progress(const std::string& stage, double done, double total) {

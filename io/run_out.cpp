@@ -2,6 +2,7 @@
 
 #include <cstdint>
 
+#include "core/timing.hpp"
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/axis_out.hpp"
@@ -15,11 +16,9 @@
 #include "solvers/loads.hpp"
 
 namespace tt::io {
-namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using core::seconds_since;
+namespace {
 
 /// temperatures.csv: time_s, then <id>_degC per named point.
 void write_temperatures(const mesh::TetMesh& mesh, const solvers::ThermalHistory& th,

@@ -6,17 +6,12 @@
 
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
+#include "core/timing.hpp"
 #include "placement/series.hpp"
 
 namespace tt::placement {
 
-namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
+using core::seconds_since;
 
 LinearProblem linear_problem(const Eigen::MatrixXd& temperatures, const Eigen::VectorXd& error) {
   if (temperatures.rows() != error.size() || error.size() < 3)

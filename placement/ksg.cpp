@@ -9,9 +9,12 @@
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
 #include "core/rng.hpp"
+#include "core/timing.hpp"
 #include "placement/random.hpp"
 
 namespace tt::placement {
+
+using core::seconds_since;
 
 namespace {
 
@@ -65,10 +68,6 @@ std::vector<double> rows_of(const Eigen::MatrixXd& m, std::span<const int> colum
   for (Eigen::Index s = 0; s < m.rows(); ++s)
     for (std::size_t c = 0; c < d; ++c) out[static_cast<std::size_t>(s) * d + c] = m(s, columns[c]);
   return out;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 /// Best admissible entry of `score` (ties to the lower pool position), or -1.

@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "core/timing.hpp"
 #include "placement/baselines.hpp"
 #include "placement/gaussian.hpp"
 #include "placement/histogram_mi.hpp"
@@ -19,13 +20,11 @@
 
 namespace tt::placement {
 
+using core::seconds_since;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 void validate(const PlacementInput& in, const PlacementOptions& o) {
   const auto n = static_cast<Eigen::Index>(in.ids.size());

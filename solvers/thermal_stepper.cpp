@@ -13,20 +13,19 @@
 
 #include "core/errors.hpp"
 #include "core/limits.hpp"
+#include "core/timing.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
 #include "solvers/feed_axis.hpp"
 #include "solvers/loads.hpp"
 
 namespace tt::solvers {
+
+using core::seconds_since;
 namespace {
 
 using Clock = std::chrono::steady_clock;
 using Sparse = Eigen::SparseMatrix<double>;
 using Dense = Eigen::MatrixXd;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 /// The solve of C + theta dt A: CHOLMOD for the sparse system, a dense Cholesky for a reduced one.
 template <class Matrix>
