@@ -118,10 +118,6 @@ placement::PlacementResult placed_on(const std::vector<fitting::Group>& groups,
   return placement::place_all(in, options);
 }
 
-nlohmann::json finite_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 double rms(const Eigen::VectorXd& r) {
   return r.size() ? std::sqrt(r.squaredNorm() / static_cast<double>(r.size())) : std::nan("");
 }
@@ -329,9 +325,9 @@ int fit_data_command(const FitDataArgs& args) {
                                       .validation)) *
                               1e6)
              : nlohmann::json(nullptr)},
-        {"gain_over_no_compensation_um2", finite_or_null(e.selection.gain_over_none * 1e12)},
+        {"gain_over_no_compensation_um2", io::finite_or_null(e.selection.gain_over_none * 1e12)},
         {"gain_over_no_compensation_standard_error_um2",
-         finite_or_null(e.selection.gain_over_none_standard_error * 1e12)},
+         io::finite_or_null(e.selection.gain_over_none_standard_error * 1e12)},
         {"test_s_um", nlohmann::json::array()},
         {"test_sm_um", e.test.sm * 1e6},
         {"test_s_sigma_um", std::isfinite(e.test.s_sigma) ? nlohmann::json(e.test.s_sigma * 1e6)

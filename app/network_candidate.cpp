@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "io/reports.hpp"
+
 namespace tt::app {
 
 fitting::ModelSpec driver_network_spec(std::uint64_t seed, const std::string& sensor_method,
@@ -115,9 +117,7 @@ std::optional<NetworkFigures> network_figures(const fitting::Evaluation& e,
 
 nlohmann::json network_json(const NetworkFigures& n) {
   const auto& net = std::get<torchnet::Network>(n.model.body);
-  const auto um = [](double v) {
-    return std::isfinite(v) ? nlohmann::json(v * 1e6) : nlohmann::json(nullptr);
-  };
+  const auto um = [](double v) { return io::finite_or_null(v, 1e6); };
   nlohmann::json test_s = nlohmann::json::array();
   for (double s : n.test.s) test_s.push_back(s * 1e6);
   return {{"model", fitting::model_label(n.model.spec)},

@@ -15,10 +15,6 @@ namespace {
 using nlohmann::json;
 constexpr double um = 1e6;  // metres to micrometres
 
-json finite_or_null(double value, double scale = 1.0) {
-  return std::isfinite(value) ? json(value * scale) : json(nullptr);
-}
-
 json effect_json(const fitting::Effect& e, const studies::ChannelCalibration& ch,
                  const std::vector<std::string>& sensor_names) {
   const fitting::TermModel& with = ch.study.after;

@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
+#include "io/reports.hpp"
 
 namespace tt::io {
 
@@ -37,14 +38,9 @@ using nlohmann::json;
 constexpr double um = 1e6;  // metres to micrometres
 constexpr double mm = 1e3;  // metres to millimetres
 
-/// NaN and infinities become null, so the file stays valid JSON that says "not defined".
-json number(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
-
 json vector_json(const Eigen::VectorXd& v, double factor = 1.0) {
   json list = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) list.push_back(number(v(i) * factor));
+  for (Eigen::Index i = 0; i < v.size(); ++i) list.push_back(finite_or_null(v(i) * factor));
   return list;
 }
 
@@ -52,9 +48,11 @@ json vector_json(const Eigen::VectorXd& v, double factor = 1.0) {
 json accuracy_json(const fitting::Accuracy& a, const std::vector<std::string>& groups) {
   json s = json::object();
   for (std::size_t g = 0; g < a.s.size() && g < groups.size(); ++g)
-    s[groups[g]] = number(a.s[g] * um);
+    s[groups[g]] = finite_or_null(a.s[g] * um);
   if (a.s.empty()) return json{{"S_um", s}, {"SM_um", nullptr}, {"S_sigma_um", nullptr}};
-  return json{{"S_um", s}, {"SM_um", number(a.sm * um)}, {"S_sigma_um", number(a.s_sigma * um)}};
+  return json{{"S_um", s},
+              {"SM_um", finite_or_null(a.sm * um)},
+              {"S_sigma_um", finite_or_null(a.s_sigma * um)}};
 }
 
 json settings_json(const fitting::ModelSpec& spec) {
@@ -199,8 +197,8 @@ json model_json(const FittedModel& model) {
     for (std::size_t k = 0; k < names.size(); ++k)
       terms.push_back(
           {{"name", names[k]},
-           {"um_per_K", number(linear->coefficients(static_cast<Eigen::Index>(k)) * um)}});
-    j["intercept_um"] = number(linear->intercept * um);
+           {"um_per_K", finite_or_null(linear->coefficients(static_cast<Eigen::Index>(k)) * um)}});
+    j["intercept_um"] = finite_or_null(linear->intercept * um);
     j["terms"] = terms;
     return j;
   }
@@ -225,15 +223,16 @@ json model_json(const FittedModel& model) {
         for (std::size_t c = 0; c < names.size(); ++c)
           terms.push_back(
               {{"name", names[c]},
-               {"um_per_K", number(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
-        outputs.push_back({{"intercept_um", number(skip->intercept(k) * um)}, {"terms", terms}});
+               {"um_per_K", finite_or_null(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
+        outputs.push_back(
+            {{"intercept_um", finite_or_null(skip->intercept(k) * um)}, {"terms", terms}});
       }
       j["linear_skip"] = outputs;
     }
     j["training"] = {{"epochs", r.epochs},
                      {"best_epoch", r.best_epoch},
-                     {"validation_loss_standardised", number(r.validation_loss)},
-                     {"seconds", number(r.seconds)},
+                     {"validation_loss_standardised", finite_or_null(r.validation_loss)},
+                     {"seconds", finite_or_null(r.seconds)},
                      {"time_budget_reached", r.budget_reached},
                      {"training_windows", r.training_windows},
                      {"validation_windows", r.validation_windows}};
@@ -249,14 +248,14 @@ json model_json(const FittedModel& model) {
   j["inputs"] = fitting::feature_names(model.features);
   j["input_center_K"] = vector_json(ppr.center);
   j["input_scale_K"] = vector_json(ppr.scale);
-  j["mean_um"] = number(ppr.mean * um);
+  j["mean_um"] = finite_or_null(ppr.mean * um);
   json ridges = json::array();
   for (const fitting::RidgeFunction& r : ppr.terms)
     ridges.push_back({{"direction", vector_json(r.direction)},
-                      {"z_low", number(r.z_low)},
-                      {"z_high", number(r.z_high)},
+                      {"z_low", finite_or_null(r.z_low)},
+                      {"z_high", finite_or_null(r.z_high)},
                       {"polynomial_um", vector_json(r.polynomial, um)},
-                      {"r_squared", number(r.r_squared)},
+                      {"r_squared", finite_or_null(r.r_squared)},
                       {"cluster_size", r.cluster_size}});
   j["ridge_functions"] = ridges;
   j["note"] =
@@ -298,11 +297,11 @@ json fit_json(const std::vector<Evaluation>& evaluations,
       rows.push_back({{"method", r.method},
                       {"m", r.m},
                       {"model", r.model},
-                      {"validation_SM_um", number(r.validation_sm * um)},
-                      {"test_SM_um", number(r.test_sm * um)},
-                      {"test_S_sigma_um", number(r.test_s_sigma * um)}});
+                      {"validation_SM_um", finite_or_null(r.validation_sm * um)},
+                      {"test_SM_um", finite_or_null(r.test_sm * um)},
+                      {"test_S_sigma_um", finite_or_null(r.test_s_sigma * um)}});
     counts.push_back({{"target", t.target_name},
-                      {"required_SM_um", number(t.required_sm * um)},
+                      {"required_SM_um", finite_or_null(t.required_sm * um)},
                       {"rows", rows},
                       {"smallest_m_by_validation", t.smallest_m_validation},
                       {"smallest_m_by_test", t.smallest_m_test}});
@@ -342,9 +341,10 @@ json modelling_record_json(const ModellingConditions& c,
         {"travel_mm", {{"x", c.travel_x * mm}, {"y", c.travel_y * mm}, {"z", c.travel_z * mm}}}}},
       {"modelling_date", c.modelling_date},
       {"initial_ambient_temperature_degC",
-       number(c.initial_ambient_temperature - core::kCelsiusOffset)},
-      {"max_spindle_speed_rpm", number(c.max_spindle_speed * 60.0 / (2.0 * std::numbers::pi))},
-      {"max_feed_rate_mm_per_min", number(c.max_feed_rate * mm * 60.0)},
+       finite_or_null(c.initial_ambient_temperature - core::kCelsiusOffset)},
+      {"max_spindle_speed_rpm",
+       finite_or_null(c.max_spindle_speed * 60.0 / (2.0 * std::numbers::pi))},
+      {"max_feed_rate_mm_per_min", finite_or_null(c.max_feed_rate * mm * 60.0)},
       {"models", models},
       {"compensation",
        "the CNC shifts the work origin by minus the predicted error; refresh the model each "
@@ -353,9 +353,9 @@ json modelling_record_json(const ModellingConditions& c,
     j["cutting"] = {{"tool", c.cutting->tool},
                     {"workpiece_material", c.cutting->workpiece_material},
                     {"workpiece_size", c.cutting->workpiece_size},
-                    {"cutting_speed_m_per_min", number(c.cutting->cutting_speed * 60.0)},
-                    {"feed_mm_per_rev", number(c.cutting->feed * mm)},
-                    {"depth_of_cut_mm", number(c.cutting->depth_of_cut * mm)}};
+                    {"cutting_speed_m_per_min", finite_or_null(c.cutting->cutting_speed * 60.0)},
+                    {"feed_mm_per_rev", finite_or_null(c.cutting->feed * mm)},
+                    {"depth_of_cut_mm", finite_or_null(c.cutting->depth_of_cut * mm)}};
   return j;
 }
 

@@ -29,10 +29,6 @@ Eigen::VectorXd stacked_residual(const fitting::TermModel& m,
   return r;
 }
 
-double rms(const Eigen::VectorXd& r) {
-  return r.size() ? std::sqrt(r.squaredNorm() / static_cast<double>(r.size())) : 0.0;
-}
-
 /// The test segments laid end to end: time on one axis (each segment 1 s after the previous
 /// one's end) [s], time since the segment's start [s], speed [rpm] and temperature rises [K].
 struct TestAxes {
@@ -101,7 +97,8 @@ ChannelCalibration channel_calibration(const DataCalibrationInput& in,
     prefix.push_back(effect.term);
     const auto model =
         fitting::fitted_term_model(training, target, ch.study.before.baseline, prefix);
-    ch.test_rms_with_effects_so_far.push_back(rms(stacked_residual(model, in.testing)));
+    ch.test_rms_with_effects_so_far.push_back(
+        core::error_figures(stacked_residual(model, in.testing)).rms);
   }
   ch.correlations_before = correlations(ch.before, axes, in.has_speed, false);
   ch.correlations_after = correlations(ch.after, axes, in.has_speed, true);
