@@ -12,7 +12,7 @@ namespace tt::app {
 
 Histories histories_from_run(const std::filesystem::path& dir) {
   const core::CaseSpec spec = io::read_case(dir / "case.resolved.toml");
-  const bool surface = spec.placement.candidates == core::PlacementSpec::Candidates::surface;
+  const bool surface = spec.placement.surface();
   const std::filesystem::path temps_file =
       dir / (surface ? io::kCandidateTemperaturesCsv : "temperatures.csv");
   if (surface &&

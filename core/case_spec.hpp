@@ -205,6 +205,8 @@ struct PlacementSpec {
   std::vector<int> bodies;  /// surface: exterior faces of these bodies' tets
   std::vector<int> groups;  /// surface: faces of these boundary groups
   int max_candidates = 0;   /// surface: > 0 thins the vertices to this many, spread out
+  /// The candidates are surface vertices (and their histories are candidate_temperatures.csv).
+  bool surface() const { return candidates == Candidates::surface; }
 };
 
 struct CaseSpec {

@@ -1274,7 +1274,7 @@ void read_placement(const Tab& root, CaseSpec& spec) {
   p.allow({"candidates", "points", "bodies", "groups", "max_candidates"});
   auto& pl = spec.placement;
   pl.candidates = choice_or<Candidates>(p, "candidates", pl.candidates, kCandidateKinds);
-  const bool surface = pl.candidates == Candidates::surface;
+  const bool surface = pl.surface();
   const auto& me = spec.mechanical;
   if (const auto* a = p.get("points")) {
     const auto idx = references(c, *a, p.at("points"), point_ids(spec), "point");
@@ -1575,7 +1575,7 @@ std::string outputs_toml(const CaseSpec& spec, const Names& bodies, const Names&
   const auto& pl = spec.placement;
   o << "\n[placement]\ncandidates = " << toml_string(name_of(kCandidateKinds, pl.candidates))
     << "\npoints = " << strings_text(pl.points) << "\n";
-  if (pl.candidates == core::PlacementSpec::Candidates::surface)
+  if (pl.surface())
     o << "bodies = " << names_text(pl.bodies, bodies)
       << "\ngroups = " << names_text(pl.groups, groups)
       << "\nmax_candidates = " << pl.max_candidates << "\n";

@@ -202,9 +202,10 @@ void write_reduced_model(const fs::path& dir, const ReducedModelFile& f) {
   write_file_atomically(dir / kJson, j.dump(2) + "\n");
 }
 
-ReducedModelFile read_reduced_model(const fs::path& dir) {
-  const fs::path json_file = dir / kJson, bin_file = dir / kBin;
-  ReducedModelFile f;
+namespace {
+
+/// reduced_model.json: format and version checked; the key, the case and the outputs' names.
+nlohmann::json read_header(const fs::path& json_file, ReducedModelFile& f) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(read_all(json_file));
@@ -236,60 +237,84 @@ ReducedModelFile read_reduced_model(const fs::path& dir) {
     throw core::DataError(json_file.string() + ": outputs: " + std::to_string(out.temperatures) +
                           " temperatures and " + (out.tcp ? "9" : "0") + " TCP rows in " +
                           std::to_string(out.names.size()) + " names; rebuild it");
-  f.info = j;
+  return j;
+}
 
-  Named m = read_named(read_all(bin_file), bin_file);
-  const auto need = [&](const std::string& name, Eigen::Index rows, Eigen::Index cols) {
+/// reduced_model.bin's matrices, taken out one by one with their sizes checked.
+struct Matrices {
+  Named m;
+  fs::path file;
+  /// The matrix `name`, rows x cols (-1: any); DataError naming the file when absent or
+  /// of another size.
+  Eigen::MatrixXd need(const std::string& name, Eigen::Index rows, Eigen::Index cols) {
     const auto it = m.find(name);
     if (it == m.end())
-      throw core::DataError(bin_file.string() + ": reduced model has no matrix '" + name +
+      throw core::DataError(file.string() + ": reduced model has no matrix '" + name +
                             "'; rebuild it with `thermotwin reduce`");
     if ((rows >= 0 && it->second.rows() != rows) || (cols >= 0 && it->second.cols() != cols))
-      throw core::DataError(bin_file.string() + ": matrix '" + name + "' is " +
+      throw core::DataError(file.string() + ": matrix '" + name + "' is " +
                             std::to_string(it->second.rows()) + " x " +
                             std::to_string(it->second.cols()) + ", expected " +
                             (rows >= 0 ? std::to_string(rows) : "any") + " x " +
                             (cols >= 0 ? std::to_string(cols) : "any"));
     return std::move(it->second);
-  };
-  auto& s = f.twin.model.system;
+  }
+};
+
+/// counts.`key` of reduced_model.json, checked to be a count.
+std::size_t count_of(const nlohmann::json& j, const char* key, const fs::path& json_file) {
+  const auto v = j["counts"].value(key, -1);
+  if (v < 0 || v > 100000)
+    throw core::DataError(json_file.string() + ": counts." + key + " = " + std::to_string(v) +
+                          ": expected a count");
+  return static_cast<std::size_t>(v);
+}
+
+/// Moving source k's columns and pieces into `s`.
+void read_moving(Matrices& m, std::size_t k, Eigen::Index r, std::int64_t nodes,
+                 solvers::ReducedThermalSystem& s) {
+  s.moving.push_back(m.need(indexed("moving", k), r, -1));
+  const Eigen::Index pieces = s.moving.back().cols();
+  s.moving_source.push_back(static_cast<int>(m.need(indexed("moving_source", k), 1, 1)(0, 0)));
+  solvers::MovingSourceShape p;
+  p.source = static_cast<int>(m.need(indexed("piece_source", k), 1, 1)(0, 0));
+  p.centre = m.need(indexed("piece_centre", k), pieces, 1);
+  p.volume = m.need(indexed("piece_volume", k), pieces, 1);
+  p.nodes = m.need(indexed("piece_nodes", k), pieces, -1).cast<int>();
+  p.weight = m.need(indexed("piece_weight", k), pieces, p.nodes.cols());
+  if (p.nodes.size() > 0 && (p.nodes.minCoeff() < 0 || p.nodes.maxCoeff() >= nodes))
+    throw core::DataError(m.file.string() + ": moving source " + std::to_string(k) +
+                          " names nodes outside the model's " + std::to_string(nodes));
+  s.moving_pieces.push_back(std::move(p));
+}
+
+}  // namespace
+
+ReducedModelFile read_reduced_model(const fs::path& dir) {
+  const fs::path json_file = dir / kJson, bin_file = dir / kBin;
+  ReducedModelFile f;
+  const nlohmann::json j = read_header(json_file, f);
+  f.info = j;
+  Matrices m{read_named(read_all(bin_file), bin_file), bin_file};
   auto& model = f.twin.model;
-  model.basis = need("basis", f.key.nodes, -1);
+  auto& s = model.system;
+  model.basis = m.need("basis", f.key.nodes, -1);
   const Eigen::Index r = model.basis.cols();
-  s.capacity = need("capacity", r, r);
-  s.conduction = need("conduction", r, r);
-  s.uniform = need("uniform", r, 1);
-  out.rows = need("outputs", static_cast<Eigen::Index>(out.names.size()), r);
-  const auto count = [&](const char* key) {
-    const auto v = j["counts"].value(key, -1);
-    if (v < 0 || v > 100000)
-      throw core::DataError(json_file.string() + ": counts." + key + " = " + std::to_string(v) +
-                            ": expected a count");
-    return static_cast<std::size_t>(v);
-  };
-  for (std::size_t k = 0, n = count("films"); k < n; ++k) {
-    s.film.push_back(need(indexed("film", k), r, r));
-    s.film_area.push_back(need(indexed("film_area", k), r, 1));
+  s.capacity = m.need("capacity", r, r);
+  s.conduction = m.need("conduction", r, r);
+  s.uniform = m.need("uniform", r, 1);
+  f.twin.outputs.rows =
+      m.need("outputs", static_cast<Eigen::Index>(f.twin.outputs.names.size()), r);
+  for (std::size_t k = 0, n = count_of(j, "films", json_file); k < n; ++k) {
+    s.film.push_back(m.need(indexed("film", k), r, r));
+    s.film_area.push_back(m.need(indexed("film_area", k), r, 1));
   }
-  for (std::size_t k = 0, n = count("sources"); k < n; ++k)
-    s.source_shape.push_back(need(indexed("source_shape", k), r, 1));
-  for (std::size_t k = 0, n = count("fluxes"); k < n; ++k)
-    s.flux_area.push_back(need(indexed("flux_area", k), r, 1));
-  for (std::size_t k = 0, n = count("moving_sources"); k < n; ++k) {
-    s.moving.push_back(need(indexed("moving", k), r, -1));
-    const Eigen::Index pieces = s.moving.back().cols();
-    s.moving_source.push_back(static_cast<int>(need(indexed("moving_source", k), 1, 1)(0, 0)));
-    solvers::MovingSourceShape p;
-    p.source = static_cast<int>(need(indexed("piece_source", k), 1, 1)(0, 0));
-    p.centre = need(indexed("piece_centre", k), pieces, 1);
-    p.volume = need(indexed("piece_volume", k), pieces, 1);
-    p.nodes = need(indexed("piece_nodes", k), pieces, -1).cast<int>();
-    p.weight = need(indexed("piece_weight", k), pieces, p.nodes.cols());
-    if (p.nodes.size() > 0 && (p.nodes.minCoeff() < 0 || p.nodes.maxCoeff() >= f.key.nodes))
-      throw core::DataError(bin_file.string() + ": moving source " + std::to_string(k) +
-                            " names nodes outside the model's " + std::to_string(f.key.nodes));
-    s.moving_pieces.push_back(std::move(p));
-  }
+  for (std::size_t k = 0, n = count_of(j, "sources", json_file); k < n; ++k)
+    s.source_shape.push_back(m.need(indexed("source_shape", k), r, 1));
+  for (std::size_t k = 0, n = count_of(j, "fluxes", json_file); k < n; ++k)
+    s.flux_area.push_back(m.need(indexed("flux_area", k), r, 1));
+  for (std::size_t k = 0, n = count_of(j, "moving_sources", json_file); k < n; ++k)
+    read_moving(m, k, r, f.key.nodes, s);
   s = solvers::with_moving_prefix(std::move(s));
   const auto& b = j.value("basis", nlohmann::json::object());
   model.stats.shifts_per_s = b.value("shifts_per_s", std::vector<double>{});

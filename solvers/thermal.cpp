@@ -56,14 +56,12 @@ Eigen::SparseMatrix<double> to_sparse(int n, const std::vector<Triplets>& chunks
   return a;
 }
 
+/// Conduction and capacity, element by element in parallel chunks.
 template <int N>
-FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
-  constexpr int F = N == 4 ? 3 : 6;
-  check_elements<N>(m);
+void volume_operators(const mesh::TetMesh& m, const core::CaseSpec& spec, FullThermalSystem& ops) {
   const int n = static_cast<int>(m.nodes.rows());
   const int nt = static_cast<int>(m.tets.rows());
   constexpr std::ptrdiff_t chunk = 4096;
-  FullThermalSystem ops;
   const bool lumped = spec.thermal.lumped_mass;
   auto pairs = core::parallel_chunks<std::pair<Triplets, Triplets>>(
       nt, chunk, [&](std::ptrdiff_t b, std::ptrdiff_t e, std::ptrdiff_t) {
@@ -99,8 +97,15 @@ FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
   }
   ops.conduction = to_sparse(n, kt);
   ops.capacity = to_sparse(n, mt);
+}
 
-  // Convection and flux on boundary groups (few faces: serial).
+/// Each film's unit-coefficient matrix and area vector, each flux's area vector (few faces:
+/// serial).
+template <int N>
+void boundary_operators(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                        FullThermalSystem& ops) {
+  constexpr int F = N == 4 ? 3 : 6;
+  const int n = static_cast<int>(m.nodes.rows());
   for (const auto& c : spec.thermal.convection) {
     Triplets h;
     Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
@@ -126,11 +131,16 @@ FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
     }
     ops.flux_area.push_back(std::move(w));
   }
-  // Sources: unit total power spread uniformly over the meshed body.
+}
+
+/// Each source's load of unit total power spread uniformly over its meshed body.
+template <int N>
+void source_shapes(const mesh::TetMesh& m, const core::CaseSpec& spec, FullThermalSystem& ops) {
+  const int n = static_cast<int>(m.nodes.rows());
   for (const auto& s : spec.thermal.sources) {
     Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
     double volume = 0;
-    for (int t = 0; t < nt; ++t) {
+    for (int t = 0; t < m.tets.rows(); ++t) {
       if (core::index_of(m.tet_region[t]) != s.body) continue;
       const auto x = tet_coords<N>(m, t);
       volume += k::element_volume(x, t);
@@ -143,12 +153,21 @@ FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
                               "' has no elements, so its heat cannot go anywhere");
     ops.source_shape.push_back(w / volume);
   }
+}
+
+template <int N>
+FullThermalSystem assemble(const mesh::TetMesh& m, const core::CaseSpec& spec) {
+  check_elements<N>(m);
+  FullThermalSystem ops;
+  volume_operators<N>(m, spec, ops);
+  boundary_operators<N>(m, spec, ops);
+  source_shapes<N>(m, spec, ops);
   ops.moving_pieces = moving_source_shapes(m, spec);
   for (const auto& shape : ops.moving_pieces) {
-    ops.moving.push_back(moving_load_matrix(shape, n));
+    ops.moving.push_back(moving_load_matrix(shape, m.nodes.rows()));
     ops.moving_source.push_back(shape.source);
   }
-  ops.uniform = Eigen::VectorXd::Ones(n);
+  ops.uniform = Eigen::VectorXd::Ones(m.nodes.rows());
   return ops;
 }
 

@@ -25,10 +25,6 @@ void set_targets(const core::CaseSpec& spec, const Eigen::MatrixXd& error, Histo
     h.targets.col(static_cast<Eigen::Index>(k)) = error.col(target_column(h.target_names[k]));
 }
 
-bool surface_candidates(const core::CaseSpec& spec) {
-  return spec.placement.candidates == core::PlacementSpec::Candidates::surface;
-}
-
 }  // namespace
 
 std::vector<int> candidate_points(const core::CaseSpec& spec) {
@@ -69,7 +65,7 @@ CandidateSet candidate_set(const core::CaseSpec& spec, const mesh::TetMesh& mesh
   };
   // Named points: all candidates for "points"; only those listed for "surface".
   std::vector<int> named;
-  if (!surface_candidates(spec))
+  if (!spec.placement.surface())
     named = candidate_points(spec);
   else
     for (const auto& id : spec.placement.points) named.push_back(point_index(spec, id));
@@ -79,7 +75,7 @@ CandidateSet candidate_set(const core::CaseSpec& spec, const mesh::TetMesh& mesh
       throw core::MeshError("named point '" + spec.points[i].id + "' is not a vertex of the mesh");
     add(spec.points[i].id, node);
   }
-  if (surface_candidates(spec)) {
+  if (spec.placement.surface()) {
     std::vector<core::RegionId> bodies;
     std::vector<core::BoundaryId> groups;
     for (int b : spec.placement.bodies) bodies.push_back(core::RegionId{b});

@@ -7,8 +7,7 @@ namespace tt::studies {
 VirtualRunReport virtual_run(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                              const VirtualRunOptions& options) {
   VirtualRunReport r;
-  if (spec.placement.candidates == core::PlacementSpec::Candidates::surface)
-    r.candidates = candidate_set(spec, mesh);
+  if (spec.placement.surface()) r.candidates = candidate_set(spec, mesh);
   const auto t0 = std::chrono::steady_clock::now();
   r.run = options.twin ? solvers::simulate_reduced(mesh, spec, *options.twin, options.progress)
                        : solvers::simulate(mesh, spec, options.progress, options.checkpointing);
