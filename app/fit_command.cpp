@@ -16,9 +16,7 @@
 #include <optional>
 #include <set>
 
-#include "app/axis_fit.hpp"
 #include "app/commands.hpp"
-#include "app/network_candidate.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
 #include "core/units.hpp"
@@ -28,13 +26,17 @@
 #include "fitting/noise.hpp"
 #include "fitting/selection.hpp"
 #include "io/atomic_dir.hpp"
+#include "io/axis_fit_out.hpp"
 #include "io/case_reader.hpp"
 #include "io/csv_out.hpp"
 #include "io/fitting_out.hpp"
+#include "io/network_out.hpp"
 #include "io/reports.hpp"
 #include "mesh/mesher.hpp"
 #include "placement/place.hpp"
 #include "solvers/campaign.hpp"
+#include "studies/axis_fit.hpp"
+#include "studies/network_candidate.hpp"
 #include "studies/placement_input.hpp"
 
 namespace tt::app {
@@ -57,7 +59,7 @@ fitting::Group group_of(const core::CaseSpec& spec, const solvers::CampaignResul
   g.error.rightCols(r.axis.values.cols()) = r.axis.values;
   g.sensor_names = h.names;
   g.target_names = h.target_names;
-  for (const auto& name : axis_target_names(spec)) g.target_names.push_back(name);
+  for (const auto& name : studies::axis_target_names(spec)) g.target_names.push_back(name);
   return g;
 }
 
@@ -132,7 +134,7 @@ int fit_command(const FitArgs& args) {
   const std::vector<fitting::ModelSpec> specs =
       args.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
                  : fitting::default_model_candidates();
-  std::map<std::string, NetworkFigures> networks;
+  std::map<std::string, studies::NetworkFigures> networks;
   std::vector<fitting::Evaluation> evals;
   std::vector<fitting::SensorCountTable> tables;
   nlohmann::json summary = nlohmann::json::object();
@@ -151,7 +153,7 @@ int fit_command(const FitArgs& args) {
     const auto corr = standard_sets(4);
     at_most_4.insert(at_most_4.end(), corr.begin(), corr.end());
     if (args.network) {
-      const auto grey = network_sensor_sets(placed, target);
+      const auto grey = studies::network_sensor_sets(placed, target);
       at_most_4.insert(at_most_4.end(), grey.begin(), grey.end());
       network_inputs.insert(network_inputs.end(), grey.begin(), grey.end());
     }
@@ -160,14 +162,15 @@ int fit_command(const FitArgs& args) {
       // The network on the grey relational sensors, on the chosen linear model's (that model its
       // linear skip) and on the best ridge's (that ridge its skip), chosen on validation beside
       // the linear models.
-      const fitting::Candidate linear_inputs = linear_inputs_network(evals.back().model, spec.seed);
+      const fitting::Candidate linear_inputs =
+          studies::linear_inputs_network(evals.back().model, spec.seed);
       at_most_4.push_back(linear_inputs.sensor_set);
       network_inputs.push_back(linear_inputs.sensor_set);
       std::vector<fitting::ModelSpec> with_network = specs;
-      with_network.push_back(driver_network_spec(spec.seed));
+      with_network.push_back(studies::driver_network_spec(spec.seed));
       with_network.push_back(linear_inputs.spec);
-      if (auto c =
-              ridge_skip_network(evals.back(), spec.seed, !groups.front().input_names.empty())) {
+      if (auto c = studies::ridge_skip_network(evals.back(), spec.seed,
+                                               !groups.front().input_names.empty())) {
         at_most_4.push_back(c->sensor_set);
         with_network.push_back(c->spec);
       }
@@ -179,7 +182,7 @@ int fit_command(const FitArgs& args) {
     tables.push_back(
         fitting::sensor_count_table(groups, split, target, all, specs, args.required_sm_um * 1e-6));
     const auto& e = evals.back();
-    const double drift = uncompensated_std(groups, split.test, target);
+    const double drift = studies::uncompensated_std(groups, split.test, target);
     const auto& chosen = e.sensor_sets[e.selection.candidates[e.selection.best].sensor_set];
     tcp_chosen.push_back({"tcp_" + groups[0].target_names[target] + "_chosen", chosen.sensors});
     std::vector<std::string> names;
@@ -195,10 +198,10 @@ int fit_command(const FitArgs& args) {
       // The network's own held-out figures beside the chosen model's, on the same groups.
       std::vector<int> refit = split.fitting;
       refit.insert(refit.end(), split.validation.begin(), split.validation.end());
-      if (auto n = network_figures(e, fitting::group_subset(groups, refit),
-                                   fitting::group_subset(groups, split.test))) {
+      if (auto n = studies::network_figures(e, fitting::group_subset(groups, refit),
+                                            fitting::group_subset(groups, split.test))) {
         const std::string& name = groups[0].target_names[target];
-        summary[name]["network"] = network_json(*n);
+        summary[name]["network"] = io::network_json(*n);
         summary[name]["network"]["test_sm_over_uncompensated"] = n->test.sm / drift;
         summary[name]["network"]["file"] = "network_" + name + ".pt";
         networks.emplace(name, std::move(*n));
@@ -206,14 +209,14 @@ int fit_command(const FitArgs& args) {
     }
   }
   // 5. The feed axis: models at its points and the polynomial from their predictions.
-  std::optional<AxisFit> axis;
+  std::optional<studies::AxisFit> axis;
   double axis_seconds = 0.0;
   if (!spec.mechanical.axis_points.empty()) {
     const auto start = std::chrono::steady_clock::now();
     std::optional<fitting::ModelSpec> network;
-    if (args.network && !network_inputs.empty()) network = driver_network_spec(spec.seed);
-    axis = axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs, network,
-                    sensor_union(network_inputs));
+    if (args.network && !network_inputs.empty()) network = studies::driver_network_spec(spec.seed);
+    axis = studies::axis_fit(spec, groups, split, tcp_targets, tcp_chosen, specs, network,
+                             sensor_union(network_inputs));
     axis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   // 6. Outputs, all or nothing.
@@ -229,10 +232,10 @@ int fit_command(const FitArgs& args) {
                                {"hours", r.spec.duty_cycle.end / 3600.0},
                                {"initial_temperature_degC", r.spec.thermal.initial_temperature_c}});
   if (axis) {
-    doc["axis"] = axis_fit_json(*axis);
+    doc["axis"] = io::axis_fit_json(*axis);
     doc["axis"]["seconds"] = axis_seconds;  // the axis points' models, network and polynomials
     if (!axis->network.empty()) doc["axis"]["network"]["file"] = "network_all_outputs.pt";
-    io::write_file_atomically(dir / "axis_fit.md", axis_fit_markdown(*axis));
+    io::write_file_atomically(dir / "axis_fit.md", io::axis_fit_markdown(*axis));
     if (!axis->network.empty())
       std::get<torchnet::Network>(axis->network.front().body)
           .save_torchscript(dir / "network_all_outputs.pt");
