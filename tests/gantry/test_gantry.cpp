@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <string>
 
-#include "app/axis_fit.hpp"
 #include "core/errors.hpp"
 #include "fitting/cnc_export.hpp"
+#include "io/axis_fit_out.hpp"
 #include "io/case_reader.hpp"
 #include "io/cnc_model_in.hpp"
 #include "io/fitting_out.hpp"
@@ -25,6 +25,7 @@
 #include "solvers/thermal_error.hpp"
 #include "solvers/thermal_stepper.hpp"
 #include "solvers/virtual_machine.hpp"
+#include "studies/axis_fit.hpp"
 #include "studies/histories.hpp"
 #include "tests/common/gantry_bar.hpp"
 
@@ -327,7 +328,7 @@ TEST_F(Gm1Coarse, CampaignRecordsTheAxisPointsAsADirectElasticSolveDoes) {
 /// axis points' dx, dy, dz), with synthetic temperatures: sensor 0 heats with the run's duty and
 /// the axis grows as a cubic in position times its increment; the TCP follows sensor 1.
 std::vector<fitting::Group> synthetic_gm1_groups(const core::CaseSpec& spec, int count) {
-  const auto axis = app::axis_target_names(spec);
+  const auto axis = studies::axis_target_names(spec);
   std::vector<fitting::Group> groups;
   for (int k = 0; k < count; ++k) {
     fitting::Group g;
@@ -372,8 +373,8 @@ TEST(AxisFit, LinearModelsAtThePointsGiveThePolynomialOfTheMeasuredError) {
   const core::CaseSpec spec = io::read_case(std::string(TT_SOURCE_DIR) + "/cases/gm1_coarse.toml");
   const auto groups = synthetic_gm1_groups(spec, 7);
   const fitting::Split split{{0, 1, 2, 3}, {4}, {5, 6}};
-  const app::AxisFit fit =
-      app::axis_fit(spec, groups, split, 2, {}, {fitting::ModelSpec{}}, std::nullopt, {});
+  const studies::AxisFit fit =
+      studies::axis_fit(spec, groups, split, 2, {}, {fitting::ModelSpec{}}, std::nullopt, {});
   ASSERT_EQ(fit.linear.size(), 33u);
   EXPECT_EQ(fit.targets.front(), 2);
   EXPECT_EQ(fit.linear.front().target_name, "A01_dx");
@@ -401,12 +402,12 @@ TEST(AxisFit, LinearModelsAtThePointsGiveThePolynomialOfTheMeasuredError) {
     EXPECT_NE(std::find(sensors.begin(), sensors.end(), want), sensors.end())
         << fit.linear[k].target_name;
   }
-  const nlohmann::json j = app::axis_fit_json(fit);
+  const nlohmann::json j = io::axis_fit_json(fit);
   EXPECT_EQ(j["targets"].size(), 33u);
   EXPECT_EQ(j["degree"], 3);
   EXPECT_LT(j["polynomial_residual"]["linear"]["dx"]["rms_um"].get<double>(),
             j["polynomial_residual"]["uncompensated"]["dx"]["rms_um"].get<double>());
-  EXPECT_NE(app::axis_fit_markdown(fit).find("| linear |"), std::string::npos);
+  EXPECT_NE(io::axis_fit_markdown(fit).find("| linear |"), std::string::npos);
   // `thermotwin export` reads the axis models back from fit.json and rebuilds, state by state,
   // the polynomial of the linear models' predictions that was judged above.
   const nlohmann::json tcp{{"target", "dy"},
@@ -435,8 +436,9 @@ TEST(AxisFit, LinearModelsAtThePointsGiveThePolynomialOfTheMeasuredError) {
             << "t " << t << " direction " << d << " point " << i;
     }
   // The axis columns must be the groups' last ones.
-  EXPECT_THROW(app::axis_fit(spec, groups, split, 1, {}, {fitting::ModelSpec{}}, std::nullopt, {}),
-               core::DataError);
+  EXPECT_THROW(
+      studies::axis_fit(spec, groups, split, 1, {}, {fitting::ModelSpec{}}, std::nullopt, {}),
+      core::DataError);
 }
 
 }  // namespace

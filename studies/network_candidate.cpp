@@ -1,12 +1,10 @@
-#include "app/network_candidate.hpp"
+#include "studies/network_candidate.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
-#include "io/reports.hpp"
-
-namespace tt::app {
+namespace tt::studies {
 
 fitting::ModelSpec driver_network_spec(std::uint64_t seed, const std::string& sensor_method,
                                        bool use_inputs) {
@@ -115,24 +113,4 @@ std::optional<NetworkFigures> network_figures(const fitting::Evaluation& e,
   return n;
 }
 
-nlohmann::json network_json(const NetworkFigures& n) {
-  const auto& net = std::get<torchnet::Network>(n.model.body);
-  const auto um = [](double v) { return io::finite_or_null(v, 1e6); };
-  nlohmann::json test_s = nlohmann::json::array();
-  for (double s : n.test.s) test_s.push_back(s * 1e6);
-  return {{"model", fitting::model_label(n.model.spec)},
-          {"chosen", n.chosen},
-          {"sensors", n.model.features.sensor_names},
-          {"validation_sm_um", um(n.validation.sm)},
-          {"test_s_um", test_s},
-          {"test_sm_um", n.test.s.empty() ? nlohmann::json(nullptr) : um(n.test.sm)},
-          {"test_s_sigma_um", n.test.s.empty() ? nlohmann::json(nullptr) : um(n.test.s_sigma)},
-          {"training_seconds", net.report().seconds},
-          {"epochs", net.report().epochs},
-          {"best_epoch", net.report().best_epoch},
-          {"time_budget_reached", net.report().budget_reached},
-          {"window_stride_samples", net.options().window_stride},
-          {"inference_ms_median", n.inference_ms}};
-}
-
-}  // namespace tt::app
+}  // namespace tt::studies

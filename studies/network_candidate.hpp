@@ -2,7 +2,7 @@
 // spec, the sensor set it is trained on, and its own held-out figures beside the chosen model's.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "fitting/models.hpp"
@@ -10,7 +10,7 @@
 #include "fitting/selection.hpp"
 #include "placement/place.hpp"
 
-namespace tt::app {
+namespace tt::studies {
 
 /// Sensor-set method of the network's inputs: the grey relational grade's best m <= 4 sensors.
 inline constexpr const char* kNetworkSensorMethod = "grey_relational_network";
@@ -68,7 +68,4 @@ std::optional<NetworkFigures> network_figures(const fitting::Evaluation& e,
                                               const std::vector<fitting::Group>& refit_groups,
                                               const std::vector<fitting::Group>& test_groups);
 
-/// For fit.json's summary: validation and test S_M, S_σ, training and inference figures [µm, s].
-nlohmann::json network_json(const NetworkFigures& n);
-
-}  // namespace tt::app
+}  // namespace tt::studies

@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,7 +15,10 @@
 #include "fitting/models.hpp"
 #include "fitting/selection.hpp"
 
-namespace tt::app {
+namespace tt::studies {
+
+/// The error directions at an axis point, in AxisError::values' column order per point.
+inline constexpr const char* kAxisDirections[3] = {"dx", "dy", "dz"};
 
 /// Target names of the axis points' error columns: "<point id>_dx", "_dy", "_dz" per point, in
 /// the case's axis_points order (AxisError::values' column order).
@@ -65,12 +67,4 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
                  const std::optional<fitting::ModelSpec>& network,
                  const std::vector<int>& network_sensors);
 
-/// For fit.json: the feed axis, per target the chosen model (its coefficients as io::model_json
-/// writes them, for `thermotwin export`), its and the network's test S_M [µm], and the
-/// polynomials' residuals per source and direction [µm].
-nlohmann::json axis_fit_json(const AxisFit& fit);
-
-/// The same as a short Markdown report.
-std::string axis_fit_markdown(const AxisFit& fit);
-
-}  // namespace tt::app
+}  // namespace tt::studies
