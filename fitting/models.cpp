@@ -1,6 +1,7 @@
 #include "fitting/models.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -50,8 +51,70 @@ int window_stride(const NetworkSettings& settings, const std::vector<Group>& gro
   return std::max(1, static_cast<int>(std::lround(settings.window_span_s / entries / median)));
 }
 
-/// The network's linear skip: per output, the ridge fit of strength `lambda` on every row of the
-/// fitting and validation sequences (in the network's input and output units).
+Eigen::MatrixXd selected_rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
+  return out;
+}
+
+/// Ridge strengths the network's linear skip is chosen among: the measured-data candidates' grid.
+constexpr std::array<double, 8> kSkipLambdas{1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0};
+/// Sequences under which (fewer) the skip chooses its own strength: fewer than the blocked
+/// evaluation's folds ever hold.
+constexpr std::size_t kSkipSequenceBlocks = 3;
+/// Time blocks (at least) that choose the skip's own strength.
+constexpr int kSkipBlocks = 5;
+
+/// #rows block index of the stacked rows of the sequences: each sequence cut into equal
+/// contiguous time blocks, at least kSkipBlocks in all (skip_lambda's blocks).
+std::vector<int> skip_blocks(const std::vector<Eigen::MatrixXd>& xs) {
+  const int per = (kSkipBlocks + static_cast<int>(xs.size()) - 1) / static_cast<int>(xs.size());
+  std::vector<int> out;
+  int first = 0;
+  for (const auto& x : xs) {
+    const Eigen::Index n = x.rows();
+    const int parts = static_cast<int>(std::min<Eigen::Index>(per, std::max<Eigen::Index>(1, n)));
+    for (Eigen::Index i = 0; i < n; ++i) out.push_back(first + static_cast<int>(i * parts / n));
+    first += parts;
+  }
+  return out;
+}
+
+/// The ridge strength of kSkipLambdas whose fit, each block held out in turn and fitted on the
+/// others, gives the lowest mean S² (residual variance) over the held-out blocks: the criterion
+/// of the blocked evaluation, one level down.
+double skip_lambda(const Eigen::MatrixXd& x, const Eigen::VectorXd& y,
+                   const std::vector<int>& block) {
+  const int blocks = *std::max_element(block.begin(), block.end()) + 1;
+  double best = kSkipLambdas.front(), best_score = std::numeric_limits<double>::infinity();
+  for (double lambda : kSkipLambdas) {
+    double score = 0.0;
+    for (int b = 0; b < blocks; ++b) {
+      std::vector<Eigen::Index> in, out;
+      for (std::size_t r = 0; r < block.size(); ++r)
+        (block[r] == b ? out : in).push_back(static_cast<Eigen::Index>(r));
+      if (out.size() < 2 || static_cast<Eigen::Index>(in.size()) < x.cols() + 3) continue;
+      const LinearFit f = linear_fit(selected_rows(x, in), selected_rows(y, in), lambda);
+      const double s =
+          residual_std(selected_rows(y, out) - linear_prediction(f, selected_rows(x, out)));
+      score += s * s;
+    }
+    if (score < best_score) {
+      best_score = score;
+      best = lambda;
+    }
+  }
+  return best;
+}
+
+/// The network's linear skip: per output, the ridge fit on every row of the fitting and
+/// validation sequences (in the network's input and output units). Its strength is `lambda` (the
+/// spec's, chosen by the blocked evaluation on speed cycles or runs) when the training is given as
+/// at least kSkipSequenceBlocks sequences, as in every fold of that evaluation; given fewer (one
+/// continuous run refitted outside a window, its features referenced to the run's start: a regime
+/// that lambda was not chosen for) it is the strength of kSkipLambdas that predicts held-out time
+/// blocks of the sequences best (skip_lambda).
 torchnet::LinearSkip linear_skip(const torchnet::Sequences& fit,
                                  const torchnet::Sequences& validation, double lambda) {
   std::vector<Eigen::MatrixXd> xs = fit.inputs, ys = fit.outputs;
@@ -64,11 +127,16 @@ torchnet::LinearSkip linear_skip(const torchnet::Sequences& fit,
     x.middleRows(static_cast<Eigen::Index>(r), xs[g].rows()) = xs[g];
     y.middleRows(static_cast<Eigen::Index>(r), ys[g].rows()) = ys[g];
   }
-  torchnet::LinearSkip skip{Eigen::VectorXd(y.cols()), Eigen::MatrixXd(y.cols(), x.cols())};
+  const bool own_strength = xs.size() < kSkipSequenceBlocks;
+  const std::vector<int> block = own_strength ? skip_blocks(xs) : std::vector<int>{};
+  torchnet::LinearSkip skip{Eigen::VectorXd(y.cols()), Eigen::MatrixXd(y.cols(), x.cols()),
+                            Eigen::VectorXd(y.cols())};
   for (Eigen::Index k = 0; k < y.cols(); ++k) {
-    const LinearFit f = linear_fit(x, y.col(k), lambda);
+    const double strength = own_strength ? skip_lambda(x, y.col(k), block) : lambda;
+    const LinearFit f = linear_fit(x, y.col(k), strength);
     skip.intercept(k) = f.intercept;
     skip.weights.row(k) = f.coefficients.transpose();
+    skip.ridge_lambda(k) = strength;
   }
   return skip;
 }
@@ -122,13 +190,6 @@ Eigen::VectorXd body_prediction(const Body& body, const Eigen::MatrixXd& x, int 
   if (const auto* network = std::get_if<torchnet::Network>(&body))
     return network->prediction(x).col(output);  // x: one group's rows in time order
   return ppr_prediction(std::get<PprModel>(body), x);
-}
-
-Eigen::MatrixXd selected_rows(const Eigen::MatrixXd& m, const std::vector<Eigen::Index>& rows) {
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
-  return out;
 }
 
 }  // namespace

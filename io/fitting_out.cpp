@@ -224,8 +224,9 @@ json model_json(const FittedModel& model) {
           terms.push_back(
               {{"name", names[c]},
                {"um_per_K", finite_or_null(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
-        outputs.push_back(
-            {{"intercept_um", finite_or_null(skip->intercept(k) * um)}, {"terms", terms}});
+        json o{{"intercept_um", finite_or_null(skip->intercept(k) * um)}, {"terms", terms}};
+        if (k < skip->ridge_lambda.size()) o["ridge_lambda"] = skip->ridge_lambda(k);
+        outputs.push_back(o);
       }
       j["linear_skip"] = outputs;
     }

@@ -75,6 +75,8 @@ struct LinearSkip {
   Eigen::VectorXd intercept;
   /// #outputs x #inputs
   Eigen::MatrixXd weights;
+  /// #outputs ridge strengths they were fitted with (for reports; empty when not known)
+  Eigen::VectorXd ridge_lambda;
 };
 
 struct TrainingReport {

@@ -252,3 +252,22 @@ TEST(NetworkWithLinearSkip, LearnsWhatTheLinearModelLeavesAndRoundTrips) {
     EXPECT_NEAR(loaded(static_cast<Eigen::Index>(k), 0), in_memory(rows[k]), 1e-4 * um);
   std::filesystem::remove(file);
 }
+
+TEST(NetworkWithLinearSkip, ChoosesItsOwnStrengthOnlyOnAContinuousRun) {
+  // Given several groups (a fold of the blocked evaluation) the skip keeps the spec's strength,
+  // which that evaluation chose; given one run it chooses among the grid on held-out time blocks
+  // of it, and a clean linear truth does not want the spec's heavy shrinkage.
+  const auto groups = campaign(6, 91, lagged_truth, 0.1 * um, 4);
+  ModelSpec spec = small_network();
+  spec.network.linear_skip = true;
+  spec.ridge_lambda = 10.0;
+  const auto several = fitted_model(spec, group_subset(groups, {0, 1, 2, 3}), {0, 1, 2, 3}, 0);
+  const auto& kept = std::get<tt::torchnet::Network>(several.body).linear_skip()->ridge_lambda;
+  ASSERT_EQ(kept.size(), 1);
+  EXPECT_EQ(kept(0), 10.0);
+  const auto one = fitted_model(spec, group_subset(groups, {0}), {0, 1, 2, 3}, 0);
+  const auto& own = std::get<tt::torchnet::Network>(one.body).linear_skip()->ridge_lambda;
+  ASSERT_EQ(own.size(), 1);
+  EXPECT_LT(own(0), 10.0);
+  EXPECT_GE(own(0), 1e-6);
+}
