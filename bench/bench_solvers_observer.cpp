@@ -11,7 +11,10 @@
 //     correlation     the four best by the standard's correlation for dy and for dz, together
 //     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
 //     estimation      greedy on the observer's posterior variance of dy + dz over the fitting
-//                     runs' duty cycles (solvers::estimation_placement, issue 20 item 4)
+//                     runs' duty cycles read every 300 s (placement::estimation_greedy: rank-one
+//                     scores, issue 20 item 4)
+//     estimation_exact the same criterion, each candidate scored by its set's criterion afresh
+//                     (the filter re-run per candidate): what the rank-one scores stand in for
 // 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
 // 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
 //    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
@@ -50,6 +53,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/twin.hpp"
+#include "studies/estimation_input.hpp"
 #include "studies/placement_input.hpp"
 
 namespace {
@@ -204,9 +208,10 @@ int main(int argc, char** argv) {
     if (argc > 8) campaign_noise.drift_relative_sigma = std::stod(argv[8]);
     const std::string sensor_choice = argc > 9 ? argv[9] : "correlation";
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
-        sensor_choice != "estimation")
+        sensor_choice != "estimation" && sensor_choice != "estimation_exact")
       throw std::runtime_error("SENSORS '" + sensor_choice +
-                               "': expected correlation, mutual_info or estimation");
+                               "': expected correlation, mutual_info, estimation or "
+                               "estimation_exact");
     const auto t_all = Clock::now();
 
     // 1. Case, mesh, twin.
@@ -266,17 +271,45 @@ int main(int argc, char** argv) {
           if (s.method == placement::Method::kGaussianGreedy && s.m == 4)
             for (int c : s.columns)
               if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
-    } else if (sensor_choice == "estimation") {
+    } else if (sensor_choice.starts_with("estimation")) {
       std::vector<core::CaseSpec> fitting_runs;
       for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);
-      const solvers::EstimationPlacement placed = solvers::estimation_placement(
-          twin, fitting_runs, cand, {1, 2}, static_cast<int>(chosen.size()),
-          fitting::SensorNoise{}.temperature_sigma, campaign_noise, 300);
+      const placement::EstimationProblem problem = studies::observer_estimation_problem(
+          twin, fitting_runs, {cand, {}, fitting::SensorNoise{}.temperature_sigma}, {"dy", "dz"},
+          campaign_noise, 300);
+      std::cout << "estimation problem: " << problem.tracks.size() << " runs, "
+                << problem.candidate_rows.cols() << " filter states ("
+                << fmt(seconds_since(t_place)) << " s)\n";
+      const auto t_greedy = Clock::now();
+      const int m = static_cast<int>(chosen.size());
+      const std::vector<int> targets{0, 1};
       chosen.clear();
-      for (const auto& s : placed.sensors)
-        chosen.push_back(static_cast<int>(std::find(cand.begin(), cand.end(), s) - cand.begin()));
-      std::cout << "estimation placement: posterior sigma of dy + dz after each sensor [um]:";
-      for (double v : placed.variance_m2) std::cout << " " << fmt(std::sqrt(v) * 1e6);
+      std::vector<double> criterion;
+      if (sensor_choice == "estimation") {
+        std::vector<int> pool(cand.size());
+        for (std::size_t k = 0; k < pool.size(); ++k) pool[k] = static_cast<int>(k);
+        const placement::GreedyPath placed =
+            placement::estimation_greedy(problem, pool, m, targets);
+        chosen = placed.order;
+        criterion = placed.scores;
+      } else {
+        for (int k = 0; k < m; ++k) {  // every candidate's set afresh
+          double best = std::numeric_limits<double>::infinity();
+          int best_c = -1;
+          for (int c = 0; c < static_cast<int>(cand.size()); ++c) {
+            if (std::find(chosen.begin(), chosen.end(), c) != chosen.end()) continue;
+            std::vector<int> trial = chosen;
+            trial.push_back(c);
+            const double v = placement::mean_posterior_variance(problem, trial).sum();
+            if (v < best) best = v, best_c = c;
+          }
+          chosen.push_back(best_c);
+          criterion.push_back(best);
+        }
+      }
+      std::cout << "estimation placement (" << fmt(seconds_since(t_greedy))
+                << " s): posterior sigma of dy + dz after each sensor [um]:";
+      for (double v : criterion) std::cout << " " << fmt(std::sqrt(v) * 1e6);
       std::cout << "\n";
     }
     std::vector<std::string> sensors;
