@@ -24,7 +24,10 @@ std::string shape(const Eigen::MatrixXd& m) {
 /// The covariance at the next reading before its update: F P F^T + Q, kept symmetric.
 Eigen::MatrixXd predicted(const Eigen::MatrixXd& p, const Eigen::MatrixXd& f,
                           const Eigen::MatrixXd& q) {
-  const Eigen::MatrixXd fpf = f * p * f.transpose();
+  // Coefficient-wise products, as the observer's: matrices of ~100 rows do not pay for Eigen's
+  // OpenMP-parallel GEMM, whose threads wait on each other when the cores are shared.
+  const Eigen::MatrixXd fp = f.lazyProduct(p);
+  const Eigen::MatrixXd fpf = fp.lazyProduct(f.transpose());
   return 0.5 * (fpf + fpf.transpose()) + q;
 }
 
@@ -115,15 +118,15 @@ Eigen::VectorXd mean_posterior_variance(const EstimationProblem& p, std::span<co
       cov = predicted(cov, track.transitions[k], track.process[k]);
       if (m > 0) {
         // P - P H^T S^-1 H P with S = H P H^T + R = L L^T: P - W^T W, W = L^-1 H P.
-        const Eigen::MatrixXd hp = h * cov;
-        Eigen::MatrixXd s = hp * h.transpose();
+        const Eigen::MatrixXd hp = h.lazyProduct(cov);
+        Eigen::MatrixXd s = hp.lazyProduct(h.transpose());
         s.diagonal() += r2;
         const Eigen::LLT<Eigen::MatrixXd> llt(s);
         if (llt.info() != Eigen::Success) fail("the readings' covariance is not positive definite");
         const Eigen::MatrixXd w = llt.matrixL().solve(hp);
-        cov -= w.transpose() * w;
+        cov -= w.transpose().lazyProduct(w);
       }
-      sum += (l * cov).cwiseProduct(l).rowwise().sum();
+      sum += l.lazyProduct(cov).cwiseProduct(l).rowwise().sum();
     }
   }
   return sum / static_cast<double>(readings(p));
@@ -161,12 +164,13 @@ GreedyPath estimation_greedy(const EstimationProblem& p, std::span<const int> po
     double criterion = 0;
     const bool scoring = step < m_max && !left.empty();
     posterior_pass(p, path.order, [&](const Eigen::MatrixXd& cov) {
-      const Eigen::MatrixXd lp = l * cov;  // nt x n
+      const Eigen::MatrixXd lp = l.lazyProduct(cov);  // nt x n
       criterion += lp.cwiseProduct(l).sum();
       if (!scoring) return;
-      const Eigen::MatrixXd hp = h * cov;  // #left x n
+      const Eigen::MatrixXd hp = h.lazyProduct(cov);  // #left x n
       const Eigen::VectorXd s = hp.cwiseProduct(h).rowwise().sum() + r2;
-      reduction += ((hp * l.transpose()).rowwise().squaredNorm().array() / s.array()).matrix();
+      const Eigen::MatrixXd hpl = hp.lazyProduct(l.transpose());  // #left x nt
+      reduction += (hpl.rowwise().squaredNorm().array() / s.array()).matrix();
     });
     if (step > 0) {
       path.scores.push_back(criterion / count);
