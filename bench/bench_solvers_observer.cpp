@@ -71,16 +71,23 @@ double seconds_since(Clock::time_point t0) {
 /// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs).
 struct Score {
   Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero(),
-                  inside_calibrated = Eigen::Vector2d::Zero();
+                  inside_calibrated = Eigen::Vector2d::Zero(),
+                  inside_adaptive = Eigen::Vector2d::Zero(),
+                  inside_product = Eigen::Vector2d::Zero();
   double n = 0;
+  /// `adaptive`, `product`: more sigmas (#samples x 2, innovation_scaled_sigma's two rules);
+  /// none: not counted.
   void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
-           const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones()) {
+           const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones(),
+           const Eigen::MatrixXd& adaptive = {}, const Eigen::MatrixXd& product = {}) {
     for (Eigen::Index i = 1; i < truth.rows(); ++i) {  // t = 0 is the reference, not a prediction
       for (int d = 0; d < 2; ++d) {
         const double e = predicted(i, d) - truth(i, d);
         ss(d) += e * e;
         inside(d) += std::abs(e) <= 2 * sigma(i, d);
         inside_calibrated(d) += std::abs(e) <= 2 * scale(d) * sigma(i, d);
+        if (adaptive.size() != 0) inside_adaptive(d) += std::abs(e) <= 2 * adaptive(i, d);
+        if (product.size() != 0) inside_product(d) += std::abs(e) <= 2 * product(i, d);
       }
       n += 1;
     }
@@ -88,7 +95,33 @@ struct Score {
   Eigen::Vector2d rms_um() const { return (ss / n).cwiseSqrt() * 1e6; }
   Eigen::Vector2d coverage() const { return inside / n; }
   Eigen::Vector2d coverage_calibrated() const { return inside_calibrated / n; }
+  Eigen::Vector2d coverage_adaptive() const { return inside_adaptive / n; }
+  Eigen::Vector2d coverage_product() const { return inside_product / n; }
 };
+
+/// The observer's (dy, dz) sigma scaled by what its innovations say of the noise model now: per
+/// sample max(calibrated scale, sqrt(window NIS / window readings)), the window the consistency
+/// test's (ConsistencyOptions::window_s). Where the declared model holds the NIS ratio is at most
+/// about 1 and the calibrated scale stays; where the innovations outgrow the noise model the
+/// sigma grows with them (a covariance-matching estimate, not calibrated on any run). `product`:
+/// instead the calibrated scale times max(1, sqrt(ratio)).
+Eigen::MatrixXd innovation_scaled_sigma(const solvers::ObserverRun& run,
+                                        const Eigen::Vector2d& scale, bool product = false) {
+  const double window = solvers::ConsistencyOptions{}.window_s;
+  Eigen::MatrixXd out = run.drift_sigma.middleCols(1, 2);
+  std::size_t first = 0;
+  double dof = 0;
+  for (Eigen::Index i = 0; i < run.times.size(); ++i) {
+    dof += run.dof(i);
+    while (run.times(static_cast<Eigen::Index>(first)) <= run.times(i) - window)
+      dof -= run.dof(static_cast<Eigen::Index>(first++));
+    const double ratio = dof > 0 ? run.window_nis(i) / dof : 1.0;
+    for (int d = 0; d < 2; ++d)
+      out(i, d) *= product ? scale(d) * std::max(1.0, std::sqrt(ratio))
+                           : std::max(scale(d), std::sqrt(ratio));
+  }
+  return out;
+}
 
 /// Alarms over a set of runs.
 struct Alarms {
@@ -406,10 +439,12 @@ int main(int argc, char** argv) {
       observed_h += r.spec.duty_cycle.end / 3600;
       Score o, rr;
       const auto [po, so] = dy_dz(run);
-      o.add(po, so, truth, scale);
+      const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
+                            product = innovation_scaled_sigma(run, scale, true);
+      o.add(po, so, truth, scale, adaptive, product);
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
-      held.observer.add(po, so, truth, scale);
+      held.observer.add(po, so, truth, scale, adaptive, product);
       held.regression.add(pr, sr, truth);
       add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
       line(r.name, "campaign, held out", o, rr, run);
@@ -485,11 +520,13 @@ int main(int argc, char** argv) {
         } else {
           geffect_own.add(po, so, true_drift, own_scale);
         }
-        o.add(po, so, true_drift, scale);
+        const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
+                              product = innovation_scaled_sigma(run, scale, true);
+        o.add(po, so, true_drift, scale, adaptive, product);
         const auto [pr, sr] = regression_on(reg, g);
         rr.add(pr, sr, true_drift);
         Method& m = effect.present ? geffect : gclean;
-        m.observer.add(po, so, true_drift, scale);
+        m.observer.add(po, so, true_drift, scale, adaptive, product);
         m.regression.add(pr, sr, true_drift);
         add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
         std::string what = kind;
@@ -508,7 +545,11 @@ int main(int argc, char** argv) {
                 << fmt(100 * m.observer.coverage()(0)) << " %, "
                 << fmt(100 * m.observer.coverage()(1)) << " %, calibrated on the campaign "
                 << fmt(100 * m.observer.coverage_calibrated()(0)) << " %, "
-                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %; regression RMS dy "
+                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %, innovation-scaled "
+                << fmt(100 * m.observer.coverage_adaptive()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_adaptive()(1)) << " %, calibrated x innovations "
+                << fmt(100 * m.observer.coverage_product()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_product()(1)) << " %; regression RMS dy "
                 << fmt(m.regression.rms_um()(0)) << " um, dz " << fmt(m.regression.rms_um()(1))
                 << " um, coverage " << fmt(100 * m.regression.coverage()(0)) << " %, "
                 << fmt(100 * m.regression.coverage()(1)) << " %\n";
