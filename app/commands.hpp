@@ -39,6 +39,7 @@ struct PlaceArgs {
   int samples = 100, bins = 20, m_max = 6;
   bool sensor_noise = false;  /// place on readings with the campaign's sensor noise
   bool quiet = false;
+  std::vector<std::string> methods;  /// placement methods by name; empty: all but observer_variance
 };
 
 struct FitArgs {

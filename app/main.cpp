@@ -183,6 +183,11 @@ Command place_line(CLI::App& cli) {
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
   place
+      ->add_option("--methods", place_args.methods,
+                   "placement methods, comma-separated (default: all but observer_variance, the "
+                   "physics observer's posterior variance, which needs the reduced model)")
+      ->delimiter(',');
+  place
       ->add_option("--rom", place_args.rom,
                    "a reduced model (thermotwin reduce CASE --out DIR) to simulate the case on")
       ->check(CLI::ExistingDirectory);

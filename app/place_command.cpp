@@ -2,7 +2,9 @@
 //   thermotwin place CASE --out DIR          simulate the case, then place sensors on its
 //   candidates thermotwin place --from RUNDIR --out DIR place sensors on a finished run's histories
 // The candidates are the case's named points, or with [placement] candidates = "surface" the
-// vertices of the chosen surfaces (docs/placement.md).
+// vertices of the chosen surfaces (docs/placement.md). --methods observer_variance also places for
+// the physics observer (its posterior variance of each target) on the reduced model (--rom, or
+// built on the fly).
 // Writes placement.json, mi_ranking.csv, candidates_mi.vtp and mi_bars_<target>.png.
 #include <chrono>
 #include <iostream>
@@ -10,15 +12,18 @@
 
 #include "app/commands.hpp"
 #include "app/study.hpp"
+#include "core/errors.hpp"
 #include "fitting/noise.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/placement_out.hpp"
+#include "io/reduced_model_io.hpp"
 #include "io/reports.hpp"
 #include "io/vtk_out.hpp"
 #include "mesh/mesher.hpp"
 #include "placement/place.hpp"
 #include "solvers/campaign.hpp"
+#include "studies/estimation_input.hpp"
 
 namespace tt::app {
 
@@ -55,6 +60,51 @@ Histories with_sensor_noise(Histories h, std::uint64_t seed) {
   return h;
 }
 
+/// The methods --methods names; none named: every method but observer_variance (which needs the
+/// reduced model). Throws CaseError naming a name that is not a method.
+std::vector<placement::Method> methods_named(const std::vector<std::string>& names) {
+  std::vector<placement::Method> methods;
+  for (const auto& name : names) {
+    const auto m = core::value_in(placement::kMethodNames, name);
+    if (!m)
+      throw core::CaseError("place --methods: '" + name + "' is not a method; expected " +
+                            core::names_list(placement::kMethodNames));
+    methods.push_back(*m);
+  }
+  if (names.empty())
+    for (const auto m : placement::all_methods())
+      if (m != placement::Method::kObserverVariance) methods.push_back(m);
+  return methods;
+}
+
+/// The physics observer's model for placement for estimation: on the reduced model (`rom`, or
+/// built on the fly), the case's duty cycle read at every output time, the campaign's sensor
+/// noise and the observer's default process noise. `record` gets the settings.
+placement::EstimationProblem estimation_problem(const core::CaseSpec& spec, const Histories& h,
+                                                const std::filesystem::path& rom,
+                                                nlohmann::json& record) {
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  solvers::Twin twin;
+  if (rom.empty()) {
+    twin = solvers::case_twin(mesh, spec);
+  } else {
+    io::ReducedModelFile file = io::read_reduced_model(rom);
+    io::check_reduced_model_fits(file, io::reduced_model_key(spec, mesh), rom);
+    twin = std::move(file.twin);
+  }
+  const solvers::ObserverNoise noise;
+  const studies::EstimationCandidates candidates{h.names, h.nodes,
+                                                 fitting::SensorNoise{}.temperature_sigma};
+  record = {{"order", twin.model.states()},
+            {"rom", rom.empty() ? std::string("built on the fly") : rom.string()},
+            {"reading_interval_s", spec.thermal.output_interval},
+            {"sensor_sigma_K", candidates.sensor_sigma_k},
+            {"heat_walk_W_per_sqrt_h", noise.heat_walk_w},
+            {"air_walk_K_per_sqrt_h", noise.air_walk_k}};
+  return studies::observer_estimation_problem(twin, {spec}, candidates, h.target_names, noise,
+                                              spec.thermal.output_interval);
+}
+
 }  // namespace
 
 placement::PlacementInput placement_input(const Histories& h) {
@@ -71,7 +121,8 @@ placement::PlacementInput placement_input(const Histories& h) {
 
 int place_command(const PlaceArgs& args) {
   // 1. Candidate histories: simulate the case, or read a finished run. The output is claimed
-  //    first: one that is refused fails before any work.
+  //    first: one that is refused fails before any work, as does a method that is not one.
+  const std::vector<placement::Method> methods = methods_named(args.methods);
   core::CaseSpec spec;
   Histories h;
   std::optional<io::OutputDir> out;
@@ -98,8 +149,14 @@ int place_command(const PlaceArgs& args) {
   options.error_bins = args.bins;
   options.m_max = args.m_max;
   options.seed = spec.seed;
+  options.methods = methods;
+  placement::PlacementInput input = placement_input(h);
+  nlohmann::json estimation;
+  if (std::find(methods.begin(), methods.end(), placement::Method::kObserverVariance) !=
+      methods.end())
+    input.estimation = estimation_problem(spec, h, args.rom, estimation);
   const auto t_place = std::chrono::steady_clock::now();
-  const placement::PlacementResult result = placement::place_all(placement_input(h), options);
+  const placement::PlacementResult result = placement::place_all(input, options);
   const double place_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_place).count();
 
@@ -108,6 +165,7 @@ int place_command(const PlaceArgs& args) {
   nlohmann::json doc = io::placement_json(result);
   doc["sensor_noise"] = args.sensor_noise;
   doc["model"] = model_used;
+  if (input.estimation) doc["observer_variance"] = estimation;
   doc["candidates"] = nlohmann::json::array();
   for (size_t c = 0; c < h.names.size(); ++c) {
     nlohmann::json entry{{"id", c + 1},

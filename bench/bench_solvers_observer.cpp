@@ -4,14 +4,19 @@
 // undeclared effect).
 // Usage: bench_solvers_observer [CASE=cases/sb1_coarse.toml] [HOURS=5] [GEN_HOURS=4]
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
-//                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation]
+//                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
+//   COUNT: how many sensors the estimation criteria place (default: as many as the correlation
+//   union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse SB-1).
 //   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
 //   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
 //     correlation     the four best by the standard's correlation for dy and for dz, together
 //     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
 //     estimation      greedy on the observer's posterior variance of dy + dz over the fitting
-//                     runs' duty cycles (solvers::estimation_placement, issue 20 item 4)
+//                     runs' duty cycles read every 300 s (placement::estimation_greedy: rank-one
+//                     scores, issue 20 item 4)
+//     estimation_exact the same criterion, each candidate scored by its set's criterion afresh
+//                     (the filter re-run per candidate): what the rank-one scores stand in for
 // 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
 // 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
 //    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
@@ -50,6 +55,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/twin.hpp"
+#include "studies/estimation_input.hpp"
 #include "studies/placement_input.hpp"
 
 namespace {
@@ -65,16 +71,23 @@ double seconds_since(Clock::time_point t0) {
 /// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs).
 struct Score {
   Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero(),
-                  inside_calibrated = Eigen::Vector2d::Zero();
+                  inside_calibrated = Eigen::Vector2d::Zero(),
+                  inside_adaptive = Eigen::Vector2d::Zero(),
+                  inside_product = Eigen::Vector2d::Zero();
   double n = 0;
+  /// `adaptive`, `product`: more sigmas (#samples x 2, innovation_scaled_sigma's two rules);
+  /// none: not counted.
   void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
-           const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones()) {
+           const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones(),
+           const Eigen::MatrixXd& adaptive = {}, const Eigen::MatrixXd& product = {}) {
     for (Eigen::Index i = 1; i < truth.rows(); ++i) {  // t = 0 is the reference, not a prediction
       for (int d = 0; d < 2; ++d) {
         const double e = predicted(i, d) - truth(i, d);
         ss(d) += e * e;
         inside(d) += std::abs(e) <= 2 * sigma(i, d);
         inside_calibrated(d) += std::abs(e) <= 2 * scale(d) * sigma(i, d);
+        if (adaptive.size() != 0) inside_adaptive(d) += std::abs(e) <= 2 * adaptive(i, d);
+        if (product.size() != 0) inside_product(d) += std::abs(e) <= 2 * product(i, d);
       }
       n += 1;
     }
@@ -82,7 +95,33 @@ struct Score {
   Eigen::Vector2d rms_um() const { return (ss / n).cwiseSqrt() * 1e6; }
   Eigen::Vector2d coverage() const { return inside / n; }
   Eigen::Vector2d coverage_calibrated() const { return inside_calibrated / n; }
+  Eigen::Vector2d coverage_adaptive() const { return inside_adaptive / n; }
+  Eigen::Vector2d coverage_product() const { return inside_product / n; }
 };
+
+/// The observer's (dy, dz) sigma scaled by what its innovations say of the noise model now: per
+/// sample max(calibrated scale, sqrt(window NIS / window readings)), the window the consistency
+/// test's (ConsistencyOptions::window_s). Where the declared model holds the NIS ratio is at most
+/// about 1 and the calibrated scale stays; where the innovations outgrow the noise model the
+/// sigma grows with them (a covariance-matching estimate, not calibrated on any run). `product`:
+/// instead the calibrated scale times max(1, sqrt(ratio)).
+Eigen::MatrixXd innovation_scaled_sigma(const solvers::ObserverRun& run,
+                                        const Eigen::Vector2d& scale, bool product = false) {
+  const double window = solvers::ConsistencyOptions{}.window_s;
+  Eigen::MatrixXd out = run.drift_sigma.middleCols(1, 2);
+  std::size_t first = 0;
+  double dof = 0;
+  for (Eigen::Index i = 0; i < run.times.size(); ++i) {
+    dof += run.dof(i);
+    while (run.times(static_cast<Eigen::Index>(first)) <= run.times(i) - window)
+      dof -= run.dof(static_cast<Eigen::Index>(first++));
+    const double ratio = dof > 0 ? run.window_nis(i) / dof : 1.0;
+    for (int d = 0; d < 2; ++d)
+      out(i, d) *= product ? scale(d) * std::max(1.0, std::sqrt(ratio))
+                           : std::max(scale(d), std::sqrt(ratio));
+  }
+  return out;
+}
 
 /// Alarms over a set of runs.
 struct Alarms {
@@ -203,10 +242,12 @@ int main(int argc, char** argv) {
     if (argc > 7) campaign_noise.air_walk_k = std::stod(argv[7]);
     if (argc > 8) campaign_noise.drift_relative_sigma = std::stod(argv[8]);
     const std::string sensor_choice = argc > 9 ? argv[9] : "correlation";
+    const int count = argc > 10 ? std::stoi(argv[10]) : 0;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
-        sensor_choice != "estimation")
+        sensor_choice != "estimation" && sensor_choice != "estimation_exact")
       throw std::runtime_error("SENSORS '" + sensor_choice +
-                               "': expected correlation, mutual_info or estimation");
+                               "': expected correlation, mutual_info, estimation or "
+                               "estimation_exact");
     const auto t_all = Clock::now();
 
     // 1. Case, mesh, twin.
@@ -266,17 +307,45 @@ int main(int argc, char** argv) {
           if (s.method == placement::Method::kGaussianGreedy && s.m == 4)
             for (int c : s.columns)
               if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
-    } else if (sensor_choice == "estimation") {
+    } else if (sensor_choice.starts_with("estimation")) {
       std::vector<core::CaseSpec> fitting_runs;
       for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);
-      const solvers::EstimationPlacement placed = solvers::estimation_placement(
-          twin, fitting_runs, cand, {1, 2}, static_cast<int>(chosen.size()),
-          fitting::SensorNoise{}.temperature_sigma, campaign_noise, 300);
+      const placement::EstimationProblem problem = studies::observer_estimation_problem(
+          twin, fitting_runs, {cand, {}, fitting::SensorNoise{}.temperature_sigma}, {"dy", "dz"},
+          campaign_noise, 300);
+      std::cout << "estimation problem: " << problem.tracks.size() << " runs, "
+                << problem.candidate_rows.cols() << " filter states ("
+                << fmt(seconds_since(t_place)) << " s)\n";
+      const auto t_greedy = Clock::now();
+      const int m = count > 0 ? count : static_cast<int>(chosen.size());
+      const std::vector<int> targets{0, 1};
       chosen.clear();
-      for (const auto& s : placed.sensors)
-        chosen.push_back(static_cast<int>(std::find(cand.begin(), cand.end(), s) - cand.begin()));
-      std::cout << "estimation placement: posterior sigma of dy + dz after each sensor [um]:";
-      for (double v : placed.variance_m2) std::cout << " " << fmt(std::sqrt(v) * 1e6);
+      std::vector<double> criterion;
+      if (sensor_choice == "estimation") {
+        std::vector<int> pool(cand.size());
+        for (std::size_t k = 0; k < pool.size(); ++k) pool[k] = static_cast<int>(k);
+        const placement::GreedyPath placed =
+            placement::estimation_greedy(problem, pool, m, targets);
+        chosen = placed.order;
+        criterion = placed.scores;
+      } else {
+        for (int k = 0; k < m; ++k) {  // every candidate's set afresh
+          double best = std::numeric_limits<double>::infinity();
+          int best_c = -1;
+          for (int c = 0; c < static_cast<int>(cand.size()); ++c) {
+            if (std::find(chosen.begin(), chosen.end(), c) != chosen.end()) continue;
+            std::vector<int> trial = chosen;
+            trial.push_back(c);
+            const double v = placement::mean_posterior_variance(problem, trial).sum();
+            if (v < best) best = v, best_c = c;
+          }
+          chosen.push_back(best_c);
+          criterion.push_back(best);
+        }
+      }
+      std::cout << "estimation placement (" << fmt(seconds_since(t_greedy))
+                << " s): posterior sigma of dy + dz after each sensor [um]:";
+      for (double v : criterion) std::cout << " " << fmt(std::sqrt(v) * 1e6);
       std::cout << "\n";
     }
     std::vector<std::string> sensors;
@@ -370,10 +439,12 @@ int main(int argc, char** argv) {
       observed_h += r.spec.duty_cycle.end / 3600;
       Score o, rr;
       const auto [po, so] = dy_dz(run);
-      o.add(po, so, truth, scale);
+      const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
+                            product = innovation_scaled_sigma(run, scale, true);
+      o.add(po, so, truth, scale, adaptive, product);
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
-      held.observer.add(po, so, truth, scale);
+      held.observer.add(po, so, truth, scale, adaptive, product);
       held.regression.add(pr, sr, truth);
       add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
       line(r.name, "campaign, held out", o, rr, run);
@@ -449,11 +520,13 @@ int main(int argc, char** argv) {
         } else {
           geffect_own.add(po, so, true_drift, own_scale);
         }
-        o.add(po, so, true_drift, scale);
+        const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
+                              product = innovation_scaled_sigma(run, scale, true);
+        o.add(po, so, true_drift, scale, adaptive, product);
         const auto [pr, sr] = regression_on(reg, g);
         rr.add(pr, sr, true_drift);
         Method& m = effect.present ? geffect : gclean;
-        m.observer.add(po, so, true_drift, scale);
+        m.observer.add(po, so, true_drift, scale, adaptive, product);
         m.regression.add(pr, sr, true_drift);
         add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
         std::string what = kind;
@@ -472,7 +545,11 @@ int main(int argc, char** argv) {
                 << fmt(100 * m.observer.coverage()(0)) << " %, "
                 << fmt(100 * m.observer.coverage()(1)) << " %, calibrated on the campaign "
                 << fmt(100 * m.observer.coverage_calibrated()(0)) << " %, "
-                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %; regression RMS dy "
+                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %, innovation-scaled "
+                << fmt(100 * m.observer.coverage_adaptive()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_adaptive()(1)) << " %, calibrated x innovations "
+                << fmt(100 * m.observer.coverage_product()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_product()(1)) << " %; regression RMS dy "
                 << fmt(m.regression.rms_um()(0)) << " um, dz " << fmt(m.regression.rms_um()(1))
                 << " um, coverage " << fmt(100 * m.regression.coverage()(0)) << " %, "
                 << fmt(100 * m.regression.coverage()(1)) << " %\n";

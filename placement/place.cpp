@@ -11,6 +11,7 @@
 #include "core/rng.hpp"
 #include "core/timing.hpp"
 #include "placement/baselines.hpp"
+#include "placement/estimation.hpp"
 #include "placement/gaussian.hpp"
 #include "placement/histogram_mi.hpp"
 #include "placement/ksg.hpp"
@@ -25,6 +26,10 @@ using core::seconds_since;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+bool wants(const PlacementOptions& o, Method m) {
+  return std::find(o.methods.begin(), o.methods.end(), m) != o.methods.end();
+}
 
 void validate(const PlacementInput& in, const PlacementOptions& o) {
   const auto n = static_cast<Eigen::Index>(in.ids.size());
@@ -52,6 +57,8 @@ void validate(const PlacementInput& in, const PlacementOptions& o) {
                             std::to_string(t.values_m.size()) + " values for " +
                             std::to_string(in.times_s.size()) +
                             " times (or non-finite values): expected one finite value per time");
+  if (in.estimation)
+    placement::validate(*in.estimation, n, static_cast<Eigen::Index>(in.targets.size()));
   if (o.samples != 0 && o.samples < 3)
     throw core::DataError("placement.samples = " + std::to_string(o.samples) +
                           ": must be 0 (as given) or >= 3 (the patent uses 100)");
@@ -238,12 +245,100 @@ std::vector<Method> all_methods() {
   return methods;
 }
 
+namespace {
+
+void estimation_selections(const TargetData& d, std::vector<Selection>& out) {
+  const int target = static_cast<int>(d.target_index);
+  // The other methods' guard: a candidate that is not a sensor of its own on the histories.
+  const Admissible admissible = [&](std::span<const int> chosen, int candidate) {
+    return adds_direction(d.linear, chosen, candidate, d.options.collinearity);
+  };
+  const GreedyPath path = estimation_greedy(*d.input.estimation, d.pool, d.options.m_max,
+                                            std::span<const int>(&target, 1), admissible);
+  for (std::size_t m = 1; m <= path.order.size(); ++m) {
+    // The score is the RMS posterior sigma over the readings [m]: lower is better.
+    out.push_back(selection(
+        d, Method::kObserverVariance, "greedy",
+        std::vector<int>(path.order.begin(), path.order.begin() + static_cast<std::ptrdiff_t>(m)),
+        std::sqrt(path.scores[m - 1]), "posterior_sigma_m", path.seconds[m - 1]));
+  }
+}
+
+void ksg_selections(const TargetData& d, TargetResult& tr) {
+  const auto& o = d.options;
+  tr.ksg_pool = ksg_pool_of(d.pool, d.linear, o.ksg_max_candidates);
+  const auto ksg =
+      ksg_problem(d.linear, o.ksg_k, core::derived_seed(o.seed, stream(d, Method::kKsgGreedy, 63)));
+  const int m_max = std::min(o.m_max, static_cast<int>(tr.ksg_pool.size()));
+  if (wants(o, Method::kKsgGreedy))
+    path_selections(d, Method::kKsgGreedy,
+                    ksg_greedy(ksg, d.linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
+                    tr.selections);
+  if (wants(o, Method::kJmiKsg))
+    path_selections(d, Method::kJmiKsg,
+                    jmi_greedy(ksg, d.linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
+                    tr.selections);
+}
+
+void qr_pod_selections(const TargetData& d, const Eigen::MatrixXd& modes, double pod_seconds,
+                       std::vector<Selection>& out) {
+  const auto& o = d.options;
+  for (int m = 1; m <= std::min<int>(o.m_max, static_cast<int>(d.pool.size())); ++m) {
+    const auto start = Clock::now();
+    const Eigen::MatrixXd lead = modes.leftCols(std::min<Eigen::Index>(m, modes.cols()));
+    const auto cols = qr_pivots(lead, d.pool, m, d.linear, o.collinearity);
+    if (static_cast<int>(cols.size()) < m) break;  // the modes are exhausted
+    auto s = selection(d, Method::kQrPod, "qr", cols, 0.0, "gaussian_bits",
+                       pod_seconds + seconds_since(start));
+    s.score = s.gaussian_bits;
+    out.push_back(std::move(s));
+  }
+}
+
+/// Every method in options.methods for target t on the resampled histories.
+TargetResult target_result(const PlacementInput& input, const PlacementOptions& o,
+                           const PlacementResult& result, const Eigen::MatrixXd& temperatures,
+                           const Eigen::MatrixXd& modes, std::size_t t) {
+  const auto& target = input.targets[t];
+  const Eigen::VectorXd y =
+      o.samples > 0
+          ? Eigen::VectorXd(resampled(input.times_s, target.values_m, result.sample_times_s))
+          : target.values_m;
+  const auto linear = linear_problem(temperatures, y);
+  const auto binned = binned_problem(temperatures, y, o.temperature_bins, o.error_bins);
+  const bool searches = wants(o, Method::kGaussianGreedy) || wants(o, Method::kGaussianGa) ||
+                        wants(o, Method::kHistogramMi);
+  const GreedyPath greedy =
+      searches ? gaussian_greedy(linear, result.pool, o.m_max, o.collinearity) : GreedyPath{};
+  const TargetData d{linear, binned, result.pool, input, o, t, greedy};
+
+  TargetResult tr;
+  tr.target = target.name;
+  tr.mi_bits = single_mi_bits(binned);
+  tr.mi_rank = ranks_descending(tr.mi_bits);
+  auto& out = tr.selections;
+  if (wants(o, Method::kHistogramMi)) histogram_selections(d, tr.mi_bits, out);
+  if (wants(o, Method::kGaussianGreedy))
+    path_selections(d, Method::kGaussianGreedy, greedy, "gaussian_bits", out);
+  if (wants(o, Method::kGaussianGa)) gaussian_ga_selections(d, out);
+  if (wants(o, Method::kKsgGreedy) || wants(o, Method::kJmiKsg)) ksg_selections(d, tr);
+  if (wants(o, Method::kQrPod)) qr_pod_selections(d, modes, result.pod_seconds, out);
+  if (wants(o, Method::kCorrelation))
+    ranked_selections(d, Method::kCorrelation, linear.r_y.cwiseAbs(), "abs_r", 0.0, out);
+  if (wants(o, Method::kGreyRelational)) {
+    const auto start = Clock::now();
+    const auto grades = grey_relational_grades(temperatures, y, o.grey_rho);
+    ranked_selections(d, Method::kGreyRelational, grades, "grey_grade", seconds_since(start), out);
+  }
+  if (wants(o, Method::kObserverVariance) && input.estimation) estimation_selections(d, out);
+  return tr;
+}
+
+}  // namespace
+
 PlacementResult place_all(const PlacementInput& input, const PlacementOptions& options) {
   validate(input, options);
   const auto& o = options;
-  auto wants = [&](Method m) {
-    return std::find(o.methods.begin(), o.methods.end(), m) != o.methods.end();
-  };
 
   // 1. A common sample grid.
   PlacementResult result;
@@ -266,73 +361,15 @@ PlacementResult place_all(const PlacementInput& input, const PlacementOptions& o
 
   // 3. POD modes do not depend on the target: once.
   Eigen::MatrixXd modes;
-  if (wants(Method::kQrPod)) {
+  if (wants(o, Method::kQrPod)) {
     const auto start = Clock::now();
     modes = pod_modes(temperatures, o.m_max);
     result.pod_seconds = seconds_since(start);
   }
 
   // 4. Every method for every target.
-  for (std::size_t t = 0; t < input.targets.size(); ++t) {
-    const auto& target = input.targets[t];
-    const Eigen::VectorXd y =
-        o.samples > 0
-            ? Eigen::VectorXd(resampled(input.times_s, target.values_m, result.sample_times_s))
-            : target.values_m;
-    const auto linear = linear_problem(temperatures, y);
-    const auto binned = binned_problem(temperatures, y, o.temperature_bins, o.error_bins);
-    const bool searches =
-        wants(Method::kGaussianGreedy) || wants(Method::kGaussianGa) || wants(Method::kHistogramMi);
-    const GreedyPath greedy =
-        searches ? gaussian_greedy(linear, result.pool, o.m_max, o.collinearity) : GreedyPath{};
-    const TargetData d{linear, binned, result.pool, input, o, t, greedy};
-
-    TargetResult tr;
-    tr.target = target.name;
-    tr.mi_bits = single_mi_bits(binned);
-    tr.mi_rank = ranks_descending(tr.mi_bits);
-    auto& out = tr.selections;
-
-    if (wants(Method::kHistogramMi)) histogram_selections(d, tr.mi_bits, out);
-    if (wants(Method::kGaussianGreedy))
-      path_selections(d, Method::kGaussianGreedy, greedy, "gaussian_bits", out);
-    if (wants(Method::kGaussianGa)) gaussian_ga_selections(d, out);
-    if (wants(Method::kKsgGreedy) || wants(Method::kJmiKsg)) {
-      tr.ksg_pool = ksg_pool_of(result.pool, linear, o.ksg_max_candidates);
-      const auto ksg = ksg_problem(linear, o.ksg_k,
-                                   core::derived_seed(o.seed, stream(d, Method::kKsgGreedy, 63)));
-      const int m_max = std::min(o.m_max, static_cast<int>(tr.ksg_pool.size()));
-      if (wants(Method::kKsgGreedy))
-        path_selections(d, Method::kKsgGreedy,
-                        ksg_greedy(ksg, linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
-                        out);
-      if (wants(Method::kJmiKsg))
-        path_selections(d, Method::kJmiKsg,
-                        jmi_greedy(ksg, linear, tr.ksg_pool, m_max, o.collinearity), "ksg_bits",
-                        out);
-    }
-    if (wants(Method::kQrPod)) {
-      for (int m = 1; m <= std::min<int>(o.m_max, static_cast<int>(result.pool.size())); ++m) {
-        const auto start = Clock::now();
-        const Eigen::MatrixXd lead = modes.leftCols(std::min<Eigen::Index>(m, modes.cols()));
-        const auto cols = qr_pivots(lead, result.pool, m, linear, o.collinearity);
-        if (static_cast<int>(cols.size()) < m) break;  // the modes are exhausted
-        auto s = selection(d, Method::kQrPod, "qr", cols, 0.0, "gaussian_bits",
-                           result.pod_seconds + seconds_since(start));
-        s.score = s.gaussian_bits;
-        out.push_back(std::move(s));
-      }
-    }
-    if (wants(Method::kCorrelation))
-      ranked_selections(d, Method::kCorrelation, linear.r_y.cwiseAbs(), "abs_r", 0.0, out);
-    if (wants(Method::kGreyRelational)) {
-      const auto start = Clock::now();
-      const auto grades = grey_relational_grades(temperatures, y, o.grey_rho);
-      ranked_selections(d, Method::kGreyRelational, grades, "grey_grade", seconds_since(start),
-                        out);
-    }
-    result.targets.push_back(std::move(tr));
-  }
+  for (std::size_t t = 0; t < input.targets.size(); ++t)
+    result.targets.push_back(target_result(input, o, result, temperatures, modes, t));
   return result;
 }
 

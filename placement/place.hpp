@@ -1,7 +1,9 @@
 // One call that runs every placement method on candidate histories and error targets:
 // the patent's histogram mutual information (ranking, exhaustive or genetic search, with its
 // saturation diagnosis), the stronger criteria (Gaussian MI greedy and GA, KSG greedy, JMI on
-// KSG, QR pivoting on POD modes) and the baselines (correlation ranking, grey relational grade).
+// KSG, QR pivoting on POD modes), the baselines (correlation ranking, grey relational grade) and,
+// when the input carries the observer's covariance model, placement for estimation (the physics
+// observer's posterior variance of each target).
 //
 // Data flow: histories on any time grid -> resampled to S samples -> per target: binned and
 // linear problems -> one Selection per (method, m).
@@ -17,6 +19,7 @@
 
 #include "core/enum_names.hpp"
 #include "core/ids.hpp"
+#include "placement/estimation.hpp"
 #include "placement/gaussian.hpp"
 #include "placement/saturation.hpp"
 #include "placement/search.hpp"
@@ -32,10 +35,11 @@ enum class Method {
   kQrPod,           ///< column-pivoted QR on the leading POD modes (ignores the target)
   kCorrelation,     ///< DB3401/T 326-2024 7.1: rank by |r| with the error
   kGreyRelational,  ///< grey relational grade, ρ = grey_rho
+  kObserverVariance,  ///< greedy on the observer's mean posterior variance (needs `estimation`)
 };
 
 /// Stable lower-case names used in files, in the order all_methods() lists them.
-inline constexpr std::array<core::Named<Method>, 8> kMethodNames{{
+inline constexpr std::array<core::Named<Method>, 9> kMethodNames{{
     {Method::kHistogramMi, "histogram_mi"},
     {Method::kGaussianGreedy, "gaussian_greedy"},
     {Method::kGaussianGa, "gaussian_ga"},
@@ -44,6 +48,7 @@ inline constexpr std::array<core::Named<Method>, 8> kMethodNames{{
     {Method::kQrPod, "qr_pod"},
     {Method::kCorrelation, "correlation"},
     {Method::kGreyRelational, "grey_relational"},
+    {Method::kObserverVariance, "observer_variance"},
 }};
 static_assert(core::one_to_one(kMethodNames));
 
@@ -63,6 +68,10 @@ struct PlacementInput {
   Eigen::VectorXd times_s;          ///< #times, strictly increasing [s]
   Eigen::MatrixXd temperatures_K;   ///< #times x #candidates histories [K]
   std::vector<Target> targets;
+  /// The physics observer's covariance model on these candidates (rows in column order) and
+  /// targets (rows in target order), for Method::kObserverVariance; without it that method is
+  /// skipped. It does not see the histories.
+  std::optional<EstimationProblem> estimation;
 };
 
 struct PlacementOptions {
@@ -95,7 +104,7 @@ struct Selection {
   std::vector<int> columns;         ///< the same as input columns
   double score = 0.0;               ///< the method's own criterion, see score_kind
   std::string score_kind;           ///< "histogram_bits", "gaussian_bits", "ksg_bits", "abs_r",
-                                    ///< "grey_grade"
+                                    ///< "grey_grade", "posterior_sigma_m"
   double gaussian_bits = 0.0;  ///< −½·log2(1 − R²) of the set: one yardstick for all methods
   double seconds = 0.0;        ///< wall time to produce this set [s]
   std::int64_t evaluations = 0;                   ///< distinct combinations scored (searches only)

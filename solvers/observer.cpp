@@ -6,7 +6,6 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "core/parallel.hpp"
 #include "core/units.hpp"
 #include "solvers/loads.hpp"
 
@@ -208,6 +207,36 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
   if (air) p_(r_ + nh, r_ + nh) = n.air_initial_k * n.air_initial_k;
 }
 
+namespace {
+
+/// F P F^T for F = [[phi, gamma], [0, I]], by blocks (r states, then the unknown inputs).
+Eigen::MatrixXd propagated(const Eigen::MatrixXd& p, const Eigen::MatrixXd& phi,
+                           const Eigen::MatrixXd& gamma) {
+  const Eigen::Index r = phi.rows(), nb = gamma.cols();
+  const auto pzz = p.topLeftCorner(r, r), pzb = p.topRightCorner(r, nb),
+             pbb = p.bottomRightCorner(nb, nb);
+  // Coefficient-wise products: matrices of ~100 rows do not pay for Eigen's OpenMP-parallel GEMM,
+  // whose threads wait on each other every step when the cores are shared (as in the stepper).
+  const Eigen::MatrixXd left = phi.lazyProduct(pzz) + gamma.lazyProduct(pzb.transpose());  // r x r
+  const Eigen::MatrixXd cross = phi.lazyProduct(pzb) + gamma.lazyProduct(pbb);             // r x nb
+  const Eigen::MatrixXd zz =
+      left.lazyProduct(phi.transpose()) + cross.lazyProduct(gamma.transpose());
+  Eigen::MatrixXd out(p.rows(), p.cols());
+  out.topLeftCorner(r, r) = 0.5 * (zz + zz.transpose());
+  out.topRightCorner(r, nb) = cross;
+  out.bottomLeftCorner(nb, r) = cross.transpose();
+  out.bottomRightCorner(nb, nb) = pbb;
+  return out;
+}
+
+}  // namespace
+
+void KalmanObserver::add_process_noise(Eigen::MatrixXd& p, double dt) const {
+  const double walk = setup_.noise.state_walk_k;
+  if (walk > 0) p.topLeftCorner(r_, r_).diagonal().array() += walk * walk / 3600.0 * dt;
+  p.bottomRightCorner(nb_, nb_).diagonal() += bias_walk_ * dt;
+}
+
 void KalmanObserver::step(double t1) {
   const AffineStep a = stepper_.step(t_, t1, prev_speed_, x_.head(r_));
   const double dt = t1 - t_;
@@ -222,21 +251,16 @@ void KalmanObserver::step(double t1) {
   }
   const Eigen::MatrixXd gamma = (*a.step_inverse).lazyProduct(dt * b);
   const Eigen::MatrixXd& phi = *a.transition;
-  // x1 = F x0 + [u; 0], F = [[Phi, Gamma], [0, I]]; P1 = F P0 F^T + Q, by blocks.
+  // x1 = F x0 + [u; 0], F = [[Phi, Gamma], [0, I]]; P1 = F P0 F^T + Q.
   Eigen::VectorXd z = phi * x_.head(r_) + a.input + gamma * x_.tail(nb_);
-  const Eigen::MatrixXd pzz = p_.topLeftCorner(r_, r_), pzb = p_.topRightCorner(r_, nb_),
-                        pbb = p_.bottomRightCorner(nb_, nb_);
-  // Coefficient-wise products: matrices of ~100 rows do not pay for Eigen's OpenMP-parallel GEMM,
-  // whose threads wait on each other every step when the cores are shared (as in the stepper).
-  const Eigen::MatrixXd left = phi.lazyProduct(pzz) + gamma.lazyProduct(pzb.transpose());  // r x r
-  const Eigen::MatrixXd cross = phi.lazyProduct(pzb) + gamma.lazyProduct(pbb);             // r x nb
-  Eigen::MatrixXd zz = left.lazyProduct(phi.transpose()) + cross.lazyProduct(gamma.transpose());
-  const double walk = setup_.noise.state_walk_k;
-  if (walk > 0) zz.diagonal().array() += walk * walk / 3600.0 * dt;
-  p_.topLeftCorner(r_, r_) = 0.5 * (zz + zz.transpose());
-  p_.topRightCorner(r_, nb_) = cross;
-  p_.bottomLeftCorner(nb_, r_) = cross.transpose();
-  p_.bottomRightCorner(nb_, nb_).diagonal() += bias_walk_ * dt;
+  p_ = propagated(p_, phi, gamma);
+  add_process_noise(p_, dt);
+  if (map_) {
+    Eigen::MatrixXd& f = map_->transition;
+    f.topRows(r_) = (phi.lazyProduct(f.topRows(r_)) + gamma.lazyProduct(f.bottomRows(nb_))).eval();
+    map_->process = propagated(map_->process, phi, gamma);
+    add_process_noise(map_->process, dt);
+  }
   x_.head(r_) = std::move(z);
   t_ = t1;
   prev_speed_ = a.speed;
@@ -314,6 +338,20 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
   e.recalibrate_since_s = monitor_.since_s();
   return e;
+}
+
+CovarianceMap KalmanObserver::advance(double t) {
+  const Eigen::Index n = r_ + nb_;
+  CovarianceMap map{Eigen::MatrixXd::Identity(n, n), Eigen::MatrixXd::Zero(n, n)};
+  map_ = &map;
+  try {
+    advance_to(t);
+  } catch (...) {
+    map_ = nullptr;
+    throw;
+  }
+  map_ = nullptr;
+  return map;
 }
 
 ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& spec,
@@ -407,73 +445,6 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
     if (observed_with.size() != 0) scale(t) *= observed_with(t);
   }
   return scale;
-}
-
-Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
-                                    const std::vector<core::CaseSpec>& runs,
-                                    const ObserverSetup& setup, double sample_s) {
-  if (!(sample_s > 0)) throw core::SolverError("observer: sample_s = " + number(sample_s));
-  ObserverSetup s = setup;
-  s.noise.drift_relative_sigma = 0;
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(s.target_rows.rows());
-  double n = 0;
-  for (const auto& spec : runs) {
-    KalmanObserver observer(system, spec, s);
-    // Any values do: the covariance does not see them. The initial temperature keeps the
-    // innovations, and so the states, of the order of a real run's.
-    const Eigen::VectorXd readings = Eigen::VectorXd::Constant(
-        s.sensor_rows.rows(), spec.thermal.initial_temperature_c + core::kCelsiusOffset);
-    for (double t = sample_s; t <= spec.duty_cycle.end + 1e-9; t += sample_s) {
-      sum += observer.assimilate(t, readings).drift_sigma.array().square().matrix();
-      n += 1;
-    }
-  }
-  return n > 0 ? Eigen::VectorXd(sum / n) : sum;
-}
-
-EstimationPlacement estimation_placement(const Twin& twin, const std::vector<core::CaseSpec>& runs,
-                                         const std::vector<std::string>& candidates,
-                                         const std::vector<int>& targets, int m,
-                                         double sensor_sigma_k, const ObserverNoise& noise,
-                                         double sample_s) {
-  if (m < 1 || m > static_cast<int>(candidates.size()))
-    throw core::SolverError("estimation placement: m = " + std::to_string(m) + " of " +
-                            std::to_string(candidates.size()) + " candidates");
-  if (runs.empty()) throw core::SolverError("estimation placement: no run to place on");
-  const auto setup_for = [&](const std::vector<std::string>& sensors) {
-    ObserverNoise with = noise;
-    with.sensor_sigma_k =
-        Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), sensor_sigma_k);
-    return twin_observer_setup(twin, runs.front(), sensors, with);
-  };
-  // The targets do not depend on the sensors: checked once, not per candidate set.
-  const Eigen::Index target_count = setup_for({candidates.front()}).target_rows.rows();
-  for (int t : targets)
-    if (t < 0 || t >= target_count)
-      throw core::SolverError("estimation placement: target index " + std::to_string(t) + " of " +
-                              std::to_string(target_count));
-  const auto criterion = [&](const std::vector<std::string>& sensors) {
-    const Eigen::VectorXd v =
-        mean_drift_variance(twin.model.system, runs, setup_for(sensors), sample_s);
-    double sum = 0;
-    for (int t : targets) sum += v(t);
-    return sum;
-  };
-  EstimationPlacement out;
-  std::vector<std::string> left = candidates;
-  for (int k = 0; k < m; ++k) {
-    std::vector<double> score(left.size());
-    core::parallel_for(static_cast<std::ptrdiff_t>(left.size()), [&](std::ptrdiff_t c) {
-      std::vector<std::string> trial = out.sensors;
-      trial.push_back(left[static_cast<std::size_t>(c)]);
-      score[static_cast<std::size_t>(c)] = criterion(trial);
-    });
-    const auto best = std::min_element(score.begin(), score.end()) - score.begin();
-    out.sensors.push_back(left[static_cast<std::size_t>(best)]);
-    out.variance_m2.push_back(score[static_cast<std::size_t>(best)]);
-    left.erase(left.begin() + best);
-  }
-  return out;
 }
 
 }  // namespace tt::solvers

@@ -124,6 +124,13 @@ struct ObserverEstimate {
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// How the filter's covariance goes from one time to a later one with no reading between:
+/// P(t1) = F P(t0) F^T + Q over the steps taken (F = the product of the steps' maps).
+struct CovarianceMap {
+  Eigen::MatrixXd transition;  /// (r + #unknown inputs) square: F
+  Eigen::MatrixXd process;     /// the same size: Q [K^2, W^2, ...]
+};
+
 /// The filter. Steps the case's loads (its duty cycle, feed axis, sinks and fluxes are its inputs)
 /// in steps of at most the case's step, equal between the load's switches and the readings, and
 /// assimilates readings as they come. It looks no further ahead than the next reading: the duty
@@ -139,6 +146,10 @@ class KalmanObserver {
   /// (#sensors [K], NaN: missing). Throws SolverError for t before the last assimilation or
   /// beyond the duty cycle's end, or readings of another size.
   ObserverEstimate assimilate(double t, const Eigen::VectorXd& readings);
+  /// Steps to time t as assimilate does, without a reading, and returns the covariance's map over
+  /// those steps: what a criterion on the covariance alone needs (it does not see the readings'
+  /// values; placement for estimation). Throws as assimilate does.
+  CovarianceMap advance(double t);
 
   const Eigen::VectorXd& state() const { return x_; }  /// [z; b]
   const Eigen::MatrixXd& covariance() const { return p_; }
@@ -149,6 +160,7 @@ class KalmanObserver {
  private:
   void advance_to(double t);
   void step(double t1);
+  void add_process_noise(Eigen::MatrixXd& p, double dt) const;
 
   const ReducedThermalSystem& sys_;
   const core::CaseSpec& spec_;
@@ -162,6 +174,7 @@ class KalmanObserver {
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
+  CovarianceMap* map_ = nullptr;  /// while advance() runs: the steps' map, accumulated
 };
 
 /// A whole run through the observer: one assimilation per sample.
@@ -203,32 +216,5 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
                                         const std::vector<Eigen::MatrixXd>& truths,
                                         double truth_sigma_m = 0,
                                         const Eigen::VectorXd& observed_with = {});
-
-/// The observer's posterior variance of each target's drift [m^2], averaged over readings every
-/// `sample_s` on each of `runs` (their duty cycles) and over the runs. The Kalman covariance does
-/// not depend on the readings' values, only on which sensors read and their noise, so this is
-/// known before any sensor is placed. setup.noise.drift_relative_sigma, which scales with the
-/// predicted drift, is left out; drift_sigma_scale is kept. #targets.
-Eigen::VectorXd mean_drift_variance(const ReducedThermalSystem& system,
-                                    const std::vector<core::CaseSpec>& runs,
-                                    const ObserverSetup& setup, double sample_s);
-
-/// Sensors placed for estimation: added one at a time, each the candidate that lowers the
-/// observer's mean posterior variance of the chosen targets' drift (summed over `targets`, indices
-/// into the setup's target names, see twin_observer_setup) the most.
-struct EstimationPlacement {
-  std::vector<std::string> sensors;  /// in the order chosen
-  std::vector<double> variance_m2;   /// after each addition: the criterion [m^2]
-};
-
-/// Greedy placement of m sensors among `candidates` (named points of the twin), each read with
-/// white noise `sensor_sigma_k` [K], under `noise`'s random walks, over `runs`' duty cycles read
-/// every `sample_s`. Candidates are scored side by side (core::parallel_for). Throws SolverError
-/// for m outside 1..#candidates or an unknown candidate or target.
-EstimationPlacement estimation_placement(const Twin& twin, const std::vector<core::CaseSpec>& runs,
-                                         const std::vector<std::string>& candidates,
-                                         const std::vector<int>& targets, int m,
-                                         double sensor_sigma_k, const ObserverNoise& noise,
-                                         double sample_s);
 
 }  // namespace tt::solvers

@@ -22,6 +22,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/observer_live.hpp"
 #include "solvers/twin.hpp"
+#include "studies/estimation_input.hpp"
 
 namespace tt::observer_test {
 namespace {
@@ -294,41 +295,52 @@ TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) 
                                                     Eigen::MatrixXd::Constant(6, k, 320.0));
   EXPECT_LE((cool.drift_sigma - hot.drift_sigma).cwiseAbs().maxCoeff(),
             1e-9 * cool.drift_sigma.maxCoeff());
-  const Eigen::VectorXd v = solvers::mean_drift_variance(s_->twin.model.system, {c}, set, 600);
-  EXPECT_NEAR(v(1), cool.drift_sigma.col(1).array().square().mean(), 1e-9 * v(1));
-
-  // Greedy placement for estimation of dy and dz among every named T point: each sensor added
-  // lowers the posterior variance, the reported figure is the set's criterion, and three placed
-  // sensors estimate better than the first three of the hand-picked set.
+  // The covariance model as placement takes it (studies::observer_estimation_problem: the map
+  // from each reading to the next, KalmanObserver::advance) gives the observer's own variance.
   std::vector<std::string> candidates;
   for (int i = 0; i < s_->twin.outputs.temperatures; ++i)
     if (const std::string& n = s_->twin.outputs.names[static_cast<std::size_t>(i)];
         n.size() == 3 && n[0] == 'T' && std::isdigit(static_cast<unsigned char>(n[1])))
       candidates.push_back(n);  // T01..T54, not the TCP
   ASSERT_GE(candidates.size(), 20u);
-  solvers::ObserverNoise noise = default_noise();
-  const solvers::EstimationPlacement placed =
-      solvers::estimation_placement(s_->twin, {c}, candidates, {1, 2}, 3, 0.04, noise, 600);
-  ASSERT_EQ(placed.sensors.size(), 3u);
-  EXPECT_LT(placed.variance_m2[1], placed.variance_m2[0]);
-  EXPECT_LT(placed.variance_m2[2], placed.variance_m2[1]);
-  const auto criterion = [&](const std::vector<std::string>& sensors) {
-    noise.sensor_sigma_k =
-        Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.04);
-    const Eigen::VectorXd var = solvers::mean_drift_variance(
-        s_->twin.model.system, {c}, solvers::twin_observer_setup(s_->twin, c, sensors, noise), 600);
+  const placement::EstimationProblem problem = studies::observer_estimation_problem(
+      s_->twin, {c}, {candidates, {}, 0.04}, {"dx", "dy", "dz"}, default_noise(), 600);
+  std::vector<int> hand;
+  for (const auto& id : kSensors)
+    hand.push_back(
+        static_cast<int>(std::find(candidates.begin(), candidates.end(), id) - candidates.begin()));
+  const Eigen::VectorXd v = placement::mean_posterior_variance(problem, hand);
+  for (int t = 0; t < 3; ++t)
+    EXPECT_NEAR(v(t), cool.drift_sigma.col(t).array().square().mean(), 1e-9 * v(t)) << t;
+
+  // Greedy placement for estimation of dy and dz among every named T point: each sensor added
+  // lowers the posterior variance, the reported figure is the set's criterion, and three placed
+  // sensors estimate better than the first three of the hand-picked set.
+  std::vector<int> pool(candidates.size());
+  for (std::size_t k = 0; k < pool.size(); ++k) pool[k] = static_cast<int>(k);
+  const std::vector<int> dy_dz{1, 2};
+  const placement::GreedyPath placed = placement::estimation_greedy(problem, pool, 3, dy_dz);
+  ASSERT_EQ(placed.order.size(), 3u);
+  EXPECT_LT(placed.scores[1], placed.scores[0]);
+  EXPECT_LT(placed.scores[2], placed.scores[1]);
+  const auto criterion = [&](const std::vector<int>& sensors) {
+    const Eigen::VectorXd var = placement::mean_posterior_variance(problem, sensors);
     return var(1) + var(2);
   };
-  EXPECT_NEAR(criterion(placed.sensors), placed.variance_m2[2], 1e-9 * placed.variance_m2[2]);
-  const double hand = criterion({kSensors[0], kSensors[1], kSensors[2]});
-  EXPECT_LT(placed.variance_m2[2], hand);
+  EXPECT_NEAR(criterion(placed.order), placed.scores[2], 1e-10 * placed.scores[2]);
+  const double first3 = criterion({hand[0], hand[1], hand[2]});
+  EXPECT_LT(placed.scores[2], first3);
+  const auto name = [&](int k) { return candidates[static_cast<std::size_t>(placed.order[k])]; };
   std::printf(
       "[observer] placed for estimation: %s %s %s, sigma(dy+dz) %.3g um (hand-picked %s "
       "%s %s: %.3g um)\n",
-      placed.sensors[0].c_str(), placed.sensors[1].c_str(), placed.sensors[2].c_str(),
-      std::sqrt(placed.variance_m2[2]) * 1e6, kSensors[0].c_str(), kSensors[1].c_str(),
-      kSensors[2].c_str(), std::sqrt(hand) * 1e6);
-  EXPECT_THROW(solvers::estimation_placement(s_->twin, {c}, candidates, {1}, 0, 0.04, noise, 600),
+      name(0).c_str(), name(1).c_str(), name(2).c_str(), std::sqrt(placed.scores[2]) * 1e6,
+      kSensors[0].c_str(), kSensors[1].c_str(), kSensors[2].c_str(), std::sqrt(first3) * 1e6);
+  EXPECT_THROW(studies::observer_estimation_problem(s_->twin, {c}, {{"T02", "nowhere"}, {}, 0.04},
+                                                    {"dy"}, default_noise(), 600),
+               core::SolverError);
+  EXPECT_THROW(studies::observer_estimation_problem(s_->twin, {c}, {{"T02"}, {}, 0.04}, {"dq"},
+                                                    default_noise(), 600),
                core::SolverError);
 }
 

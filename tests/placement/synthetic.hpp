@@ -93,4 +93,37 @@ inline PlacementInput c54_input(double noise_K, std::uint64_t seed) {
   return in;
 }
 
+/// The physics observer's view of c54_input's machine, for placement for estimation: the three
+/// responses as the filter's states, each a first-order lag of its time constant driven by an
+/// unknown heat input (white, variance 1 - a^2 per reading, a = exp(-dt/tau)); a candidate reads
+/// its weights on them (as c54_input mixes them) with `sigma_K`; dy and dz are c54_input's rows.
+/// One run of `readings` readings every 360 s from a known start.
+inline EstimationProblem c54_estimation(const PlacementInput& in, double sigma_K, int readings) {
+  EstimationProblem p;
+  const double tau[3] = {400.0, 1500.0, 5000.0}, dt = 360.0;
+  Eigen::Matrix3d f = Eigen::Matrix3d::Zero(), q = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    f(a, a) = std::exp(-dt / tau[a]);
+    q(a, a) = 1.0 - f(a, a) * f(a, a);
+  }
+  CovarianceTrack track;
+  track.initial = Eigen::Matrix3d::Zero();
+  track.transitions.assign(static_cast<std::size_t>(readings), f);
+  track.process.assign(static_cast<std::size_t>(readings), q);
+  p.tracks.push_back(track);
+  const auto n = static_cast<Eigen::Index>(in.ids.size());
+  p.candidate_rows.resize(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::RowVector3d x = in.positions_m.row(i);
+    const double front = std::exp(-std::pow((x(2) - 0.425) / 0.12, 2));
+    const double rear = std::exp(-std::pow((x(2) - 0.065) / 0.12, 2));
+    const double lift = 0.5 + x(1) + 0.5 * std::abs(x(0));
+    p.candidate_rows.row(i) << 8.0 * front * lift, 5.0 * rear * lift, 3.0 + 2.0 * x(2);
+  }
+  p.candidate_sigma = Eigen::VectorXd::Constant(n, sigma_K);
+  p.target_rows.resize(2, 3);
+  p.target_rows << 2e-6, 3e-6, -4e-6, 6e-6, 1e-6, 9e-6;
+  return p;
+}
+
 }  // namespace tt::placement::synthetic

@@ -36,7 +36,8 @@ void expect_no_twin_pair(const PlacementResult& r, const std::vector<std::pair<i
 }  // namespace
 
 TEST(Place, TwinsAreNeverBothChosenWithOrWithoutTheMirrorRule) {
-  const auto input = synthetic::c54_input(0.002, 1);
+  auto input = synthetic::c54_input(0.002, 1);
+  input.estimation = synthetic::c54_estimation(input, 0.05, 20);
   const auto pairs = mirror_twins(input.positions_m, 0.0, 1e-6);
   ASSERT_EQ(pairs.size(), 24u);
 

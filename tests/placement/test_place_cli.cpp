@@ -1,6 +1,9 @@
 // End to end through the CLI on the coarse SB-1 (order 1): `run` with the housing's surface
 // vertices as candidates records their histories (candidates.csv, candidate_temperatures.csv),
-// and `place --from` the run chooses among them with every method, for dy and dz, m = 1..6.
+// and `place --from` the run chooses among them with every method, for dy and dz, m = 1..6;
+// `--methods observer_variance` places for the physics observer on the reduced model built on the
+// fly (the vertices read through the basis rows) and writes it into placement.json as its schema
+// says; a name that is not a method is refused.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,6 +15,7 @@
 #include <vector>
 
 #include "io/child_process.hpp"
+#include "tests/common/output_schema.hpp"
 
 namespace {
 
@@ -115,6 +119,37 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
       for (size_t k = 0; k < a.size(); ++k)
         EXPECT_EQ(a[k]["ids"], b[k]["ids"]) << target << " " << method;
     }
+  // Placement for estimation beside the correlation ranking: the observer's posterior sigma of
+  // each target falls with every sensor added.
+  ASSERT_EQ(thermotwin({"place", "--from", (dir / "run").string(), "--out",
+                        (dir / "place_observer").string(), "--methods",
+                        "observer_variance,correlation", "--m-max", "3", "--quiet"},
+                       dir / "place.log"),
+            0)
+      << text_of(dir / "place.log");
+  EXPECT_TRUE(tt::test::matches_output_schemas("place", dir / "place_observer"));
+  const auto observer = nlohmann::json::parse(text_of(dir / "place_observer" / "placement.json"));
+  EXPECT_GT(observer["observer_variance"]["order"].get<int>(), 10);
+  for (const std::string target : {"dy", "dz"}) {
+    const auto& by_method = observer["targets"][target]["methods"];
+    EXPECT_FALSE(by_method.contains("histogram_mi")) << "only the methods asked for";
+    ASSERT_TRUE(by_method.contains("correlation"));
+    const auto& sets = by_method["observer_variance"];
+    ASSERT_EQ(sets.size(), 3u) << target;
+    for (size_t k = 0; k < sets.size(); ++k) {
+      EXPECT_EQ(sets[k]["m"], k + 1);
+      EXPECT_EQ(sets[k]["score_kind"], "posterior_sigma_m");
+      if (k > 0) EXPECT_LT(sets[k]["score"].get<double>(), sets[k - 1]["score"].get<double>());
+    }
+  }
+  EXPECT_NE(thermotwin({"place", "--from", (dir / "run").string(), "--out",
+                        (dir / "place_bad").string(), "--methods", "observer_varianse", "--quiet"},
+                       dir / "place.log"),
+            0);
+  EXPECT_NE(text_of(dir / "place.log").find("'observer_varianse' is not a method"),
+            std::string::npos)
+      << text_of(dir / "place.log");
+  EXPECT_FALSE(fs::exists(dir / "place_bad" / "placement.json"));
   if (!HasFailure()) fs::remove_all(dir);  // kept for a look when something failed
 }
 

@@ -1,0 +1,50 @@
+// Placement for estimation on a twin: the physics observer's covariance model
+// (solvers::KalmanObserver) as the plain matrices placement::estimation_greedy takes, over a set
+// of duty cycles (docs/placement.md, "Placement for estimation").
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "placement/estimation.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/twin.hpp"
+
+namespace tt::studies {
+
+/// The observer's covariance along `run`'s duty cycle read at `times` [s] (increasing, after 0,
+/// within the duty cycle) under `setup`'s process noise: the map from each reading to the next,
+/// which no reading changes. Throws SolverError as solvers::KalmanObserver does.
+placement::CovarianceTrack observer_covariance_track(const solvers::ReducedThermalSystem& system,
+                                                     const core::CaseSpec& run,
+                                                     const solvers::ObserverSetup& setup,
+                                                     const Eigen::VectorXd& times);
+
+/// Readings every `sample_s` from sample_s to the duty cycle's end. Throws SolverError when
+/// sample_s is not > 0.
+Eigen::VectorXd reading_times(const core::CaseSpec& run, double sample_s);
+
+/// Candidates of an estimation problem on a twin: a named point of the twin reads through its
+/// output row; any other candidate through the reduced basis's row of its mesh node.
+struct EstimationCandidates {
+  std::vector<std::string> names;  /// #candidates
+  std::vector<int> nodes;          /// #candidates mesh node, -1 when not known
+  double sensor_sigma_k = 0.05;    /// white noise of every reading [K]
+};
+
+/// The observer's estimation problem on `twin` over `runs` (their duty cycles, each read every
+/// `sample_s`): the covariance tracks, the candidates' rows and sigmas, and the rows of the
+/// targets `targets` (names of the observer's targets: "dx", "dy", "dz", "<axis point>_dy", ...),
+/// each scaled by noise.drift_sigma_scale when that is set (one factor per observer target).
+/// Throws SolverError for a candidate that is neither a named point nor a node of the twin's
+/// basis, an unknown target, or no run.
+placement::EstimationProblem observer_estimation_problem(const solvers::Twin& twin,
+                                                         const std::vector<core::CaseSpec>& runs,
+                                                         const EstimationCandidates& candidates,
+                                                         const std::vector<std::string>& targets,
+                                                         const solvers::ObserverNoise& noise,
+                                                         double sample_s);
+
+}  // namespace tt::studies
