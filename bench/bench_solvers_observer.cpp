@@ -26,7 +26,10 @@
 //    the test runs): solvers::drift_sigma_calibration, the factor per target that makes the mean
 //    normalised squared error against their true drift 1. The observer on each test run (the
 //    run's declared inputs), and the regression, against the true (noiseless) drift; coverage
-//    with the reported sigma and with the calibrated one.
+//    with the reported sigma, with the calibrated one, and "adapted": the sigma widened by the
+//    innovations (ObserverNoise::widen_on_inconsistency) with the 95 % quantile factor
+//    (solvers::drift_sigma_coverage_calibration) from the same training runs. A faster alarm:
+//    the shortest window of 600, 900, 1800 s that raises nothing on the training runs.
 // 5. The calibration generator's runs (its own finer mesh and step, its sensor noise): CLEAN_RUNS
 //    with no effect and one per effect kind, random duty cycles of GEN_HOURS; the observer is
 //    given the declared case and the run's duty cycle only. The effect runs' coverage also with
