@@ -327,18 +327,24 @@ int main(int argc, char** argv) {
     campaign_noise.sensor_sigma_k = Eigen::VectorXd::Constant(
         static_cast<Eigen::Index>(sensors.size()), fitting::SensorNoise{}.temperature_sigma);
     const auto t_cal = Clock::now();
-    std::vector<solvers::ObserverRun> training;
+    // The training runs through the observer with `noise` and `consistency`.
+    const auto observe_training = [&](const solvers::ObserverNoise& noise,
+                                      const solvers::ConsistencyOptions& consistency) {
+      std::vector<solvers::ObserverRun> out;
+      for (int i : fitted) {
+        const auto& r = runs[static_cast<std::size_t>(i)];
+        const auto& g = noisy_s[static_cast<std::size_t>(i)];
+        solvers::ObserverSetup su = solvers::twin_observer_setup(twin, r.spec, sensors, noise);
+        su.consistency = consistency;
+        out.push_back(solvers::observe(twin.model.system, r.spec, su, g.time, g.temperature));
+      }
+      return out;
+    };
+    const std::vector<solvers::ObserverRun> training = observe_training(campaign_noise, {});
     std::vector<Eigen::MatrixXd> training_truth;
-    for (int i : fitted) {
-      const auto& r = runs[static_cast<std::size_t>(i)];
-      const auto& g = noisy_s[static_cast<std::size_t>(i)];
-      training.push_back(
-          solvers::observe(twin.model.system, r.spec,
-                           solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise),
-                           g.time, g.temperature));
+    for (int i : fitted)
       training_truth.push_back(
-          as_targets(clean[static_cast<std::size_t>(i)].error, training.back().drift.cols()));
-    }
+          as_targets(clean[static_cast<std::size_t>(i)].error, training.front().drift.cols()));
     const Eigen::VectorXd training_nees =
         solvers::mean_normalised_squared_error(training, training_truth);
     const Eigen::VectorXd campaign_scale =
@@ -349,19 +355,8 @@ int main(int argc, char** argv) {
     // (solvers::drift_sigma_coverage_calibration). Both rules fixed before any run was scored.
     solvers::ObserverNoise adapted_noise = campaign_noise;
     adapted_noise.widen_on_inconsistency = true;
-    {
-      std::vector<solvers::ObserverRun> widened;
-      for (int i : fitted) {
-        const auto& r = runs[static_cast<std::size_t>(i)];
-        const auto& g = noisy_s[static_cast<std::size_t>(i)];
-        widened.push_back(
-            solvers::observe(twin.model.system, r.spec,
-                             solvers::twin_observer_setup(twin, r.spec, sensors, adapted_noise),
-                             g.time, g.temperature));
-      }
-      adapted_noise.drift_sigma_scale =
-          solvers::drift_sigma_coverage_calibration(widened, training_truth);
-    }
+    adapted_noise.drift_sigma_scale = solvers::drift_sigma_coverage_calibration(
+        observe_training(adapted_noise, {}), training_truth);
     const auto adapted_sigma = [&](const core::CaseSpec& c, const solvers::ObserverNoise& noise,
                                    const Eigen::VectorXd& time, const Eigen::MatrixXd& readings) {
       solvers::ObserverNoise with = noise;
@@ -380,15 +375,7 @@ int main(int argc, char** argv) {
       fast.window_s = window;
       fast.sustain_s = window / 2;
       int raised = 0;
-      for (int i : fitted) {
-        const auto& r = runs[static_cast<std::size_t>(i)];
-        const auto& g = noisy_s[static_cast<std::size_t>(i)];
-        solvers::ObserverSetup su =
-            solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise);
-        su.consistency = fast;
-        raised +=
-            solvers::observe(twin.model.system, r.spec, su, g.time, g.temperature).recalibrate;
-      }
+      for (const auto& run : observe_training(campaign_noise, fast)) raised += run.recalibrate;
       std::cout << "alarm window " << window << " s, sustained " << window / 2 << " s: raised on "
                 << raised << " of the " << fitted.size() << " training runs\n";
       if (raised == 0) break;
