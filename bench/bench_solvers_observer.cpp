@@ -4,10 +4,14 @@
 // undeclared effect).
 // Usage: bench_solvers_observer [CASE=cases/sb1_coarse.toml] [HOURS=5] [GEN_HOURS=4]
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
-//                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT]
+//                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT=0]
+//                               [GEN_ONLY=-1]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
-//   COUNT: how many sensors the estimation criteria place (default: as many as the correlation
-//   union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse SB-1).
+//   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
+//   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
+//   SB-1).
+//   GEN_ONLY = k >= 0: only the generator's run k (gen_k) is simulated and observed; the others'
+//     random draws are still made, so gen_k is the run the whole bench draws (to look into one).
 //   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
 //   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
 //     correlation     the four best by the standard's correlation for dy and for dz, together
@@ -29,7 +33,10 @@
 //    the test runs): solvers::drift_sigma_calibration, the factor per target that makes the mean
 //    normalised squared error against their true drift 1. The observer on each test run (the
 //    run's declared inputs), and the regression, against the true (noiseless) drift; coverage
-//    with the reported sigma and with the calibrated one.
+//    with the reported sigma, with the calibrated one, and "adapted": the sigma widened by the
+//    innovations (ObserverNoise::widen_on_inconsistency) with the 95 % quantile factor
+//    (solvers::drift_sigma_coverage_calibration) from the same training runs. A faster alarm:
+//    the shortest window of 600, 900, 1800 s that raises nothing on the training runs.
 // 5. The calibration generator's runs (its own finer mesh and step, its sensor noise): CLEAN_RUNS
 //    with no effect and one per effect kind, random duty cycles of GEN_HOURS; the observer is
 //    given the declared case and the run's duty cycle only. The effect runs' coverage also with
@@ -68,26 +75,24 @@ double seconds_since(Clock::time_point t0) {
 }
 
 /// Per target (dy, dz): sum of squared errors, samples, samples inside ±2σ, and inside ±2σ with
-/// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs).
+/// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs), and inside
+/// ±2 `adapted` σ (the observer run with the coverage calibration and the widening, if given).
 struct Score {
   Eigen::Vector2d ss = Eigen::Vector2d::Zero(), inside = Eigen::Vector2d::Zero(),
                   inside_calibrated = Eigen::Vector2d::Zero(),
-                  inside_adaptive = Eigen::Vector2d::Zero(),
-                  inside_product = Eigen::Vector2d::Zero();
+                  inside_adapted = Eigen::Vector2d::Zero();
   double n = 0;
-  /// `adaptive`, `product`: more sigmas (#samples x 2, innovation_scaled_sigma's two rules);
-  /// none: not counted.
+  /// `adapted`: the adapted run's sigma (#samples x 2); none: not counted.
   void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
            const Eigen::MatrixXd& truth, const Eigen::Vector2d& scale = Eigen::Vector2d::Ones(),
-           const Eigen::MatrixXd& adaptive = {}, const Eigen::MatrixXd& product = {}) {
+           const Eigen::MatrixXd& adapted = {}) {
     for (Eigen::Index i = 1; i < truth.rows(); ++i) {  // t = 0 is the reference, not a prediction
       for (int d = 0; d < 2; ++d) {
         const double e = predicted(i, d) - truth(i, d);
         ss(d) += e * e;
         inside(d) += std::abs(e) <= 2 * sigma(i, d);
         inside_calibrated(d) += std::abs(e) <= 2 * scale(d) * sigma(i, d);
-        if (adaptive.size() != 0) inside_adaptive(d) += std::abs(e) <= 2 * adaptive(i, d);
-        if (product.size() != 0) inside_product(d) += std::abs(e) <= 2 * product(i, d);
+        if (adapted.size() != 0) inside_adapted(d) += std::abs(e) <= 2 * adapted(i, d);
       }
       n += 1;
     }
@@ -95,33 +100,8 @@ struct Score {
   Eigen::Vector2d rms_um() const { return (ss / n).cwiseSqrt() * 1e6; }
   Eigen::Vector2d coverage() const { return inside / n; }
   Eigen::Vector2d coverage_calibrated() const { return inside_calibrated / n; }
-  Eigen::Vector2d coverage_adaptive() const { return inside_adaptive / n; }
-  Eigen::Vector2d coverage_product() const { return inside_product / n; }
+  Eigen::Vector2d coverage_adapted() const { return inside_adapted / n; }
 };
-
-/// The observer's (dy, dz) sigma scaled by what its innovations say of the noise model now: per
-/// sample max(calibrated scale, sqrt(window NIS / window readings)), the window the consistency
-/// test's (ConsistencyOptions::window_s). Where the declared model holds the NIS ratio is at most
-/// about 1 and the calibrated scale stays; where the innovations outgrow the noise model the
-/// sigma grows with them (a covariance-matching estimate, not calibrated on any run). `product`:
-/// instead the calibrated scale times max(1, sqrt(ratio)).
-Eigen::MatrixXd innovation_scaled_sigma(const solvers::ObserverRun& run,
-                                        const Eigen::Vector2d& scale, bool product = false) {
-  const double window = solvers::ConsistencyOptions{}.window_s;
-  Eigen::MatrixXd out = run.drift_sigma.middleCols(1, 2);
-  std::size_t first = 0;
-  double dof = 0;
-  for (Eigen::Index i = 0; i < run.times.size(); ++i) {
-    dof += run.dof(i);
-    while (run.times(static_cast<Eigen::Index>(first)) <= run.times(i) - window)
-      dof -= run.dof(static_cast<Eigen::Index>(first++));
-    const double ratio = dof > 0 ? run.window_nis(i) / dof : 1.0;
-    for (int d = 0; d < 2; ++d)
-      out(i, d) *= product ? scale(d) * std::max(1.0, std::sqrt(ratio))
-                           : std::max(scale(d), std::sqrt(ratio));
-  }
-  return out;
-}
 
 /// Alarms over a set of runs.
 struct Alarms {
@@ -243,6 +223,7 @@ int main(int argc, char** argv) {
     if (argc > 8) campaign_noise.drift_relative_sigma = std::stod(argv[8]);
     const std::string sensor_choice = argc > 9 ? argv[9] : "correlation";
     const int count = argc > 10 ? std::stoi(argv[10]) : 0;
+    const int gen_only = argc > 11 ? std::stoi(argv[11]) : -1;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
         sensor_choice != "estimation" && sensor_choice != "estimation_exact")
       throw std::runtime_error("SENSORS '" + sensor_choice +
@@ -385,33 +366,80 @@ int main(int argc, char** argv) {
     campaign_noise.sensor_sigma_k = Eigen::VectorXd::Constant(
         static_cast<Eigen::Index>(sensors.size()), fitting::SensorNoise{}.temperature_sigma);
     const auto t_cal = Clock::now();
-    std::vector<solvers::ObserverRun> training;
+    // The training runs through the observer with `noise` and `consistency`.
+    const auto observe_training = [&](const solvers::ObserverNoise& noise,
+                                      const solvers::ConsistencyOptions& consistency) {
+      std::vector<solvers::ObserverRun> out;
+      for (int i : fitted) {
+        const auto& r = runs[static_cast<std::size_t>(i)];
+        const auto& g = noisy_s[static_cast<std::size_t>(i)];
+        solvers::ObserverSetup su = solvers::twin_observer_setup(twin, r.spec, sensors, noise);
+        su.consistency = consistency;
+        out.push_back(solvers::observe(twin.model.system, r.spec, su, g.time, g.temperature));
+      }
+      return out;
+    };
+    const std::vector<solvers::ObserverRun> training = observe_training(campaign_noise, {});
     std::vector<Eigen::MatrixXd> training_truth;
-    for (int i : fitted) {
-      const auto& r = runs[static_cast<std::size_t>(i)];
-      const auto& g = noisy_s[static_cast<std::size_t>(i)];
-      training.push_back(
-          solvers::observe(twin.model.system, r.spec,
-                           solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise),
-                           g.time, g.temperature));
+    for (int i : fitted)
       training_truth.push_back(
-          as_targets(clean[static_cast<std::size_t>(i)].error, training.back().drift.cols()));
-    }
+          as_targets(clean[static_cast<std::size_t>(i)].error, training.front().drift.cols()));
     const Eigen::VectorXd training_nees =
         solvers::mean_normalised_squared_error(training, training_truth);
     const Eigen::VectorXd campaign_scale =
         solvers::drift_sigma_calibration(training, training_truth);
     const Eigen::Vector2d scale = campaign_scale.segment(1, 2);
+    // The adapted sigma: widened by the innovations (ObserverNoise::widen_on_inconsistency), its
+    // factor the 95 % quantile of |error| / 2σ on the same training runs observed so
+    // (solvers::drift_sigma_coverage_calibration). Both rules fixed before any run was scored.
+    solvers::ObserverNoise adapted_noise = campaign_noise;
+    adapted_noise.widen_on_inconsistency = true;
+    adapted_noise.drift_sigma_scale = solvers::drift_sigma_coverage_calibration(
+        observe_training(adapted_noise, {}), training_truth);
+    const auto adapted_sigma = [&](const core::CaseSpec& c, const solvers::ObserverNoise& noise,
+                                   const Eigen::VectorXd& time, const Eigen::MatrixXd& readings) {
+      solvers::ObserverNoise with = noise;
+      with.widen_on_inconsistency = true;
+      with.drift_sigma_scale = adapted_noise.drift_sigma_scale;
+      const solvers::ObserverRun run =
+          solvers::observe(twin.model.system, c,
+                           solvers::twin_observer_setup(twin, c, sensors, with), time, readings);
+      return Eigen::MatrixXd(run.drift_sigma.middleCols(1, 2));
+    };
+    // A faster alarm: the shortest consistency window (sustained for half of it) that raises
+    // nothing on the six training runs, among 600, 900 and 1800 s (the default). Rule fixed
+    // before any run was scored; the held-out and generator runs then report its alarms.
+    solvers::ConsistencyOptions fast;
+    for (double window : {600.0, 900.0, 1800.0}) {
+      fast.window_s = window;
+      fast.sustain_s = window / 2;
+      int raised = 0;
+      for (const auto& run : observe_training(campaign_noise, fast)) raised += run.recalibrate;
+      std::cout << "alarm window " << window << " s, sustained " << window / 2 << " s: raised on "
+                << raised << " of the " << fitted.size() << " training runs\n";
+      if (raised == 0) break;
+    }
+    const auto fast_alarm = [&](const core::CaseSpec& c, const solvers::ObserverNoise& noise,
+                                const Eigen::VectorXd& time, const Eigen::MatrixXd& readings) {
+      solvers::ObserverSetup su = solvers::twin_observer_setup(twin, c, sensors, noise);
+      su.consistency = fast;
+      return solvers::observe(twin.model.system, c, su, time, readings);
+    };
+    Alarms clean_fast, effect_fast;
     std::cout << "calibration on the " << fitted.size()
               << " training runs: mean normalised squared error dy " << fmt(training_nees(1))
               << ", dz " << fmt(training_nees(2)) << " -> sigma scale dy " << fmt(scale(0))
-              << ", dz " << fmt(scale(1)) << " (" << fmt(seconds_since(t_cal)) << " s)\n";
+              << ", dz " << fmt(scale(1)) << "; coverage calibration of the widened sigma: dy "
+              << fmt(adapted_noise.drift_sigma_scale(1)) << ", dz "
+              << fmt(adapted_noise.drift_sigma_scale(2)) << " (" << fmt(seconds_since(t_cal))
+              << " s)\n";
     Method held;
     Alarms clean_alarms, effect_alarms;
     double observer_s = 0, observed_h = 0;
     std::cout
         << "\nrun | kind | observer RMS dy, dz [um] | regression RMS dy, dz [um] | "
-           "observer 2σ coverage dy, dz | calibrated | regression coverage dy, dz | alarm at [s] "
+           "observer 2σ coverage dy, dz | calibrated | adapted | regression coverage dy, dz | "
+           "alarm at [s] "
            "(since)\n";
     const auto line = [&](const std::string& name, const std::string& kind, const Score& o,
                           const Score& r, const solvers::ObserverRun& run) {
@@ -419,7 +447,9 @@ int main(int argc, char** argv) {
                 << fmt(o.rms_um()(1)) << " | " << fmt(r.rms_um()(0)) << ", " << fmt(r.rms_um()(1))
                 << " | " << fmt(100 * o.coverage()(0)) << " %, " << fmt(100 * o.coverage()(1))
                 << " % | " << fmt(100 * o.coverage_calibrated()(0)) << " %, "
-                << fmt(100 * o.coverage_calibrated()(1)) << " % | " << fmt(100 * r.coverage()(0))
+                << fmt(100 * o.coverage_calibrated()(1)) << " % | "
+                << fmt(100 * o.coverage_adapted()(0)) << " %, "
+                << fmt(100 * o.coverage_adapted()(1)) << " % | " << fmt(100 * r.coverage()(0))
                 << " %, " << fmt(100 * r.coverage()(1)) << " % | "
                 << (run.recalibrate ? fmt(run.recalibrate_at_s, 5) + " (" +
                                           fmt(run.recalibrate_since_s, 5) + ")"
@@ -439,14 +469,15 @@ int main(int argc, char** argv) {
       observed_h += r.spec.duty_cycle.end / 3600;
       Score o, rr;
       const auto [po, so] = dy_dz(run);
-      const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
-                            product = innovation_scaled_sigma(run, scale, true);
-      o.add(po, so, truth, scale, adaptive, product);
+      const Eigen::MatrixXd sa = adapted_sigma(r.spec, campaign_noise, g.time, g.temperature);
+      o.add(po, so, truth, scale, sa);
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
-      held.observer.add(po, so, truth, scale, adaptive, product);
+      held.observer.add(po, so, truth, scale, sa);
       held.regression.add(pr, sr, truth);
       add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
+      add_alarm(clean_fast, fast_alarm(r.spec, campaign_noise, g.time, g.temperature),
+                r.spec.duty_cycle.end / 3600);
       line(r.name, "campaign, held out", o, rr, run);
     }
 
@@ -480,6 +511,18 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < plan.size(); ++k) {
         const auto& [kind, effect] = plan[k];
         const core::DutyCycle duty = calibration::random_duty_cycle(gen_hours, rng);
+        if (gen_only >= 0 && static_cast<int>(k) != gen_only) {
+          // The noise's draws depend on the run's size only: a run of zeros of that size.
+          io::MeasuredRun skipped;
+          const auto ns =
+              static_cast<Eigen::Index>(std::floor(duty.end / gopt.sample_interval_s)) + 1;
+          skipped.time = Eigen::VectorXd::Zero(ns);
+          skipped.temperature =
+              Eigen::MatrixXd::Zero(ns, static_cast<Eigen::Index>(sensors.size()));
+          skipped.displacement = Eigen::MatrixXd::Zero(ns, 3);
+          calibration::with_noise(skipped, gopt, rng);
+          continue;
+        }
         const core::CaseSpec truth_spec =
             calibration::truth_case(gen, effect, duty, static_cast<int>(k));
         const std::string name = "gen_" + std::to_string(k);
@@ -520,19 +563,62 @@ int main(int argc, char** argv) {
         } else {
           geffect_own.add(po, so, true_drift, own_scale);
         }
-        const Eigen::MatrixXd adaptive = innovation_scaled_sigma(run, scale),
-                              product = innovation_scaled_sigma(run, scale, true);
-        o.add(po, so, true_drift, scale, adaptive, product);
+        const Eigen::MatrixXd sa =
+            adapted_sigma(declared, gen_noise, measured.time, measured.temperature);
+        o.add(po, so, true_drift, scale, sa);
         const auto [pr, sr] = regression_on(reg, g);
         rr.add(pr, sr, true_drift);
         Method& m = effect.present ? geffect : gclean;
-        m.observer.add(po, so, true_drift, scale, adaptive, product);
+        m.observer.add(po, so, true_drift, scale, sa);
         m.regression.add(pr, sr, true_drift);
         add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
+        const solvers::ObserverRun fast_run =
+            fast_alarm(declared, gen_noise, measured.time, measured.temperature);
+        add_alarm(effect.present ? effect_fast : clean_fast, fast_run, gen_hours);
+        if (fast_run.recalibrate)
+          std::cout << name << ": faster alarm at " << fast_run.recalibrate_at_s << " s (since "
+                    << fast_run.recalibrate_since_s << " s)\n";
         std::string what = kind;
         if (effect.present)
           what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
         line(name, "generator, " + what, o, rr, run);
+        if (gen_only >= 0) {
+          // The one run looked into: the effect's place, the unknown inputs' estimates, the
+          // innovations per sensor and the error's course.
+          std::cout << "effect centre [m] " << effect.centre.transpose() << ", area " << effect.area
+                    << " m2, groups:";
+          for (const auto& gname : effect.groups) std::cout << " " << gname;
+          std::cout << "\nunknown inputs at the end (sigma):";
+          const Eigen::Index last = run.times.size() - 1;
+          for (std::size_t b = 0; b < run.unknown_input_names.size(); ++b)
+            std::cout << " " << run.unknown_input_names[b] << " "
+                      << fmt(run.unknown_inputs(last, static_cast<Eigen::Index>(b))) << " ("
+                      << fmt(run.unknown_inputs_sigma(last, static_cast<Eigen::Index>(b))) << ")";
+          std::cout << "\ninnovation RMS per sensor [K]:";
+          for (Eigen::Index c = 0; c < run.innovation.cols(); ++c)
+            std::cout << " " << sensors[static_cast<std::size_t>(c)] << " "
+                      << fmt(std::sqrt(run.innovation.col(c).squaredNorm() /
+                                       static_cast<double>(run.innovation.rows())));
+          std::cout << "\nRMS dy, dz [um] with one sensor left out (its readings missing):";
+          for (Eigen::Index c = 0; c < measured.temperature.cols(); ++c) {
+            Eigen::MatrixXd without = measured.temperature;
+            without.col(c).setConstant(std::numeric_limits<double>::quiet_NaN());
+            const solvers::ObserverRun left =
+                solvers::observe(twin.model.system, declared, setup, measured.time, without);
+            Score ls;
+            ls.add(left.drift.middleCols(1, 2), left.drift_sigma.middleCols(1, 2), true_drift);
+            std::cout << " " << sensors[static_cast<std::size_t>(c)] << " " << fmt(ls.rms_um()(0))
+                      << ", " << fmt(ls.rms_um()(1));
+          }
+          std::cout << "\nt [s] | true dy, dz [um] | observer dy, dz [um] | sigma dy, dz [um] | "
+                       "NIS window / bound\n";
+          for (Eigen::Index i = 0; i < run.times.size(); i += 30)
+            std::cout << run.times(i) << " | " << fmt(true_drift(i, 0) * 1e6) << ", "
+                      << fmt(true_drift(i, 1) * 1e6) << " | " << fmt(po(i, 0) * 1e6) << ", "
+                      << fmt(po(i, 1) * 1e6) << " | " << fmt(so(i, 0) * 1e6) << ", "
+                      << fmt(so(i, 1) * 1e6) << " | " << fmt(run.window_nis(i)) << " / "
+                      << fmt(run.window_bound(i)) << "\n";
+        }
       }
       std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
                 << fmt(seconds_since(t_gen)) << " s)\n\n";
@@ -545,11 +631,9 @@ int main(int argc, char** argv) {
                 << fmt(100 * m.observer.coverage()(0)) << " %, "
                 << fmt(100 * m.observer.coverage()(1)) << " %, calibrated on the campaign "
                 << fmt(100 * m.observer.coverage_calibrated()(0)) << " %, "
-                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %, innovation-scaled "
-                << fmt(100 * m.observer.coverage_adaptive()(0)) << " %, "
-                << fmt(100 * m.observer.coverage_adaptive()(1)) << " %, calibrated x innovations "
-                << fmt(100 * m.observer.coverage_product()(0)) << " %, "
-                << fmt(100 * m.observer.coverage_product()(1)) << " %; regression RMS dy "
+                << fmt(100 * m.observer.coverage_calibrated()(1)) << " %, adapted "
+                << fmt(100 * m.observer.coverage_adapted()(0)) << " %, "
+                << fmt(100 * m.observer.coverage_adapted()(1)) << " %; regression RMS dy "
                 << fmt(m.regression.rms_um()(0)) << " um, dz " << fmt(m.regression.rms_um()(1))
                 << " um, coverage " << fmt(100 * m.regression.coverage()(0)) << " %, "
                 << fmt(100 * m.regression.coverage()(1)) << " %\n";
@@ -563,6 +647,12 @@ int main(int argc, char** argv) {
              "coverage "
           << fmt(100 * geffect_own.coverage_calibrated()(0)) << " %, "
           << fmt(100 * geffect_own.coverage_calibrated()(1)) << " %\n";
+    std::cout << "faster alarm (window " << fast.window_s << " s): " << clean_fast.raised << " in "
+              << clean_fast.hours << " h of clean runs ("
+              << fmt(clean_fast.raised / clean_fast.hours) << " per hour); " << effect_fast.raised
+              << " of " << effect_runs << " effect runs; delays [s]:";
+    for (double d : effect_fast.delays_s) std::cout << " " << d;
+    std::cout << "\n";
     std::cout << "alarms on clean runs: " << clean_alarms.raised << " in " << clean_alarms.hours
               << " h (" << fmt(clean_alarms.raised / clean_alarms.hours) << " per hour)\n";
     std::cout << "alarms on effect runs: " << effect_alarms.raised << " of " << effect_runs

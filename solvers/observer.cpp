@@ -336,6 +336,8 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   if (setup_.noise.drift_sigma_scale.size() != 0)
     e.drift_sigma.array() *= setup_.noise.drift_sigma_scale.array();
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
+  if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
+    e.drift_sigma *= std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
   e.recalibrate_since_s = monitor_.since_s();
   return e;
 }
@@ -399,16 +401,18 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
   return run;
 }
 
-Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& runs,
-                                              const std::vector<Eigen::MatrixXd>& truths,
-                                              double truth_sigma_m) {
+namespace {
+
+/// Per target, the (estimate - truth, reported sigma) of every sample whose truth is known and
+/// whose sigma is above 0 (t = 0: the start is known). Throws SolverError when the sizes differ.
+std::vector<std::vector<std::pair<double, double>>> errors_and_sigmas(
+    const std::vector<ObserverRun>& runs, const std::vector<Eigen::MatrixXd>& truths) {
   if (runs.size() != truths.size() || runs.empty())
     throw core::SolverError("observer calibration: " + std::to_string(runs.size()) + " runs and " +
                             std::to_string(truths.size()) +
                             " truths; expected as many, at least 1");
   const Eigen::Index nt = runs.front().drift.cols();
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(nt), count = Eigen::VectorXd::Zero(nt);
-  const double truth_var = truth_sigma_m * truth_sigma_m;
+  std::vector<std::vector<std::pair<double, double>>> out(static_cast<std::size_t>(nt));
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const ObserverRun& run = runs[k];
     const Eigen::MatrixXd& truth = truths[k];
@@ -421,11 +425,26 @@ Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& ru
     for (Eigen::Index i = 0; i < truth.rows(); ++i)
       for (Eigen::Index t = 0; t < nt; ++t) {
         const double sigma = run.drift_sigma(i, t), e = run.drift(i, t) - truth(i, t);
-        if (!(sigma > 0) || !std::isfinite(e)) continue;
-        sum(t) += (e * e - truth_var) / (sigma * sigma);
-        count(t) += 1;
+        if (sigma > 0 && std::isfinite(e)) out[static_cast<std::size_t>(t)].emplace_back(e, sigma);
       }
   }
+  return out;
+}
+
+}  // namespace
+
+Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& runs,
+                                              const std::vector<Eigen::MatrixXd>& truths,
+                                              double truth_sigma_m) {
+  const auto samples = errors_and_sigmas(runs, truths);
+  const auto nt = static_cast<Eigen::Index>(samples.size());
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(nt), count = Eigen::VectorXd::Zero(nt);
+  const double truth_var = truth_sigma_m * truth_sigma_m;
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (const auto& [e, sigma] : samples[static_cast<std::size_t>(t)]) {
+      sum(t) += (e * e - truth_var) / (sigma * sigma);
+      count(t) += 1;
+    }
   return (count.array() > 0)
       .select(sum.array() / count.array(), std::numeric_limits<double>::quiet_NaN())
       .matrix();
@@ -442,6 +461,36 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
   Eigen::VectorXd scale = Eigen::VectorXd::Ones(nees.size());
   for (Eigen::Index t = 0; t < nees.size(); ++t) {
     if (nees(t) > 0) scale(t) = std::sqrt(nees(t));  // NaN and <= 0 (noise only) keep 1
+    if (observed_with.size() != 0) scale(t) *= observed_with(t);
+  }
+  return scale;
+}
+
+Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>& runs,
+                                                 const std::vector<Eigen::MatrixXd>& truths,
+                                                 double coverage,
+                                                 const Eigen::VectorXd& observed_with) {
+  if (!(coverage > 0 && coverage < 1))
+    throw core::SolverError("observer calibration: coverage " + number(coverage) +
+                            ": expected 0 < coverage < 1");
+  const auto samples = errors_and_sigmas(runs, truths);
+  const auto nt = static_cast<Eigen::Index>(samples.size());
+  if (observed_with.size() != 0 && observed_with.size() != nt)
+    throw core::SolverError("observer calibration: " + std::to_string(observed_with.size()) +
+                            " scales for " + std::to_string(nt) + " targets");
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(nt);
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    std::vector<double> ratio;
+    for (const auto& [e, sigma] : samples[static_cast<std::size_t>(t)])
+      ratio.push_back(std::abs(e) / (2 * sigma));
+    if (!ratio.empty()) {
+      // The nearest rank: the smallest factor under which at least `coverage` of them lie.
+      const auto rank = static_cast<std::size_t>(
+          std::max(1.0, std::ceil(coverage * static_cast<double>(ratio.size()) - 1e-9)) - 1);
+      std::nth_element(ratio.begin(), ratio.begin() + static_cast<std::ptrdiff_t>(rank),
+                       ratio.end());
+      if (ratio[rank] > 0) scale(t) = ratio[rank];
+    }
     if (observed_with.size() != 0) scale(t) *= observed_with(t);
   }
   return scale;

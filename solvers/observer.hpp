@@ -45,6 +45,12 @@ struct ObserverNoise {
   /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
   /// alarm) as it is. Empty: 1 for every target.
   Eigen::VectorXd drift_sigma_scale;
+  /// Widen the reported sigma while the innovations say the machine is no longer the model: by
+  /// sqrt(NIS / dof) over the consistency window when that is above 1 (a filter whose noise is
+  /// too small by a factor a has innovations a times its S, and errors a times its P). It leaves
+  /// the filter (gain, innovations, alarm) as it is, like drift_sigma_scale, on top of which it
+  /// acts: a sigma calibrated where the model holds does not stay narrow where it no longer does.
+  bool widen_on_inconsistency = false;
 };
 
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
@@ -93,6 +99,7 @@ class InnovationMonitor {
   bool add(double t, double nis, int dof);
   double window_nis() const { return sum_; }      /// NIS summed over the window
   double window_bound() const { return bound_; }  /// its chi-square bound
+  int window_dof() const { return dof_sum_; }     /// readings in the window: NIS's expectation
   bool exceeded() const { return sum_ > bound_; }
   bool recalibrate() const { return alarm_; }
   /// When the inconsistency started [s]: the change point of the NIS's mean before the alarm,
@@ -216,5 +223,17 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
                                         const std::vector<Eigen::MatrixXd>& truths,
                                         double truth_sigma_m = 0,
                                         const Eigen::VectorXd& observed_with = {});
+
+/// The factor on the reported sigma that makes the share `coverage` of the runs' samples lie
+/// within ±2 sigma of their true drift: per target the `coverage` quantile of |estimate - truth| /
+/// (2 sigma) times `observed_with` (empty: 1); 1 where no sample counted. Unlike
+/// drift_sigma_calibration it aims at the band's coverage itself, which errors with heavier
+/// tails than a Gaussian's miss at a mean normalised squared error of 1. Same runs and truths,
+/// same sizes and errors as mean_normalised_squared_error; throws SolverError for a coverage
+/// outside (0, 1).
+Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>& runs,
+                                                 const std::vector<Eigen::MatrixXd>& truths,
+                                                 double coverage = 0.95,
+                                                 const Eigen::VectorXd& observed_with = {});
 
 }  // namespace tt::solvers

@@ -87,6 +87,13 @@ class Observer : public ::testing::Test {
     n.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(kSensors.size()), 0.04);
     return n;
   }
+  /// The clean run's true drift as the observer's targets: the TCP's known, the rest NaN.
+  static Eigen::MatrixXd clean_tcp_truth(const solvers::ObserverRun& run) {
+    Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(run.drift.rows(), run.drift.cols(),
+                                                      std::numeric_limits<double>::quiet_NaN());
+    truth.leftCols(3) = s_->clean_truth.displacement.leftCols(3);
+    return truth;
+  }
   static Study* s_;
 };
 Study* Observer::s_ = nullptr;
@@ -212,9 +219,7 @@ TEST_F(Observer, CalibratedSigmaMakesTheTrainingErrorsNormalAndLeavesTheFilter) 
   const solvers::ObserverSetup plain = setup(default_noise());
   const std::vector<solvers::ObserverRun> runs{
       solvers::observe(s_->twin.model.system, c, plain, s_->clean.time, s_->clean.temperature)};
-  Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(runs[0].drift.rows(), runs[0].drift.cols(),
-                                                    std::numeric_limits<double>::quiet_NaN());
-  truth.leftCols(3) = s_->clean_truth.displacement.leftCols(3);  // the TCP's: known
+  const Eigen::MatrixXd truth = clean_tcp_truth(runs[0]);
   const std::vector<Eigen::MatrixXd> truths{truth};
   const Eigen::VectorXd nees = solvers::mean_normalised_squared_error(runs, truths);
   const Eigen::VectorXd scale = solvers::drift_sigma_calibration(runs, truths);
@@ -239,6 +244,74 @@ TEST_F(Observer, CalibratedSigmaMakesTheTrainingErrorsNormalAndLeavesTheFilter) 
                core::SolverError);
   calibrated.noise.drift_sigma_scale = Eigen::VectorXd::Ones(truth.cols() + 1);
   EXPECT_THROW(solvers::KalmanObserver(s_->twin.model.system, c, calibrated), core::SolverError);
+}
+
+TEST_F(Observer, CoverageCalibrationAndWideningOnInconsistency) {
+  // The coverage calibration is the smallest factor under which 95 % of the training run's
+  // samples lie within ±2σ: applied, they do; 1 % less, they do not.
+  const core::CaseSpec c = run_spec();
+  const solvers::ObserverSetup plain = setup(default_noise());
+  const std::vector<solvers::ObserverRun> runs{
+      solvers::observe(s_->twin.model.system, c, plain, s_->clean.time, s_->clean.temperature)};
+  const Eigen::MatrixXd truth = clean_tcp_truth(runs[0]);
+  const Eigen::VectorXd scale = solvers::drift_sigma_coverage_calibration(runs, {truth}, 0.95);
+  for (int d = 0; d < 3; ++d) {
+    double in = 0, in_less = 0, n = 0;
+    for (Eigen::Index i = 1; i < truth.rows(); ++i) {
+      const double e = std::abs(runs[0].drift(i, d) - truth(i, d)), s = runs[0].drift_sigma(i, d);
+      in += e <= 2 * scale(d) * s;
+      in_less += e <= 2 * 0.99 * scale(d) * s;
+      n += 1;
+    }
+    EXPECT_GE(in / n, 0.95) << "direction " << d;
+    EXPECT_LT(in_less / n, 0.95) << "direction " << d;
+  }
+  for (Eigen::Index d = 3; d < truth.cols(); ++d) EXPECT_EQ(scale(d), 1.0);  // no truth: kept
+  const Eigen::VectorXd twice =
+      solvers::drift_sigma_coverage_calibration(runs, {truth}, 0.95, 2 * scale);
+  for (Eigen::Index d = 0; d < scale.size(); ++d)
+    EXPECT_NEAR(twice(d), 2 * scale(d) * scale(d), 1e-12);
+  EXPECT_THROW(solvers::drift_sigma_coverage_calibration(runs, {truth}, 1.0), core::SolverError);
+
+  // Widening: on the run with an undeclared heat input, where the innovations outgrow the noise
+  // model, the reported sigma is sqrt(window NIS / dof) times the plain one when that is above
+  // 1, the plain one otherwise; the estimate, innovations and alarm are the filter's own.
+  solvers::ObserverSetup widened = plain;
+  widened.noise.widen_on_inconsistency = true;
+  const solvers::ObserverRun heat =
+      solvers::observe(s_->twin.model.system, c, plain, s_->heat.time, s_->heat.temperature);
+  const solvers::ObserverRun wide =
+      solvers::observe(s_->twin.model.system, c, widened, s_->heat.time, s_->heat.temperature);
+  EXPECT_EQ(wide.drift, heat.drift);
+  EXPECT_EQ(wide.nis, heat.nis);
+  EXPECT_EQ(wide.recalibrate_at_s, heat.recalibrate_at_s);
+  Eigen::VectorXi dof_window = Eigen::VectorXi::Zero(heat.dof.size());
+  double widest = 1;
+  for (Eigen::Index i = 0; i < heat.dof.size(); ++i) {
+    // The window's readings: those of the samples within window_s before this one.
+    for (Eigen::Index j = 0; j <= i; ++j)
+      if (heat.times(j) > heat.times(i) - plain.consistency.window_s) dof_window(i) += heat.dof(j);
+    const double f = std::sqrt(std::max(1.0, heat.window_nis(i) / dof_window(i)));
+    widest = std::max(widest, f);
+    for (int d = 0; d < 3; ++d)
+      EXPECT_NEAR(wide.drift_sigma(i, d), f * heat.drift_sigma(i, d), 1e-12 * f * 1e-3)
+          << "sample " << i << " direction " << d;
+  }
+  // Where the alarm is raised the window's NIS is above its chi-square bound (about 1.13 times
+  // its readings here): the heat input's innovations did widen it.
+  ASSERT_TRUE(heat.recalibrate);
+  EXPECT_GT(widest, 1.1);
+  const solvers::ObserverRun clean_wide =
+      solvers::observe(s_->twin.model.system, c, widened, s_->clean.time, s_->clean.temperature);
+  // On the clean run, once the window is full, the widening stays small: the noise model holds.
+  double clean_widest = 1;
+  for (Eigen::Index i = 0; i < clean_wide.times.size(); ++i)
+    if (clean_wide.times(i) >= plain.consistency.window_s)
+      clean_widest =
+          std::max(clean_widest, clean_wide.drift_sigma(i, 1) / runs[0].drift_sigma(i, 1));
+  std::cerr << "widening: at most " << widest << " on the heat run, " << clean_widest
+            << " on the clean run\n";
+  EXPECT_LE(clean_widest, 1.3);
 }
 
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
