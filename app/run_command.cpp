@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "app/commands.hpp"
@@ -47,79 +48,100 @@ int mesh_command(const MeshArgs& args) {
   return 0;
 }
 
-int run_command(const RunArgs& args) {
-  const auto t_start = Clock::now();
-  // 1. Read and validate the case; claim the output and the checkpoint beside it before any
-  //    work, so that a refused or unwritable --out fails at once, not after the solve.
+namespace {
+
+/// The case, with the duty cycle of --duty-cycle when given.
+core::CaseSpec run_case(const RunArgs& args) {
   if (args.end_s && args.duty_cycle.empty())
     throw core::CaseError("run: --end-s " + std::to_string(*args.end_s) +
                           " sets the end of a duty cycle given with --duty-cycle; hint: give "
                           "--duty-cycle FILE.csv, or change duty_cycle.end_s in the case");
-  const core::CaseSpec spec =
-      args.duty_cycle.empty()
-          ? io::read_case(args.case_file)
-          : io::with_duty_cycle_csv(io::read_case(args.case_file), args.duty_cycle, args.end_s);
+  return args.duty_cycle.empty()
+             ? io::read_case(args.case_file)
+             : io::with_duty_cycle_csv(io::read_case(args.case_file), args.duty_cycle, args.end_s);
+}
+
+/// The reduced model of --rom, checked to have been built for this machine and mesh.
+std::optional<io::ReducedModelFile> run_rom(const RunArgs& args, const core::CaseSpec& spec,
+                                            const mesh::TetMesh& mesh) {
+  if (args.rom.empty()) {
+    if (args.verify)
+      throw core::CaseError(
+          "run: --verify compares a reduced run with the full model: give --rom DIR");
+    return std::nullopt;
+  }
+  if (args.resume)
+    throw core::CaseError("run: --resume continues a full run; a run with --rom " +
+                          args.rom.string() + " takes seconds: run it again without --resume");
+  io::ReducedModelFile rom = io::read_reduced_model(args.rom);
+  io::check_reduced_model_fits(rom, io::reduced_model_key(spec, mesh), args.rom);
+  return rom;
+}
+
+/// The time loop saves its state beside DIR (DIR.checkpoint) so that --resume continues a run that
+/// was killed; a save that fails (disk full) costs only the resume point: warned once, the run goes
+/// on. `resumed` holds the state read back with --resume.
+solvers::Checkpointing run_checkpointing(const RunArgs& args, const std::filesystem::path& file,
+                                         const io::CheckpointKey& key,
+                                         std::optional<solvers::ThermalCheckpoint>& resumed) {
+  if (args.resume && std::filesystem::exists(file)) {
+    resumed = io::read_checkpoint(file, key);
+    std::cerr << "thermotwin: resuming at t = " << resumed->time << " s (step " << resumed->steps
+              << ")\n";
+  } else if (args.resume) {
+    std::cerr << "thermotwin: note: no checkpoint at " << file.string() << "; starting at t = 0\n";
+  }
+  solvers::Checkpointing checkpointing;
+  checkpointing.interval_s = args.stop_after_steps > 0 ? 0 : args.checkpoint_every_s;
+  checkpointing.resume = resumed ? &*resumed : nullptr;
+  if (args.stop_after_steps > 0 || args.checkpoint_every_s >= 0)
+    checkpointing.save =
+        [file, key, stop = args.stop_after_steps,
+         failed = std::make_shared<bool>(false)](const solvers::ThermalCheckpoint& state) {
+          try {
+            io::write_checkpoint(file, key, state);
+          } catch (const core::IoError& e) {
+            if (!*failed)
+              std::cerr << "thermotwin: warning: checkpoint not saved: " << e.what()
+                        << "; the run goes on (--resume would start from an earlier state)\n";
+            *failed = true;
+          }
+          if (stop > 0 && state.steps >= stop) std::_Exit(3);  // as if killed
+        };
+  return checkpointing;
+}
+
+}  // namespace
+
+int run_command(const RunArgs& args) {
+  const auto t_start = Clock::now();
+  // 1. Read and validate the case; claim the output and the checkpoint beside it before any
+  //    work, so that a refused or unwritable --out fails at once, not after the solve.
+  const core::CaseSpec spec = run_case(args);
   const std::filesystem::path checkpoint = io::checkpoint_path(args.out);
   std::vector<std::filesystem::path> inputs = io::case_input_files(spec);
   inputs.push_back(checkpoint);
   if (!args.rom.empty()) inputs.push_back(args.rom);
   io::OutputDir out(args.out, inputs);
-  const bool checkpoints = args.stop_after_steps > 0 || args.checkpoint_every_s >= 0;
-  if (checkpoints) io::require_writable_checkpoint(checkpoint);
-  // 2. Mesh.
+  if (args.stop_after_steps > 0 || args.checkpoint_every_s >= 0)
+    io::require_writable_checkpoint(checkpoint);
+  // 2. Mesh; the reduced model, when given.
   const auto t_mesh = Clock::now();
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const double mesh_s = seconds_since(t_mesh);
+  const auto say = [&](const std::string& line) {
+    if (!args.quiet) std::cerr << "thermotwin: " << line << "\n";
+  };
   if (!args.quiet)
     std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows()
               << " tets (" << mesh_s << " s)\n";
-  // A reduced model, when given, must have been built for this machine and mesh.
-  std::optional<io::ReducedModelFile> rom;
-  if (!args.rom.empty()) {
-    if (args.resume)
-      throw core::CaseError("run: --resume continues a full run; a run with --rom " +
-                            args.rom.string() + " takes seconds: run it again without --resume");
-    rom = io::read_reduced_model(args.rom);
-    io::check_reduced_model_fits(*rom, io::reduced_model_key(spec, mesh), args.rom);
-  } else if (args.verify) {
-    throw core::CaseError(
-        "run: --verify compares a reduced run with the full model: give --rom DIR");
-  }
-  // 3. Simulate: heat transfer, then thermo-elasticity. The time loop saves its state beside
-  //    DIR (DIR.checkpoint) so that --resume continues a run that was killed; a save that fails
-  //    (disk full) costs only the resume point: warned once, the run goes on.
-  const io::CheckpointKey key = io::checkpoint_key(spec, mesh);
+  const std::optional<io::ReducedModelFile> rom = run_rom(args, spec, mesh);
+  // 3. Simulate: heat transfer, then thermo-elasticity.
   std::optional<solvers::ThermalCheckpoint> resumed;
-  if (args.resume && std::filesystem::exists(checkpoint)) {
-    resumed = io::read_checkpoint(checkpoint, key);
-    std::cerr << "thermotwin: resuming at t = " << resumed->time << " s (step " << resumed->steps
-              << ")\n";
-  } else if (args.resume) {
-    std::cerr << "thermotwin: note: no checkpoint at " << checkpoint.string()
-              << "; starting at t = 0\n";
-  }
-  solvers::Checkpointing checkpointing;
-  checkpointing.interval_s = args.stop_after_steps > 0 ? 0 : args.checkpoint_every_s;
-  checkpointing.resume = resumed ? &*resumed : nullptr;
-  bool save_failed = false;
-  if (checkpoints)
-    checkpointing.save = [&](const solvers::ThermalCheckpoint& state) {
-      try {
-        io::write_checkpoint(checkpoint, key, state);
-      } catch (const core::IoError& e) {
-        if (!save_failed)
-          std::cerr << "thermotwin: warning: checkpoint not saved: " << e.what()
-                    << "; the run goes on (--resume would start from an earlier state)\n";
-        save_failed = true;
-      }
-      if (args.stop_after_steps > 0 && state.steps >= args.stop_after_steps)
-        std::_Exit(3);  // as if killed
-    };
+  const solvers::Checkpointing checkpointing =
+      run_checkpointing(args, checkpoint, io::checkpoint_key(spec, mesh), resumed);
   const solvers::Progress progress = [&](double t, double end) {
     if (!args.quiet) report_progress(rom ? "thermal (reduced)" : "thermal", t, end);
-  };
-  const auto say = [&](const std::string& line) {
-    if (!args.quiet) std::cerr << "thermotwin: " << line << "\n";
   };
   const studies::VirtualRunReport report = studies::virtual_run(
       mesh, spec, {rom ? &rom->twin : nullptr, args.verify, progress, say, checkpointing});

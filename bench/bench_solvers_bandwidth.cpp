@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/cholmod/cholmod_factor.hpp"
@@ -27,9 +28,7 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using tt::core::seconds_since;
 
 /// CPU time of the calling thread [s]: unlike wall time, it excludes the time the thread waits
 /// while other processes hold the cores (the bench machine is shared).

@@ -52,6 +52,7 @@
 #include "calibration/generator.hpp"
 #include "calibration/model.hpp"
 #include "core/rng.hpp"
+#include "core/timing.hpp"
 #include "core/units.hpp"
 #include "fitting/models.hpp"
 #include "fitting/noise.hpp"
@@ -70,9 +71,7 @@ namespace {
 using namespace tt;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using tt::core::seconds_since;
 
 /// Per target (dy, dz): sum of squared errors, samples, samples inside ±2σ, and inside ±2σ with
 /// σ times the calibrated scale (solvers::drift_sigma_calibration on training runs), and inside

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "core/timing.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/twin.hpp"
@@ -20,9 +21,7 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using tt::core::seconds_since;
 
 /// Peak resident set of this process so far [MB] (VmHWM).
 double peak_rss_mb() {

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/case_reader.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/loads.hpp"
@@ -44,9 +45,7 @@ namespace {
 
 namespace s = tt::solvers;
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using tt::core::seconds_since;
 
 struct Cycle {
   std::string name;
