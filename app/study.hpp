@@ -1,6 +1,7 @@
 // The CLI's adapters around the studies: a run directory's histories (app/run_histories.cpp) and
-// the thermal model a study steps (app/model_choice.cpp). Which points are candidates and their
-// histories are studies/histories.hpp's.
+// the thermal model a study steps (app/model_choice.cpp: --rom read, then
+// studies/model_choice.hpp's choice, its report written by io/model_out.hpp). Which points are
+// candidates and their histories are studies/histories.hpp's.
 #pragma once
 
 #include <Eigen/Core>
@@ -38,11 +39,7 @@ struct ModelChoice {
 };
 
 /// A campaign's results on the chosen model, and what was used (for the report: "kind" full or
-/// reduced, its order and where it came from).
-/// The reduced model's error indicator on `run` for summary files (`max_K`, `tolerance_K`,
-/// `above_tolerance`); above its tolerance it also warns on stderr.
-nlohmann::json indicator_report(const solvers::ErrorIndicator& indicator, const std::string& run);
-
+/// reduced, its order and where it came from; io::campaign_model_json).
 struct CampaignOnModel {
   std::vector<solvers::CampaignResult> results;
   nlohmann::json model;

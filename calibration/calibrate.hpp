@@ -102,9 +102,4 @@ using ChannelFigures = core::ErrorFigures;
 ChannelFigures channel_figures(const std::vector<Eigen::MatrixXd>& measured,
                                const std::vector<Eigen::MatrixXd>& simulated, int channel);
 
-/// The calibration.json document (docs/schemas/calibration.schema.json, shared with calibrate's
-/// data-driven mode): `r` names the channels of the per-channel test figures.
-nlohmann::json calibration_json(const CalibrationResult& result, const Readout& r,
-                                const std::vector<std::string>& train_names);
-
 }  // namespace tt::calibration

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "io/atomic_dir.hpp"
+#include "io/calibration_head.hpp"
 #include "io/csv_out.hpp"
 #include "io/plot.hpp"
 #include "io/reports.hpp"
@@ -122,15 +123,24 @@ const char* const kNoTemperature =
     "not applicable: no machine model behind the data, so no temperature is predicted (reported "
     "as null)";
 
+/// calibration.json's head (io/calibration_head.hpp): no machine model, so no temperature figure.
+CalibrationHead calibration_head(const studies::DataCalibrationReport& r, const SplitRuns& runs) {
+  CalibrationHead head;
+  head.mode = "data-driven (no --case)";
+  for (const auto& run : runs.runs)
+    (run.train ? head.training_runs : head.test_runs).push_back(run.folder.string());
+  head.temperature_note = kNoTemperature;
+  head.displacement_rms_um_before = r.rms_before * um;
+  head.displacement_rms_um_after = r.rms_after * um;
+  for (const auto& ch : r.channels)
+    head.channels.push_back({ch.name, false, ch.figures_before, ch.figures_after});
+  return head;
+}
+
 json calibration_document(const studies::DataCalibrationReport& r, const SplitRuns& runs) {
-  json before = json::object(), after = json::object(), tested = json::object(),
-       models = json::object(), diagnosis = json::object(), effects = json::array(),
-       worse = json::array();
+  json tested = json::object(), models = json::object(), diagnosis = json::object(),
+       effects = json::array();
   for (const auto& ch : r.channels) {
-    before[ch.name] = figures_json(ch.figures_before);
-    after[ch.name] = figures_json(ch.figures_after);
-    after[ch.name]["worse_than_before"] = ch.figures_after.rms > ch.figures_before.rms;
-    if (ch.figures_after.rms > ch.figures_before.rms) worse.push_back(ch.name);
     for (std::size_t k = 0; k < ch.study.effects.size(); ++k) {
       json e = effect_json(ch.study.effects[k], ch, r.sensor_names);
       e["test_rms_um_with_effects_so_far"] = ch.test_rms_with_effects_so_far[k] * um;
@@ -155,36 +165,20 @@ json calibration_document(const studies::DataCalibrationReport& r, const SplitRu
   std::stable_sort(effects.begin(), effects.end(), [](const json& a, const json& b) {
     return a["explained_fraction"].get<double>() > b["explained_fraction"].get<double>();
   });
-  json doc{{"format", "thermotwin-calibration/1"},
-           {"mode", "data-driven (no --case)"},
-           {"training_runs", json::array()},
-           {"test_runs", json::array()},
-           {"runs", runs_json(runs)},
-           {"before",
-            {{"temperature_rms_K", nullptr},
-             {"temperature_note", kNoTemperature},
-             {"displacement_rms_um", r.rms_before * um},
-             {"channels", before}}},
-           {"after",
-            {{"temperature_rms_K", nullptr},
-             {"temperature_note", kNoTemperature},
-             {"displacement_rms_um", r.rms_after * um},
-             {"channels", after}}},
-           {"effects", effects},
-           {"tested_per_step", tested},
-           {"models", models},
-           {"test_residual_correlations", diagnosis},
-           {"method",
-            {{"baseline", kBaselineMethod},
-             {"explained_fraction",
-              "share of the baseline's leave-one-segment-out training residual sum of squares the "
-              "effect removes (given the effects added before it)"},
-             {"threshold", kThreshold},
-             {"segments", r.block_origin + "; each segment's drift re-zeroed at its start"}}},
-           {"speed_input", r.has_speed},
-           {"after_worse_than_before_on_test", worse}};
-  for (const auto& run : runs.runs)
-    doc[run.train ? "training_runs" : "test_runs"].push_back(run.folder.string());
+  json doc = calibration_head_json(calibration_head(r, runs));
+  doc["runs"] = runs_json(runs);
+  doc["effects"] = effects;
+  doc["tested_per_step"] = tested;
+  doc["models"] = models;
+  doc["test_residual_correlations"] = diagnosis;
+  doc["method"] = {
+      {"baseline", kBaselineMethod},
+      {"explained_fraction",
+       "share of the baseline's leave-one-segment-out training residual sum of squares the "
+       "effect removes (given the effects added before it)"},
+      {"threshold", kThreshold},
+      {"segments", r.block_origin + "; each segment's drift re-zeroed at its start"}};
+  doc["speed_input"] = r.has_speed;
   return doc;
 }
 
@@ -211,7 +205,7 @@ std::string report_markdown(const studies::DataCalibrationReport& r, const json&
   if (!worse.empty()) {
     md << "**Worse after than before on the test data:**";
     for (const auto& ch : r.channels)
-      if (ch.figures_after.rms > ch.figures_before.rms)
+      if (ch.worse_after_than_before())
         md << " " << ch.name << " (" << ch.figures_before.rms * um << " -> "
            << ch.figures_after.rms * um << " um RMS)";
     md << ". The effects were claimed on held-out training segments only; on these test data "

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -14,6 +13,8 @@
 #include "fitting/residual_study.hpp"
 #include "fitting/segments.hpp"
 #include "fitting/selection.hpp"
+#include "studies/progress.hpp"
+#include "studies/test_figures.hpp"
 
 namespace tt::studies {
 
@@ -49,6 +50,9 @@ struct ChannelCalibration {
   /// the test residuals, stacked over the test segments [m]
   Eigen::VectorXd before, after;
   core::ErrorFigures figures_before, figures_after;
+  bool worse_after_than_before() const {
+    return studies::worse_after_than_before(figures_before, figures_after);
+  }
   ResidualCorrelations correlations_before, correlations_after;
   /// #test samples x 4: time on one axis (segments laid end to end, 1 s apart) [s], speed [rpm]
   /// (zeros without one), measured drift [m], the baseline's prediction [m]
@@ -66,9 +70,6 @@ struct DataCalibrationReport {
   /// over every channel and test sample [m]
   double rms_before = 0.0, rms_after = 0.0;
 };
-
-/// Receives a line of progress (the number of blocks, each channel as it starts).
-using Progress = std::function<void(const std::string&)>;
 
 /// The study. Throws core::DataError when the training pieces cannot be cut into at least two
 /// blocks or the segments disagree in their sensors and channels.

@@ -13,6 +13,7 @@
 
 #include "calibration_checks.hpp"
 #include "core/errors.hpp"
+#include "io/calibration_model_out.hpp"
 
 namespace tt::calibration {
 namespace {
@@ -198,7 +199,7 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   for (const auto& e : res.runners_up)
     air_reported |= e["kind"] == "ambient_temperature" && e.contains("unphysical");
   EXPECT_TRUE(air_reported) << res.runners_up.dump(1);
-  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, s.train.readout, {}).dump(1);
+  ASSERT_FALSE(res.effects.empty()) << io::selection_json(res).dump(1);
   EXPECT_EQ(res.effects[0]["kind"], "speed_dependent_convection");
 }
 
@@ -254,7 +255,7 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   const auto runs = testing::effect_runs(s, {e}, rng, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
-  ASSERT_FALSE(res.effects.empty()) << calibration_json(res, s.train.readout, {}).dump(1);
+  ASSERT_FALSE(res.effects.empty()) << io::selection_json(res).dump(1);
   const nlohmann::json& claim = res.effects[0];
   ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
   EXPECT_EQ(claim["location"]["source"], "front_bearing_friction");
@@ -336,7 +337,7 @@ TEST(Pairs, DISABLED_TwoEffectsAreClaimedTogether) {
   std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
               res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
               a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
-  ASSERT_EQ(res.effects.size(), 2u) << calibration_json(res, s.train.readout, {}).dump(1);
+  ASSERT_EQ(res.effects.size(), 2u) << io::selection_json(res).dump(1);
   std::set<std::string> kinds{res.effects[0]["kind"], res.effects[1]["kind"]};
   EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
