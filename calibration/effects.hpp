@@ -333,6 +333,28 @@ Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma);
 Eigen::MatrixXd whitened_rows(const Eigen::MatrixXd& a, const Whitened& w,
                               const Eigen::VectorXd& sigma);
 
+/// One run's residual and shared columns with a per-run air's least squares eliminated: the air is
+/// fitted on the run's temperature rows (as the choice fits it), so y -> y - A (At'At)^-1 At' y_t
+/// and the columns likewise; shared parameters fitted to them are then fitted jointly with the
+/// air, which follows them. A run with an ambient sensor has its air read: only subtracted.
+struct AirEliminated {
+  Eigen::MatrixXd m;               /// shared columns, the air eliminated (whitened rows)
+  Eigen::VectorXd y;               /// residual, the air eliminated (whitened rows)
+  Eigen::MatrixXd a;               /// the air's columns (whitened rows); empty without an air
+  std::vector<Eigen::Index> keep;  /// the rows the air is fitted on
+};
+/// `y` and `shared` (whitened rows of run `ri` as `w` keeps them) with the air `air` eliminated;
+/// unchanged when `air` is null.
+AirEliminated air_eliminated(const Candidate* air, const RunModel& run, const Readout& r,
+                             const Whitened& w, const Eigen::VectorXd& y,
+                             const Eigen::MatrixXd& shared, size_t ri, const Eigen::VectorXd& sigma,
+                             const CalibrationOptions& options);
+/// The air beside shared parameters `x`: fitted within its bounds to what y - shared x leaves on
+/// the run's temperature rows (or read from the run's ambient sensor). `y` holds no air.
+Eigen::VectorXd air_at(const Candidate& air, const RunModel& run, const AirEliminated& e,
+                       const Eigen::VectorXd& y, const Eigen::MatrixXd& shared,
+                       const Eigen::VectorXd& x, const CalibrationOptions& options);
+
 /// Least squares from the normal equations g x = b, ridged by `ridge` x g's mean diagonal.
 Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, double ridge);
 
