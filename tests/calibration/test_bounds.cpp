@@ -317,6 +317,25 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   EXPECT_EQ(one.claimed[0].kind, EffectKind::heat_input);
 }
 
+/// Prints the pairs; whether the one-after-the-other choice ranked `greedy_first` first and the
+/// best pair claims the kinds `a` and `b` instead.
+::testing::AssertionResult claimed_by_pair(const Selection& sel, EffectKind greedy_first,
+                                           EffectKind a, EffectKind b) {
+  for (const auto& p : sel.pairs)
+    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
+                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
+                p.admissible ? " admissible" : "");
+  if (sel.ranking.empty() || sel.ranking[0].kind != greedy_first)
+    return ::testing::AssertionFailure() << "the first round ranks another kind first";
+  if (sel.claimed.size() != 2 || !sel.by_pair)
+    return ::testing::AssertionFailure()
+           << sel.claimed.size() << " claims, by pair " << sel.by_pair;
+  if (std::set<EffectKind>{sel.claimed[0].kind, sel.claimed[1].kind} != std::set<EffectKind>{a, b})
+    return ::testing::AssertionFailure()
+           << "claimed " << sel.claimed[0].name << " and " << sel.claimed[1].name;
+  return ::testing::AssertionSuccess();
+}
+
 // Two effects (a heat input and a conductivity) whose sum a third candidate (a speed gain of
 // convection) nearly matches alone: one after the other takes the third first and can only patch
 // what it leaves; scored jointly, the pair of the two fits and is claimed instead.
@@ -336,18 +355,8 @@ TEST(Pairs, JointPairBeatsOneAfterTheOther) {
       candidate(EffectKind::material_parameter, "conductivity", {2.5 * y[0], 2.5 * y[1]}));
   cat.candidates.push_back(candidate(EffectKind::speed_dependent_convection, "speed gain", z));
   const Selection sel = select_effects(cat, CalibrationOptions{});
-  for (const auto& f : sel.ranking)
-    std::printf("[bounds] %s: score %.1f %s\n", f.name.c_str(), f.score, f.unphysical.c_str());
-  for (const auto& p : sel.pairs)
-    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
-                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
-                p.admissible ? " admissible" : "");
-  ASSERT_FALSE(sel.ranking.empty());
-  EXPECT_EQ(sel.ranking[0].kind, EffectKind::speed_dependent_convection);  // greedy's first
-  ASSERT_EQ(sel.claimed.size(), 2u);
-  EXPECT_TRUE(sel.by_pair);
-  std::set<EffectKind> kinds{sel.claimed[0].kind, sel.claimed[1].kind};
-  EXPECT_EQ(kinds, (std::set<EffectKind>{EffectKind::heat_input, EffectKind::material_parameter}));
+  ASSERT_TRUE(claimed_by_pair(sel, EffectKind::speed_dependent_convection, EffectKind::heat_input,
+                              EffectKind::material_parameter));
   for (const auto& f : sel.claimed)
     EXPECT_NEAR(f.parameters.at(0), f.kind == EffectKind::heat_input ? 0.5 : 0.2, 0.02) << f.name;
   // Without pairs (one effect at most) the greedy choice stands.
@@ -392,17 +401,8 @@ TEST(Pairs, AnAirAndTheMechanismItShadowsAreFittedTogether) {
   cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity", d));
   const Selection sel = select_effects(cat, CalibrationOptions{});
   for (const auto& f : sel.claimed) std::printf("[bounds] claimed: %s\n", f.name.c_str());
-  for (const auto& p : sel.pairs)
-    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
-                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
-                p.admissible ? " admissible" : "");
-  ASSERT_FALSE(sel.ranking.empty());
-  EXPECT_EQ(sel.ranking[0].kind, EffectKind::ambient_temperature);  // greedy's first
-  ASSERT_EQ(sel.claimed.size(), 2u);
-  EXPECT_TRUE(sel.by_pair);
-  std::set<EffectKind> kinds{sel.claimed[0].kind, sel.claimed[1].kind};
-  EXPECT_EQ(kinds, (std::set<EffectKind>{EffectKind::ambient_temperature,
-                                         EffectKind::temperature_dependent_heat}));
+  ASSERT_TRUE(claimed_by_pair(sel, EffectKind::ambient_temperature, EffectKind::ambient_temperature,
+                              EffectKind::temperature_dependent_heat));
   for (const auto& f : sel.claimed) {
     if (f.kind == EffectKind::temperature_dependent_heat) {
       EXPECT_NEAR(f.parameters.at(0), 0.05, 0.002);
