@@ -1157,22 +1157,22 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
   };
   for (size_t x = 0; x < pool.size(); ++x)
     for (size_t y = x + 1; y < pool.size(); ++y) add_pair(pool[x], pool[y]);
-  // Each pool member's best partner over the whole catalogue, found on the residual with the
-  // member's fit removed: a partner that the first round ranks low because another candidate took
-  // part of the member's signal (a heat input at its true place, behind patches near an offset
-  // sensor that explain the offset as heat) is scored with it jointly too.
-  // A per-run air's partners are found jointly with it instead (each candidate fitted beside the
-  // air, pair_fit): an air fitted alone takes part of a mechanism's signal (heat that grows with
-  // temperature warms the machine slowly, as a drifting air does), and what it leaves favours
-  // another candidate (a conductivity) over the mechanism. The best of each kind is scored.
+  // Each pool member's best partner of each kind over the whole catalogue, each candidate fitted
+  // jointly with the member (pair_fit): a partner that the first round ranks low because the
+  // member took part of its signal is scored with it too. Found on the residual the member's own
+  // fit leaves, the partner is the one that best matches that remainder, not the one that best
+  // fits beside the member: an air fitted alone takes part of a heat law's signal (heat that
+  // grows with temperature warms the machine slowly, as a drifting air does), and what it leaves
+  // favoured a conductivity; a heat law fitted alone takes part of a film's, and what it leaves
+  // favoured the bearing's conductivity over the film. A candidate's score alone does not matter.
   for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
     const int a = pool[x];
-    if (!per_run(a)) continue;
     std::map<EffectKind, std::pair<double, int>> best_of_kind;
     for (const EffectFit& f : fits) {
       const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-      // Its score alone does not matter: beside the air it may explain what it could not alone.
-      if (c.per_run || c.fixed) continue;
+      if (f.candidate == fits[static_cast<size_t>(a)].candidate || c.fixed ||
+          (c.per_run && per_run(a)))
+        continue;
       const PairFit pf =
           pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)], f, sel.null_score, o);
       if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
@@ -1181,22 +1181,6 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
         best_of_kind[f.kind] = {pf.score, f.candidate};
     }
     for (const auto& [kind, best] : best_of_kind) add_pair(a, best.second);
-  }
-  for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
-    const int a = pool[x];
-    if (per_run(a)) continue;
-    std::vector<EffectFit> given =
-        score_all(cat, ws, without_fits(cat, ws, ys, sel.sigma, {fits[static_cast<size_t>(a)]}, o),
-                  sel.sigma, o, true);
-    int best_partner = -1;
-    for (const EffectFit& f : given) {
-      const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-      if (f.candidate == a || (c.per_run && per_run(a)) || c.fixed || f.score <= 0) continue;
-      if (best_partner >= 0 && f.score <= given[static_cast<size_t>(best_partner)].score) continue;
-      if (!unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o).empty()) continue;
-      best_partner = f.candidate;
-    }
-    if (best_partner >= 0) add_pair(a, best_partner);
   }
   std::sort(pairs.begin(), pairs.end(),
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });

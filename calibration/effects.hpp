@@ -73,12 +73,12 @@ struct CalibrationOptions {
   /// Candidates of the first round reported (best per kind and place): the several-places
   /// candidates and the pairs' pool need more than the eight that one place each gave.
   int ranking_size = 12;
-  /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
-  /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
+  /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates of
+  /// the first round (a per-run air among them), at most `pair_pool_per_kind` of a kind.
   int pair_pool = 8, pair_pool_per_kind = 3;
-  /// ... and each of the first `pair_partner_searches` pool members with its best partner over
-  /// the whole catalogue on the residual the member leaves (one more scoring of the catalogue
-  /// each).
+  /// ... and each of the first `pair_partner_searches` pool members with its best partner of each
+  /// kind over the whole catalogue, every candidate fitted jointly with the member (one joint
+  /// least squares per candidate each).
   int pair_partner_searches = 8;
   std::uint64_t seed = 20260107;
   // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
