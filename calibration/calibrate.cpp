@@ -347,26 +347,11 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
     tr.measured = measured_channels(run, rt);
     const core::CaseSpec spec = case_for_run(declared, run);
     tr.before = march(model, spec, rt, run.time, {}, {}).base;
-    AugmentedCase aug{spec, {}};
-    for (const auto& f : res.selection.claimed) {
-      const Candidate& c = cat.candidates[f.candidate];
-      std::vector<double> p = f.parameters;
-      if (c.per_run) {
-        const auto it = std::find_if(test_cat.candidates.begin(), test_cat.candidates.end(),
-                                     [&](const Candidate& x) { return x.name == c.name; });
-        p = fit_run_parameters(*it, static_cast<int>(ti), test_cat.runs[ti], r, res.selection.sigma,
-                               o);
-        aug = augmented_case(aug, *it, p, r);
-      } else {
-        aug = augmented_case(aug, c, p, r);
-      }
-    }
-    // What the written file says: read back its TOML, mesh it, simulate it.
-    const core::CaseSpec again =
-        io::case_from_toml(io::resolved_case_toml(aug.spec), "augmented.toml");
-    if (res.selection.claimed.empty()) {
-      tr.after = tr.before;
-    } else {
+    // The test run simulated with `aug` as its written file reads back (meshed again: heat inputs
+    // add boundary groups), sensor corrections applied.
+    auto simulated = [&](const AugmentedCase& aug) -> Eigen::MatrixXd {
+      const core::CaseSpec again =
+          io::case_from_toml(io::resolved_case_toml(aug.spec), "augmented.toml");
       // The augmented case's own mesh: its new boundary groups take faces of the same tets.
       const mesh::TetMesh m2 = mesh::mesh_case(again);
       if (model.is_reduced() && same_tets(m2, mesh)) {
@@ -376,14 +361,51 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
         Readout r2 = rt;
         r2.displacement = displacement_with_expansions(rt, declared, again);
         const MarchModel augmented = model.with_case(m2, again);
-        tr.after = corrected(march(augmented, again, r2, run.time, {}, {}).base, run.time, r2,
-                             aug.sensors);
-      } else {
-        const Readout r2 = readout(m2, again, run);
-        tr.after = corrected(march(MarchModel(m2, again), again, r2, run.time, {}, {}).base,
-                             run.time, r2, aug.sensors);
+        return corrected(march(augmented, again, r2, run.time, {}, {}).base, run.time, r2,
+                         aug.sensors);
       }
+      const Readout r2 = readout(m2, again, run);
+      return corrected(march(MarchModel(m2, again), again, r2, run.time, {}, {}).base, run.time, r2,
+                       aug.sensors);
+    };
+    // The shared claims first; a per-run air is then fitted to what the model with them leaves of
+    // the test run (fitted against the declared model alone, it would take the other claims'
+    // signal a second time), and declared before them (a heat input's new group copies the
+    // covered group's sink).
+    AugmentedCase aug{spec, {}};
+    std::vector<const EffectFit*> airs;
+    for (const auto& f : res.selection.claimed) {
+      const Candidate& c = cat.candidates[f.candidate];
+      if (c.per_run)
+        airs.push_back(&f);
+      else
+        aug = augmented_case(aug, c, f.parameters, r);
     }
+    if (!airs.empty()) {
+      RunModel left = test_cat.runs[ti];
+      if (airs.size() < res.selection.claimed.size()) left.base = simulated(aug);
+      AugmentedCase with_air{spec, {}};
+      for (const EffectFit* f : airs) {
+        const Candidate& c = cat.candidates[f->candidate];
+        const auto it = std::find_if(test_cat.candidates.begin(), test_cat.candidates.end(),
+                                     [&](const Candidate& x) { return x.name == c.name; });
+        const std::vector<double> p =
+            fit_run_parameters(*it, static_cast<int>(ti), left, r, res.selection.sigma, o);
+        with_air = augmented_case(with_air, *it, p, r);
+        // A second air is fitted to what the first leaves (its columns are the declared model's).
+        const Eigen::VectorXd moved =
+            it->columns[ti] *
+            Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
+        left.base +=
+            Eigen::Map<const Eigen::MatrixXd>(moved.data(), left.base.rows(), left.base.cols());
+      }
+      for (const auto& f : res.selection.claimed) {
+        const Candidate& c = cat.candidates[f.candidate];
+        if (!c.per_run) with_air = augmented_case(with_air, c, f.parameters, r);
+      }
+      aug = with_air;
+    }
+    tr.after = res.selection.claimed.empty() ? tr.before : simulated(aug);
     tr.augmented = aug;
     meas.push_back(tr.measured);
     before.push_back(tr.before);
@@ -459,7 +481,7 @@ nlohmann::json effect_json(const Catalogue& cat, const EffectFit& f, bool claime
   if (c.kind == EffectKind::ambient_temperature) j["duty_correlation"] = f.duty_correlation;
   if (!f.unphysical.empty()) j["unphysical"] = f.unphysical;
   if (f.refit_iterations > 0) {
-    // Per-run parameters and lags are held as fitted while the others are refitted about them.
+    // A per-run air follows the others' refit; lags are held as fitted.
     nlohmann::json refit = {{"iterations", f.refit_iterations},
                             {"converged", f.refit_converged},
                             {"whitened_ss_at_linearised", f.refit_ss_linearised},

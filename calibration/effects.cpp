@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <optional>
 #include <random>
@@ -129,6 +130,22 @@ Eigen::VectorXd fitted_theta(const Candidate& c, const EffectFit& f, size_t ri) 
   if (c.fixed) return Eigen::VectorXd::Ones(1);
   const std::vector<double>& p = c.per_run ? f.run_parameters.at(ri) : f.parameters;
   return Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
+}
+
+/// The kept rows of `w` that a per-run air is fitted on: the temperatures, when the run has them
+/// (the displacements stay a check).
+std::vector<Eigen::Index> temperature_rows(const Whitened& w, const Readout& r) {
+  std::vector<Eigen::Index> keep;
+  for (size_t k = 0; k < w.rows.size(); ++k)
+    if (r.sensors == 0 || w.channel[k] < r.sensors) keep.push_back(static_cast<Eigen::Index>(k));
+  return keep;
+}
+
+/// Rows `keep` of `a`.
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& a, const std::vector<Eigen::Index>& keep) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(keep.size()), a.cols());
+  for (size_t k = 0; k < keep.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = a.row(keep[k]);
+  return out;
 }
 
 /// Speeds the runs' duty cycles use [rpm].
@@ -799,20 +816,41 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
 std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,
                                        const Readout& r, const Eigen::VectorXd& sigma,
                                        const CalibrationOptions& o) {
-  Whitened w = whitened(model, sigma);
-  // Temperatures only when the run has them: the displacements stay a check.
-  std::vector<Eigen::Index> keep;
-  for (size_t k = 0; k < w.rows.size(); ++k)
-    if (r.sensors == 0 || w.channel[k] < r.sensors) keep.push_back(static_cast<Eigen::Index>(k));
-  const Eigen::MatrixXd a_all = whitened_rows(c.columns[run], w, sigma);
-  Eigen::MatrixXd a(static_cast<Eigen::Index>(keep.size()), a_all.cols());
-  Eigen::VectorXd y(static_cast<Eigen::Index>(keep.size()));
-  for (size_t k = 0; k < keep.size(); ++k) {
-    a.row(static_cast<Eigen::Index>(k)) = a_all.row(keep[k]);
-    y(static_cast<Eigen::Index>(k)) = w.y(keep[k]);
-  }
+  const Whitened w = whitened(model, sigma);
+  const std::vector<Eigen::Index> keep = temperature_rows(w, r);
+  const Eigen::MatrixXd a = rows_of(whitened_rows(c.columns[run], w, sigma), keep);
+  const Eigen::VectorXd y = rows_of(w.y, keep);
   const Eigen::VectorXd theta = per_run_theta(c, model, a.transpose() * a, a.transpose() * y, o);
   return std::vector<double>(theta.data(), theta.data() + theta.size());
+}
+
+AirEliminated air_eliminated(const Candidate* air, const RunModel& run, const Readout& r,
+                             const Whitened& w, const Eigen::VectorXd& y,
+                             const Eigen::MatrixXd& shared, size_t ri, const Eigen::VectorXd& sigma,
+                             const CalibrationOptions& o) {
+  AirEliminated out{shared, y, {}, {}};
+  if (!air) return out;
+  out.a = whitened_rows(air->columns[ri], w, sigma);
+  out.keep = temperature_rows(w, r);
+  if (run.air.size() > 0) {  // read from the ambient sensor: nothing to fit
+    out.y -= out.a * air_from_sensor(*air, run);
+    return out;
+  }
+  const Eigen::MatrixXd at = rows_of(out.a, out.keep);
+  Eigen::MatrixXd gt = at.transpose() * at;
+  gt.diagonal().array() += std::max(o.ridge, 1e-6) * std::max(gt.diagonal().mean(), 1e-300);
+  const Eigen::LDLT<Eigen::MatrixXd> f(gt);
+  out.y -= out.a * f.solve(at.transpose() * rows_of(y, out.keep));
+  out.m -= out.a * f.solve(at.transpose() * rows_of(shared, out.keep));
+  return out;
+}
+
+Eigen::VectorXd air_at(const Candidate& air, const RunModel& run, const AirEliminated& e,
+                       const Eigen::VectorXd& y, const Eigen::MatrixXd& shared,
+                       const Eigen::VectorXd& x, const CalibrationOptions& o) {
+  const Eigen::MatrixXd at = rows_of(e.a, e.keep);
+  const Eigen::VectorXd left = rows_of(y - shared * x, e.keep);
+  return per_run_theta(air, run, at.transpose() * at, at.transpose() * left, o);
 }
 
 namespace {
@@ -894,17 +932,9 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
     } else if (c.per_run) {
       for (size_t ri = 0; ri < nr; ++ri) {
         // Fit on the run's temperatures, score on all of its channels.
-        std::vector<Eigen::Index> keep;
-        const Eigen::MatrixXd a = whitened_rows(c.columns[ri], ws[ri], sigma);
-        for (size_t k = 0; k < ws[ri].rows.size(); ++k)
-          if (r.sensors == 0 || ws[ri].channel[k] < r.sensors)
-            keep.push_back(static_cast<Eigen::Index>(k));
-        Eigen::MatrixXd at(static_cast<Eigen::Index>(keep.size()), a.cols());
-        Eigen::VectorXd yt(static_cast<Eigen::Index>(keep.size()));
-        for (size_t k = 0; k < keep.size(); ++k) {
-          at.row(static_cast<Eigen::Index>(k)) = a.row(keep[k]);
-          yt(static_cast<Eigen::Index>(k)) = ys[ri](keep[k]);
-        }
+        const std::vector<Eigen::Index> keep = temperature_rows(ws[ri], r);
+        const Eigen::MatrixXd at = rows_of(whitened_rows(c.columns[ri], ws[ri], sigma), keep);
+        const Eigen::VectorXd yt = rows_of(ys[ri], keep);
         const RunModel& rm = cat.runs[ri];
         const Eigen::VectorXd th =
             per_run_theta(c, rm, at.transpose() * at, at.transpose() * yt, o);
@@ -976,31 +1006,88 @@ double gain_spread(const std::vector<double>& a, const std::vector<double>& b) {
 
 /// Candidates `a` and `b` (their single fits of the first round) fitted together: the joint
 /// leave-one-run-out gains, the joint in-sample parameters, each member judged physical with them.
+/// One member may be a per-run air: it is fitted on each run beside the other's shared parameters
+/// (on the held-out run too, as a single air is), so that an air and a mechanism it can shadow are
+/// sized together.
 PairFit pair_fit(const Catalogue& cat, const std::vector<Whitened>& ws,
                  const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
                  const EffectFit& a, const EffectFit& b, double null_score,
                  const CalibrationOptions& o) {
   const Candidate& ca = cat.candidates[static_cast<size_t>(a.candidate)];
   const Candidate& cb = cat.candidates[static_cast<size_t>(b.candidate)];
-  const Eigen::Index pa = ca.columns.front().cols(), pb = cb.columns.front().cols();
-  std::vector<Normal> normals;
-  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
-    Eigen::MatrixXd m(static_cast<Eigen::Index>(ws[ri].rows.size()), pa + pb);
-    m.leftCols(pa) = whitened_rows(ca.columns[ri], ws[ri], sigma);
-    m.rightCols(pb) = whitened_rows(cb.columns[ri], ws[ri], sigma);
-    normals.push_back({m.transpose() * m, m.transpose() * ys[ri], ys[ri].squaredNorm()});
-  }
-  const SharedFit sf = shared_fit(normals, o);
   PairFit pf;
   pf.first = a;
   pf.second = b;
+  if ((ca.per_run && cb.per_run) || ca.fixed || cb.fixed) {
+    pf.score = -std::numeric_limits<double>::infinity();  // no joint least squares
+    return pf;
+  }
+  const Candidate* air = ca.per_run ? &ca : (cb.per_run ? &cb : nullptr);
+  // The shared columns: both members', or the one that is not the air.
+  std::vector<const Candidate*> shared;
+  for (const Candidate* c : {&ca, &cb})
+    if (!c->per_run) shared.push_back(c);
+  const size_t nr = cat.runs.size();
+  std::vector<Normal> normals;
+  std::vector<Eigen::MatrixXd> cols(nr);
+  std::vector<AirEliminated> design;
+  double penalty = 0;
+  for (const Candidate* c : shared) penalty += static_cast<double>(c->columns.front().cols());
+  for (size_t ri = 0; ri < nr; ++ri) {
+    Eigen::Index p = 0;
+    for (const Candidate* c : shared) p += c->columns.front().cols();
+    cols[ri].resize(static_cast<Eigen::Index>(ws[ri].rows.size()), p);
+    Eigen::Index at = 0;
+    for (const Candidate* c : shared) {
+      const Eigen::Index k = c->columns.front().cols();
+      cols[ri].middleCols(at, k) = whitened_rows(c->columns[ri], ws[ri], sigma);
+      at += k;
+    }
+    design.push_back(
+        air_eliminated(air, cat.runs[ri], cat.readout, ws[ri], ys[ri], cols[ri], ri, sigma, o));
+    const AirEliminated& e = design.back();
+    normals.push_back({e.m.transpose() * e.m, e.m.transpose() * e.y, e.y.squaredNorm()});
+    if (air && cat.runs[ri].air.size() == 0)
+      penalty += static_cast<double>(air->columns.front().cols());
+  }
+  const SharedFit sf = shared_fit(normals, o);
   pf.fold_gains = sf.fold_gains;
-  pf.heldout_gain = sf.heldout;
-  pf.score = sf.heldout - o.penalty_per_parameter * static_cast<double>(pa + pb);
-  pf.first.parameters.assign(sf.full.data(), sf.full.data() + pa);
-  pf.second.parameters.assign(sf.full.data() + pa, sf.full.data() + pa + pb);
-  pf.first.unphysical = unphysical_reason(ca, pf.first.parameters, {}, cat.runs, o);
-  pf.second.unphysical = unphysical_reason(cb, pf.second.parameters, {}, cat.runs, o);
+  std::vector<std::vector<double>> airs;
+  if (air) {
+    // Gains against the residual itself, with each run's air fitted within its bounds beside the
+    // shared parameters of its fold (those of the other runs).
+    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(sf.full.size(), sf.full.size());
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(sf.full.size());
+    for (const auto& nm : normals) {
+      g += nm.g;
+      rhs += nm.b;
+    }
+    for (size_t ri = 0; ri < nr; ++ri) {
+      const Eigen::VectorXd x = solve_ridge(g - normals[ri].g, rhs - normals[ri].b, o.ridge);
+      const Eigen::VectorXd th = air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], x, o);
+      pf.fold_gains[ri] =
+          ys[ri].squaredNorm() - (ys[ri] - cols[ri] * x - design[ri].a * th).squaredNorm();
+      const Eigen::VectorXd full =
+          air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], sf.full, o);
+      airs.emplace_back(full.data(), full.data() + full.size());
+    }
+  }
+  for (double gain : pf.fold_gains) pf.heldout_gain += gain;
+  pf.score = pf.heldout_gain - o.penalty_per_parameter * penalty;
+  Eigen::Index at = 0;
+  for (EffectFit* f : {&pf.first, &pf.second}) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f->candidate)];
+    if (c.per_run) {
+      f->parameters.clear();
+      f->run_parameters = airs;
+    } else {
+      const Eigen::Index k = c.columns.front().cols();
+      f->parameters.assign(sf.full.data() + at, sf.full.data() + at + k);
+      at += k;
+    }
+    f->unphysical =
+        unphysical_reason(c, f->parameters, f->run_parameters, cat.runs, o, &f->duty_correlation);
+  }
   pf.adds_first = pf.score - b.score;
   pf.adds_second = pf.score - a.score;
   pf.admissible = pf.first.unphysical.empty() && pf.second.unphysical.empty() &&
@@ -1051,39 +1138,49 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
   for (int i : order) {
     const EffectFit& f = fits[static_cast<size_t>(i)];
     const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-    // Shared parameters only: a per-run air or a fixed lag has no joint least squares here.
-    if (!f.unphysical.empty() || c.per_run || c.fixed || f.score <= 0) continue;
+    // A fixed lag has no joint least squares; a per-run air is fitted per run beside the other.
+    if (!f.unphysical.empty() || c.fixed || f.score <= 0) continue;
     if (per_kind[f.kind]++ >= o.pair_pool_per_kind) continue;
     pool.push_back(i);
     if (static_cast<int>(pool.size()) >= o.pair_pool) break;
   }
   std::vector<PairFit> pairs;
   std::set<std::pair<int, int>> scored;
+  auto per_run = [&](int i) {
+    return cat.candidates[static_cast<size_t>(fits[static_cast<size_t>(i)].candidate)].per_run;
+  };
   auto add_pair = [&](int a, int b) {
-    if (a == b || !scored.insert({std::min(a, b), std::max(a, b)}).second) return;
+    if (a == b || (per_run(a) && per_run(b))) return;  // one air per pair
+    if (!scored.insert({std::min(a, b), std::max(a, b)}).second) return;
     pairs.push_back(pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)],
                              fits[static_cast<size_t>(b)], sel.null_score, o));
   };
   for (size_t x = 0; x < pool.size(); ++x)
     for (size_t y = x + 1; y < pool.size(); ++y) add_pair(pool[x], pool[y]);
-  // Each pool member's best partner over the whole catalogue, found on the residual with the
-  // member's fit removed: a partner that the first round ranks low because another candidate took
-  // part of the member's signal (a heat input at its true place, behind patches near an offset
-  // sensor that explain the offset as heat) is scored with it jointly too.
+  // Each pool member's best partner of each kind over the whole catalogue, each candidate fitted
+  // jointly with the member (pair_fit): a partner that the first round ranks low because the
+  // member took part of its signal is scored with it too. Found on the residual the member's own
+  // fit leaves, the partner is the one that best matches that remainder, not the one that best
+  // fits beside the member: an air fitted alone takes part of a heat law's signal (heat that
+  // grows with temperature warms the machine slowly, as a drifting air does), and what it leaves
+  // favoured a conductivity; a heat law fitted alone takes part of a film's, and what it leaves
+  // favoured the bearing's conductivity over the film. A candidate's score alone does not matter.
   for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
     const int a = pool[x];
-    std::vector<EffectFit> given =
-        score_all(cat, ws, without_fits(cat, ws, ys, sel.sigma, {fits[static_cast<size_t>(a)]}, o),
-                  sel.sigma, o, true);
-    int best_partner = -1;
-    for (const EffectFit& f : given) {
+    std::map<EffectKind, std::pair<double, int>> best_of_kind;
+    for (const EffectFit& f : fits) {
       const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-      if (f.candidate == a || c.per_run || c.fixed || f.score <= 0) continue;
-      if (best_partner >= 0 && f.score <= given[static_cast<size_t>(best_partner)].score) continue;
-      if (!unphysical_reason(c, f.parameters, {}, cat.runs, o).empty()) continue;
-      best_partner = f.candidate;
+      if (f.candidate == fits[static_cast<size_t>(a)].candidate || c.fixed ||
+          (c.per_run && per_run(a)))
+        continue;
+      const PairFit pf =
+          pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)], f, sel.null_score, o);
+      if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
+      const auto it = best_of_kind.find(f.kind);
+      if (it == best_of_kind.end() || pf.score > it->second.first)
+        best_of_kind[f.kind] = {pf.score, f.candidate};
     }
-    if (best_partner >= 0) add_pair(a, best_partner);
+    for (const auto& [kind, best] : best_of_kind) add_pair(a, best.second);
   }
   std::sort(pairs.begin(), pairs.end(),
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
@@ -1095,7 +1192,7 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
   if (best == pairs.end() || sel.claimed.empty()) return;
   for (const auto& f : sel.claimed) {
     const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-    if (c.per_run || c.fixed) return;  // the greedy choice holds what pairs cannot
+    if (c.fixed) return;  // the greedy choice holds what pairs cannot
   }
   auto same = [](const PairFit& p, int a, int b) {
     return (p.first.candidate == a && p.second.candidate == b) ||
@@ -1107,6 +1204,7 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
     // The greedy pair scored the same way (its members from the first round's fits).
     const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
                                     fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
+    if (!std::isfinite(greedy.score)) return;  // two airs: no joint fit to compare with
     if (best->score - greedy.score <= gain_spread(best->fold_gains, greedy.fold_gains)) return;
   } else if (best->score - sel.claimed[0].score <=
              std::max(sel.null_score, std::max(best->first.floor, best->second.floor))) {

@@ -73,12 +73,12 @@ struct CalibrationOptions {
   /// Candidates of the first round reported (best per kind and place): the several-places
   /// candidates and the pairs' pool need more than the eight that one place each gave.
   int ranking_size = 12;
-  /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates with
-  /// shared parameters of the first round, at most `pair_pool_per_kind` of a kind.
+  /// Pairs scored jointly (max_effects >= 2): among the `pair_pool` best physical candidates of
+  /// the first round (a per-run air among them), at most `pair_pool_per_kind` of a kind.
   int pair_pool = 8, pair_pool_per_kind = 3;
-  /// ... and each of the first `pair_partner_searches` pool members with its best partner over
-  /// the whole catalogue on the residual the member leaves (one more scoring of the catalogue
-  /// each).
+  /// ... and each of the first `pair_partner_searches` pool members with its best partner of each
+  /// kind over the whole catalogue, every candidate fitted jointly with the member (one joint
+  /// least squares per candidate each).
   int pair_partner_searches = 8;
   std::uint64_t seed = 20260107;
   // What a fitted parameter may be (docs/calibration.md, "Physics within bounds"): a candidate
@@ -332,6 +332,28 @@ Whitened whitened(const RunModel& run, const Eigen::VectorXd& sigma);
 /// The rows of `a` ((#samples #channels) x k, column-major channels) that `w` keeps, whitened.
 Eigen::MatrixXd whitened_rows(const Eigen::MatrixXd& a, const Whitened& w,
                               const Eigen::VectorXd& sigma);
+
+/// One run's residual and shared columns with a per-run air's least squares eliminated: the air is
+/// fitted on the run's temperature rows (as the choice fits it), so y -> y - A (At'At)^-1 At' y_t
+/// and the columns likewise; shared parameters fitted to them are then fitted jointly with the
+/// air, which follows them. A run with an ambient sensor has its air read: only subtracted.
+struct AirEliminated {
+  Eigen::MatrixXd m;               /// shared columns, the air eliminated (whitened rows)
+  Eigen::VectorXd y;               /// residual, the air eliminated (whitened rows)
+  Eigen::MatrixXd a;               /// the air's columns (whitened rows); empty without an air
+  std::vector<Eigen::Index> keep;  /// the rows the air is fitted on
+};
+/// `y` and `shared` (whitened rows of run `ri` as `w` keeps them) with the air `air` eliminated;
+/// unchanged when `air` is null.
+AirEliminated air_eliminated(const Candidate* air, const RunModel& run, const Readout& r,
+                             const Whitened& w, const Eigen::VectorXd& y,
+                             const Eigen::MatrixXd& shared, size_t ri, const Eigen::VectorXd& sigma,
+                             const CalibrationOptions& options);
+/// The air beside shared parameters `x`: fitted within its bounds to what y - shared x leaves on
+/// the run's temperature rows (or read from the run's ambient sensor). `y` holds no air.
+Eigen::VectorXd air_at(const Candidate& air, const RunModel& run, const AirEliminated& e,
+                       const Eigen::VectorXd& y, const Eigen::MatrixXd& shared,
+                       const Eigen::VectorXd& x, const CalibrationOptions& options);
 
 /// Least squares from the normal equations g x = b, ridged by `ridge` x g's mean diagonal.
 Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, double ridge);

@@ -32,6 +32,13 @@ struct Claims {
         return false;
     return true;
   }
+  /// The claimed per-run air, fitted on each run beside the shared claims; -1: none. (The choice
+  /// claims at most one air: a pair holds one.)
+  int air() const {
+    for (size_t k = 0; k < fits.size(); ++k)
+      if (candidate(k).per_run) return static_cast<int>(k);
+    return -1;
+  }
   bool changes_operators() const {
     for (size_t k = 0; k < fits.size(); ++k)
       if (candidate(k).kind == EffectKind::material_parameter && candidate(k).field != "expansion")
@@ -132,6 +139,41 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
   return {w.y, whitened_rows(jac, w, sigma), prediction};
 }
 
+/// A step on run `ri` with the claimed air's least squares eliminated (the air follows the shared
+/// parameters instead of being held: held, an air fitted beside a linearised law keeps that law's
+/// share when the law is resized), and what gives the air at a step from there.
+struct AirFree {
+  AirEliminated e;            /// residual and Jacobian, the air eliminated
+  Eigen::VectorXd y_without;  /// residual with the air taken out (whitened rows)
+  Eigen::MatrixXd jacobian;   /// Jacobian as the step gave it
+};
+AirFree air_free(const Claims& cl, const Step& s, size_t ri, const Eigen::VectorXd& sigma,
+                 const CalibrationOptions& o) {
+  const int k = cl.air();
+  if (k < 0) return {{s.jacobian, s.y, {}, {}}, s.y, s.jacobian};
+  const Candidate& air = cl.candidate(static_cast<size_t>(k));
+  const RunModel& rm = cl.cat->runs[ri];
+  const Whitened w = whitened(rm, sigma);  // the same rows as the step's: the finite readings
+  const std::vector<double>& held = cl.fits[static_cast<size_t>(k)].run_parameters.at(ri);
+  const Eigen::VectorXd y = s.y + whitened_rows(air.columns.at(ri), w, sigma) *
+                                      Eigen::Map<const Eigen::VectorXd>(
+                                          held.data(), static_cast<Eigen::Index>(held.size()));
+  return {air_eliminated(&air, rm, cl.cat->readout, w, y, s.jacobian, ri, sigma, o), y, s.jacobian};
+}
+
+/// The claimed air on every run at `step` from the point `at` was taken at (within its bounds).
+void move_air(Claims& cl, const std::vector<AirFree>& at, const Eigen::VectorXd& step,
+              const CalibrationOptions& o) {
+  const int k = cl.air();
+  if (k < 0) return;
+  const Candidate& air = cl.candidate(static_cast<size_t>(k));
+  for (size_t ri = 0; ri < at.size(); ++ri) {
+    const Eigen::VectorXd a =
+        air_at(air, cl.cat->runs[ri], at[ri].e, at[ri].y_without, at[ri].jacobian, step, o);
+    cl.fits[static_cast<size_t>(k)].run_parameters.at(ri).assign(a.data(), a.data() + a.size());
+  }
+}
+
 /// The updated model at `theta` (its operators assembled again when a claim changes them).
 std::optional<MarchModel> updated_operators(const MarchModel& model, const core::CaseSpec& declared,
                                             const Claims& cl, const Eigen::VectorXd& theta) {
@@ -154,6 +196,7 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
   const Eigen::Index p = theta.size();
   double ss_first = 0, ss_last = std::numeric_limits<double>::infinity();
   Eigen::VectorXd last_theta = theta, step = Eigen::VectorXd::Zero(p);
+  std::vector<AirFree> last_pieces;  /// the air's pieces at last_theta
   int iterations = 0;
   bool converged = false;
   Eigen::VectorXd beyond;  /// the step that left the bounds, when one did
@@ -164,22 +207,27 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
     Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
     Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
     double ss = 0;
+    std::vector<AirFree> pieces;
     for (size_t ri = 0; ri < cl.cat->runs.size(); ++ri) {
-      const Step s = linearised_on_run(model_u, declared, cl, theta, ri, sigma);
-      g += s.jacobian.transpose() * s.jacobian;
-      b += s.jacobian.transpose() * s.y;
-      ss += s.y.squaredNorm();
+      pieces.push_back(
+          air_free(cl, linearised_on_run(model_u, declared, cl, theta, ri, sigma), ri, sigma, o));
+      const AirEliminated& e = pieces.back().e;
+      g += e.m.transpose() * e.m;
+      b += e.m.transpose() * e.y;
+      ss += e.y.squaredNorm();
     }
     if (it == 0) ss_first = ss;
     if (ss > ss_last && it > 0) {
       // The last step overshot: take half of it from where it started.
       step /= 2;
       theta = last_theta + step;
+      move_air(cl, last_pieces, step, o);
       ++iterations;
       continue;
     }
     ss_last = ss;
     last_theta = theta;
+    last_pieces = std::move(pieces);
     step = solve_ridge(g, b, 1e-12);
     // Standard errors of the parameters (whitened residuals: unit noise).
     const Eigen::VectorXd se =
@@ -198,6 +246,7 @@ void gauss_newton(const MarchModel& model, const core::CaseSpec& declared, Claim
       break;
     }
     theta += step;
+    move_air(cl, last_pieces, step, o);
     ++iterations;
     if (converged) break;
   }
@@ -280,7 +329,9 @@ HeldOutCheck heldout_check(const MarchModel& model, const core::CaseSpec& declar
   for (const auto& f : start.fits) resized |= !f.linearised.empty();
   auto ss_on = [&](const Claims& cl, const Eigen::VectorXd& theta, size_t ri) {
     const std::optional<MarchModel> own = updated_operators(model, declared, cl, theta);
-    return linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma).y.squaredNorm();
+    return air_free(cl, linearised_on_run(own ? *own : model, declared, cl, theta, ri, sigma), ri,
+                    sigma, o)
+        .e.y.squaredNorm();
   };
   for (size_t ri = 0; ri < start.cat->runs.size(); ++ri) {
     Eigen::VectorXd lin = resized ? chosen : linearised_without(start, ri, sigma, o);
@@ -369,7 +420,10 @@ Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
       f.refit_heldout_ss_refitted = check.refitted;
       f.refit_accepted = !checked || check.refitted < check.linearised;
       f.refitted = f.parameters;
-      if (!f.refit_accepted) f.parameters = start.fits[k].parameters;
+      if (!f.refit_accepted) {
+        f.parameters = start.fits[k].parameters;
+        f.run_parameters = start.fits[k].run_parameters;
+      }
     }
     // A size that is unphysical once found is not claimed; the others are sized without it.
     std::vector<EffectFit> kept;

@@ -20,8 +20,10 @@ namespace tt::calibration {
 /// options.refit_tolerance_sigmas of its standard error or options.refit_tolerance_rel of its
 /// value, after at most options.refit_max_iterations steps; a step that raises the sum of
 /// squares is halved, and so is one that leaves the physical bounds (unphysical_reason), up to
-/// eight times: a claim whose step still leaves them "runs into the physical bounds". Per-run
-/// parameters (the air) and lags are held as fitted. Claims are refitted when one is not linear in
+/// eight times: a claim whose step still leaves them "runs into the physical bounds". A claimed
+/// per-run air is fitted on each run beside the shared parameters (its least squares on the run's
+/// temperature rows eliminated from every step, then refitted within its bounds at the new
+/// point); lags are held as fitted. Claims are refitted when one is not linear in
 /// its parameter (nonlinear_in_parameter) or when there are two; otherwise `sel` is returned as it
 /// is. A claim whose refitted value is unphysical is dropped from the claims (its `unphysical` says
 /// why) and the rest are refitted again.

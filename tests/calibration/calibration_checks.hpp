@@ -45,7 +45,7 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
               res.before.temperature_rms_K, res.after.temperature_rms_K,
               res.before.displacement_rms_um, res.after.displacement_rms_um,
               res.selection.null_score);
-  for (size_t k = 0; k < std::min<size_t>(3, res.selection.ranking.size()); ++k)
+  for (size_t k = 0; k < res.selection.ranking.size(); ++k)
     std::printf(
         "[calibration]   rank %zu: %s score %.1f floor %.1f explained %.3f p0 %.4g %s\n", k,
         res.selection.ranking[k].name.c_str(), res.selection.ranking[k].score,
@@ -55,6 +55,11 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   for (const auto& c : res.selection.claimed)
     std::printf("[calibration]   claimed: %s score %.1f floor %.1f p0 %.4g\n", c.name.c_str(),
                 c.score, c.floor, c.parameters.empty() ? 0.0 : c.parameters[0]);
+  for (const auto& p : res.selection.pairs)
+    std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f%s\n",
+                p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
+                p.admissible ? " admissible" : "");
+  if (res.selection.by_pair) std::printf("[calibration]   claimed by the best pair\n");
   for (const auto& [was, now] : res.selection.backfit_replaced)
     std::printf("[calibration]   backfit: %s replaced by %s\n", was.c_str(), now.c_str());
   for (const auto& a : res.selection.ambiguous)

@@ -317,6 +317,25 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   EXPECT_EQ(one.claimed[0].kind, EffectKind::heat_input);
 }
 
+/// Prints the pairs; whether the one-after-the-other choice ranked `greedy_first` first and the
+/// best pair claims the kinds `a` and `b` instead.
+::testing::AssertionResult claimed_by_pair(const Selection& sel, EffectKind greedy_first,
+                                           EffectKind a, EffectKind b) {
+  for (const auto& p : sel.pairs)
+    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
+                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
+                p.admissible ? " admissible" : "");
+  if (sel.ranking.empty() || sel.ranking[0].kind != greedy_first)
+    return ::testing::AssertionFailure() << "the first round ranks another kind first";
+  if (sel.claimed.size() != 2 || !sel.by_pair)
+    return ::testing::AssertionFailure()
+           << sel.claimed.size() << " claims, by pair " << sel.by_pair;
+  if (std::set<EffectKind>{sel.claimed[0].kind, sel.claimed[1].kind} != std::set<EffectKind>{a, b})
+    return ::testing::AssertionFailure()
+           << "claimed " << sel.claimed[0].name << " and " << sel.claimed[1].name;
+  return ::testing::AssertionSuccess();
+}
+
 // Two effects (a heat input and a conductivity) whose sum a third candidate (a speed gain of
 // convection) nearly matches alone: one after the other takes the third first and can only patch
 // what it leaves; scored jointly, the pair of the two fits and is claimed instead.
@@ -336,16 +355,8 @@ TEST(Pairs, JointPairBeatsOneAfterTheOther) {
       candidate(EffectKind::material_parameter, "conductivity", {2.5 * y[0], 2.5 * y[1]}));
   cat.candidates.push_back(candidate(EffectKind::speed_dependent_convection, "speed gain", z));
   const Selection sel = select_effects(cat, CalibrationOptions{});
-  for (const auto& p : sel.pairs)
-    std::printf("[bounds] pair %s + %s: score %.1f (adds %.1f, %.1f)%s\n", p.first.name.c_str(),
-                p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
-                p.admissible ? " admissible" : "");
-  ASSERT_FALSE(sel.ranking.empty());
-  EXPECT_EQ(sel.ranking[0].kind, EffectKind::speed_dependent_convection);  // greedy's first
-  ASSERT_EQ(sel.claimed.size(), 2u);
-  EXPECT_TRUE(sel.by_pair);
-  std::set<EffectKind> kinds{sel.claimed[0].kind, sel.claimed[1].kind};
-  EXPECT_EQ(kinds, (std::set<EffectKind>{EffectKind::heat_input, EffectKind::material_parameter}));
+  ASSERT_TRUE(claimed_by_pair(sel, EffectKind::speed_dependent_convection, EffectKind::heat_input,
+                              EffectKind::material_parameter));
   for (const auto& f : sel.claimed)
     EXPECT_NEAR(f.parameters.at(0), f.kind == EffectKind::heat_input ? 0.5 : 0.2, 0.02) << f.name;
   // Without pairs (one effect at most) the greedy choice stands.
@@ -355,6 +366,57 @@ TEST(Pairs, JointPairBeatsOneAfterTheOther) {
   ASSERT_EQ(single.claimed.size(), 1u);
   EXPECT_EQ(single.claimed[0].kind, EffectKind::speed_dependent_convection);
   EXPECT_FALSE(single.by_pair);
+}
+
+// Issue 16's draw 11 in miniature: the shop's air drifted (by its own ramp in each run) and a
+// bearing's heat grew with temperature. One after the other, the air is claimed first and takes
+// part of the heat law's signal; what it leaves is matched better by a third candidate (a
+// conductivity whose response is the heat law's without the air's share, plus a little of its
+// own) than by the heat law. A pair holds a per-run air: it is fitted on each run beside the heat
+// law's shared parameter (the air eliminated from the joint least squares), and the true pair is
+// claimed with both sizes.
+TEST(Pairs, AnAirAndTheMechanismItShadowsAreFittedTogether) {
+  std::vector<RunModel> runs{run_model("a", 3, 1800, 0), run_model("b", 3, 2400, 1)};
+  const double ramp_K[] = {1.0, -0.8};  /// the air's change over each run
+  std::vector<Eigen::VectorXd> x, d;
+  Catalogue cat = one_channel(runs);
+  const Candidate air = air_candidate(cat.runs, 1800);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const Eigen::VectorXd seen =
+        lagged(runs[r].times, ramp_K[r] * (runs[r].times.array() / 10800).matrix(), 1200);
+    x.push_back(10 * speed_response(runs[r], 900));  // per 1/K of the temperature coefficient
+    const Eigen::MatrixXd& a = air.columns[r];
+    const Eigen::VectorXd shadow = a * a.colPivHouseholderQr().solve(x[r]);
+    // Its own part: what the air and the heat law's remainder cannot give.
+    Eigen::MatrixXd both(a.rows(), a.cols() + 1);
+    both << a, x[r] - shadow;
+    Eigen::VectorXd own = speed_response(runs[r], 60, 0.5);
+    own -= both * both.colPivHouseholderQr().solve(own);
+    d.push_back(x[r] - shadow + 0.3 * shadow.norm() / own.norm() * own);
+    cat.runs[r].measured.col(0) += 0.05 * x[r] + seen;
+    add_noise(cat.runs[r], 0.01, 60 + r);
+  }
+  cat.candidates.push_back(air);
+  cat.candidates.push_back(candidate(EffectKind::temperature_dependent_heat, "heat law", x));
+  cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity", d));
+  const Selection sel = select_effects(cat, CalibrationOptions{});
+  for (const auto& f : sel.claimed) std::printf("[bounds] claimed: %s\n", f.name.c_str());
+  ASSERT_TRUE(claimed_by_pair(sel, EffectKind::ambient_temperature, EffectKind::ambient_temperature,
+                              EffectKind::temperature_dependent_heat));
+  for (const auto& f : sel.claimed) {
+    if (f.kind == EffectKind::temperature_dependent_heat) {
+      EXPECT_NEAR(f.parameters.at(0), 0.05, 0.002);
+      continue;
+    }
+    ASSERT_EQ(f.run_parameters.size(), runs.size());
+    // The hats sum to one and the channel sees the air through a lag from its start: a constant
+    // change is not seen here (it is in a thermal model), so the knots are compared to the first.
+    for (size_t r = 0; r < runs.size(); ++r)
+      for (size_t k = 1; k < air.knots.size(); ++k)
+        EXPECT_NEAR(f.run_parameters[r][k] - f.run_parameters[r][0],
+                    ramp_K[r] * air.knots[k] / 10800, 0.05)
+            << "run " << r << " knot " << k;
+  }
 }
 
 TEST(Ambiguity, HintNamesTheAmbientSensorAndADutyCycle) {

@@ -289,12 +289,11 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
 // jointly among the first round's best, or one after the other), both sized by the refit about the
 // model updated with the other. (A random heat-input draw is not used here: its box is drawn on the
 // generator's mesh, whose faces move with the build's floating point.)
-// Disabled: it fails on main as of 1bfa644 (only the heat law is claimed, 0.033 /K; the film is
-// not); the same test with a random 7 W heat input and the housing's film halved passed on
-// bb78659 and fails on 1bfa644 too (docs/calibration.md, "Pairs scored jointly" and Limits).
-// Still fails with a third claim, backfitting and each pool member's best partner (2026-11-26):
-// the heat law (0.034 /K) is claimed with the bearing's conductivity +25 %, not the film.
-TEST(Pairs, DISABLED_TwoEffectsAreClaimedTogether) {
+// Disabled from 1bfa644 until 2026-11-26 (only the heat law claimed, or with the bearing's
+// conductivity +25 % in place of the film): each pool member's partners were found on what its own
+// fit alone left, where the heat law had taken part of the film's signal. Partners are now found by
+// fitting each candidate jointly with the member (docs/calibration.md, "Pairs scored jointly").
+TEST(Pairs, TwoEffectsAreClaimedTogether) {
   const Study& s = study();
   std::mt19937_64 rng = core::generator(41, 1);
   InjectedEffect film;
