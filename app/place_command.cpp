@@ -13,6 +13,7 @@
 #include "app/commands.hpp"
 #include "app/study.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "fitting/noise.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
@@ -157,8 +158,7 @@ int place_command(const PlaceArgs& args) {
     input.estimation = estimation_problem(spec, h, args.rom, estimation);
   const auto t_place = std::chrono::steady_clock::now();
   const placement::PlacementResult result = placement::place_all(input, options);
-  const double place_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_place).count();
+  const double place_s = core::seconds_since(t_place);
 
   // 3. Outputs, all or nothing.
   const auto& dir = out->path();

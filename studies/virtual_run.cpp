@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "core/timing.hpp"
+
 namespace tt::studies {
 
 VirtualRunReport virtual_run(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
@@ -11,7 +13,7 @@ VirtualRunReport virtual_run(const mesh::TetMesh& mesh, const core::CaseSpec& sp
   const auto t0 = std::chrono::steady_clock::now();
   r.run = options.twin ? solvers::simulate_reduced(mesh, spec, *options.twin, options.progress)
                        : solvers::simulate(mesh, spec, options.progress, options.checkpointing);
-  r.simulate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.simulate_s = core::seconds_since(t0);
   // The reduced run's own error indicator: the full-order residual at sampled output steps.
   if (options.twin && spec.thermal.scheme == core::TimeScheme::backward_euler)
     r.indicator = solvers::twin_indicator(r.run.operators, options.twin->model, spec);
