@@ -23,7 +23,6 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "thermal-measurement/1";
-constexpr double kMetresPerMicrometre = 1e-6;
 
 /// What a data.csv column holds, once the header has been matched against meta.json.
 enum class ColumnRole { time, input, sensor, probe };
@@ -560,7 +559,7 @@ void fill_samples(const std::vector<double>& values, std::size_t rows,
           run.temperature(r, slot.index) = v + core::kCelsiusOffset;
           break;
         case ColumnRole::probe:
-          run.displacement(r, slot.index) = v * kMetresPerMicrometre;
+          run.displacement(r, slot.index) = v * core::kMetresPerMicrometre;
           break;
       }
     }
@@ -729,7 +728,7 @@ void write_measured_run(const fs::path& folder, const MeasuredRun& run) {
     }
     for (Eigen::Index c = 0; c < run.displacement.cols(); ++c) {
       csv += ',';
-      append_number(csv, run.displacement(r, c) / kMetresPerMicrometre);
+      append_number(csv, run.displacement(r, c) / core::kMetresPerMicrometre);
     }
     csv += '\n';
   }

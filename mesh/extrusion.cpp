@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -20,8 +21,6 @@ using core::Body;
 using core::Primitive;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// A closed ring of 2D points, counter-clockwise.
 using Ring = std::vector<Vector2d>;
@@ -449,7 +448,7 @@ cgal::TriangleSurface primitive_surface(const Primitive& p, int n) {
 }  // namespace
 
 double faceted_radius(double r, int n) {
-  const double a = 2 * kPi / n;
+  const double a = 2 * std::numbers::pi / n;
   return r * std::sqrt(a / std::sin(a));
 }
 
@@ -457,7 +456,7 @@ std::vector<Vector2d> faceted_circle(const Vector2d& centre, double r, int n) {
   const double rf = faceted_radius(r, n);
   std::vector<Vector2d> ring(n);
   for (int k = 0; k < n; ++k) {
-    const double a = 2 * kPi * k / n;
+    const double a = 2 * std::numbers::pi * k / n;
     ring[k] = centre + rf * Vector2d(std::cos(a), std::sin(a));
   }
   return ring;
@@ -479,9 +478,10 @@ double exact_body_volume(const Body& body) {
       case Primitive::Kind::box:
         return (p.max - p.min).prod();
       case Primitive::Kind::cylinder:
-        return kPi * p.radius * p.radius * (p.z_max - p.z_min);
+        return std::numbers::pi * p.radius * p.radius * (p.z_max - p.z_min);
       case Primitive::Kind::annulus:
-        return kPi * (p.radius * p.radius - p.inner_radius * p.inner_radius) * (p.z_max - p.z_min);
+        return std::numbers::pi * (p.radius * p.radius - p.inner_radius * p.inner_radius) *
+               (p.z_max - p.z_min);
       default:
         return -1.0;
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <unordered_map>
 
@@ -17,7 +18,6 @@ namespace tt::mesh {
 namespace {
 
 using Eigen::Vector3d;
-constexpr double kPi = 3.14159265358979323846;
 
 /// Outward faces of a positively oriented tet, as local corner indices.
 constexpr int kFaceCorners[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
@@ -75,7 +75,7 @@ bool selector_matches(const core::FaceSelector& s, const TetMesh& m, int f, cons
     if (std::abs(g.normal.z()) > 1e-6) return false;
     const double r = s.on_cylinder->radius;
     const double rf = faceted_radius(r, circle_segments);
-    const double r_in = rf * std::cos(kPi / circle_segments);
+    const double r_in = rf * std::cos(std::numbers::pi / circle_segments);
     for (const auto& c : g.corners) {
       const double d = (c.head<2>() - s.on_cylinder->axis).norm();
       if (d < std::min(r, r_in) - tol || d > std::max(r, rf) + tol) return false;
@@ -95,9 +95,10 @@ double primitive_volume(const core::Primitive& p, const core::Body& body) {
     case Kind::box:
       return (p.max - p.min).prod();
     case Kind::cylinder:
-      return kPi * p.radius * p.radius * (p.z_max - p.z_min);
+      return std::numbers::pi * p.radius * p.radius * (p.z_max - p.z_min);
     case Kind::annulus:
-      return kPi * (p.radius * p.radius - p.inner_radius * p.inner_radius) * (p.z_max - p.z_min);
+      return std::numbers::pi * (p.radius * p.radius - p.inner_radius * p.inner_radius) *
+             (p.z_max - p.z_min);
     case Kind::surface_file:
       return std::max(0.0, exact_body_volume(body));
   }
@@ -161,7 +162,8 @@ MeshEstimate mesh_estimate(const core::CaseSpec& spec) {
         if (p.kind != Kind::cylinder && p.kind != Kind::annulus) continue;
         const double h = p.z_max - p.z_min;
         for (const double r : {p.radius, p.kind == Kind::annulus ? p.inner_radius : 0.0})
-          if (r > 0) e.surface_tets += kSurfaceFill * n * std::max(1.0, h * n / (2 * kPi * r));
+          if (r > 0)
+            e.surface_tets += kSurfaceFill * n * std::max(1.0, h * n / (2 * std::numbers::pi * r));
       }
   return e;
 }
@@ -422,7 +424,7 @@ double min_dihedral_deg(const TetMesh& m) {
     for (int i = 0; i < 4; ++i)
       for (int j = i + 1; j < 4; ++j) {
         const double cosine = std::clamp(-n[i].dot(n[j]), -1.0, 1.0);
-        worst = std::min(worst, std::acos(cosine) * 180.0 / kPi);
+        worst = std::min(worst, std::acos(cosine) * 180.0 / std::numbers::pi);
       }
   }
   return worst;

@@ -4,14 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "core/errors.hpp"
 #include "core/limits.hpp"
 
 namespace tt::solvers {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double speed_at(const core::DutyCycle& cycle, double t) {
   double n = cycle.segments.empty() ? 0.0 : cycle.segments.front().speed_rpm;
@@ -44,7 +43,7 @@ double source_power(const core::HeatSource& s, double n, double feed) {
                             ? 1e-7 * s.palmgren_f0 * std::pow(nu_n, 2.0 / 3.0) * std::pow(dm_mm, 3)
                             : 160e-7 * s.palmgren_f0 * std::pow(dm_mm, 3);
       const double m1 = s.palmgren_f1 * s.palmgren_p1 * dm_mm;
-      return (m0 + m1) * 1e-3 * 2 * kPi * n / 60.0;
+      return (m0 + m1) * 1e-3 * 2 * std::numbers::pi * n / 60.0;
     }
   }
   return 0.0;
