@@ -11,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "core/rng.hpp"
+#include "core/units.hpp"
 #include "fitting/features.hpp"
 
 namespace tt::fitting {
@@ -18,7 +19,7 @@ namespace tt::fitting {
 namespace {
 
 /// The fits run in µm so that sums of squares stay far from underflow and cancellation.
-constexpr double kMicrometres = 1e6;
+using core::kMicrometresPerMetre;
 
 /// How the baseline's form fits: with an intercept or not, and its ridge strength (linear_fit's
 /// λ, dimensionless).
@@ -100,25 +101,25 @@ Eigen::MatrixXd term_columns(const EffectTerm& term, const std::vector<int>& sen
   const Eigen::Index n = s.group.time.size();
   const Eigen::VectorXd krpm = s.speed / 1000.0;
   switch (term.kind) {
-    case EffectKind::speed_dependent_offset: {
+    case TermKind::speed_dependent_offset: {
       Eigen::MatrixXd x(n, 2);
       x.col(0) = krpm;
       x.col(1) = krpm.array().square().matrix();
       return x;
     }
-    case EffectKind::lagged_speed:
+    case TermKind::lagged_speed:
       return low_pass(s.group.time, krpm, term.time_constant);
-    case EffectKind::lag: {
+    case TermKind::lag: {
       Eigen::MatrixXd x(n, static_cast<Eigen::Index>(sensors.size()));
       for (std::size_t k = 0; k < sensors.size(); ++k)
         x.col(static_cast<Eigen::Index>(k)) =
             low_pass(s.group.time, increment(s, sensors[k]), term.time_constant);
       return x;
     }
-    case EffectKind::ambient_temperature:
-    case EffectKind::missing_sensor:
+    case TermKind::ambient_temperature:
+    case TermKind::missing_sensor:
       return increment(s, term.sensor);
-    case EffectKind::drift_in_time:
+    case TermKind::drift_in_time:
       return ((s.group.time.array() - s.group.time(0)) / 3600.0).matrix();
   }
   return Eigen::MatrixXd(n, 0);
@@ -137,7 +138,7 @@ Eigen::MatrixXd joined_columns(const Eigen::MatrixXd& a, const Eigen::MatrixXd& 
 }
 
 Eigen::VectorXd target_um(const Segment& s, int target) {
-  return s.group.error.col(target) * kMicrometres;
+  return s.group.error.col(target) * kMicrometresPerMetre;
 }
 
 /// A surrogate of the columns of x with the same amplitude spectrum and random phases (the same
@@ -168,9 +169,9 @@ Eigen::MatrixXd phase_randomised(const Eigen::MatrixXd& x, std::mt19937_64& rng)
 
 int parameter_count(const EffectTerm& term, const std::vector<int>& sensors) {
   switch (term.kind) {
-    case EffectKind::speed_dependent_offset:
+    case TermKind::speed_dependent_offset:
       return 2;
-    case EffectKind::lag:
+    case TermKind::lag:
       return static_cast<int>(sensors.size());
     default:
       return 1;
@@ -178,35 +179,34 @@ int parameter_count(const EffectTerm& term, const std::vector<int>& sensors) {
 }
 
 /// The settings tried for one kind; empty when the kind does not apply.
-std::vector<EffectTerm> term_grid(EffectKind kind, const std::vector<int>& sensors,
-                                  int sensor_count, const ResidualStudyOptions& options,
-                                  bool has_speed) {
+std::vector<EffectTerm> term_grid(TermKind kind, const std::vector<int>& sensors, int sensor_count,
+                                  const ResidualStudyOptions& options, bool has_speed) {
   std::vector<EffectTerm> grid;
   switch (kind) {
-    case EffectKind::speed_dependent_offset:
+    case TermKind::speed_dependent_offset:
       if (has_speed) grid.push_back({kind, 0.0, -1});
       break;
-    case EffectKind::lagged_speed:
+    case TermKind::lagged_speed:
       if (has_speed)
         for (double tau : options.time_constants) grid.push_back({kind, tau, -1});
       break;
-    case EffectKind::lag:
+    case TermKind::lag:
       // A lag filters the baseline's sensors: none to filter on no compensation.
       if (!sensors.empty())
         for (double tau : options.time_constants) grid.push_back({kind, tau, -1});
       break;
-    case EffectKind::ambient_temperature:
+    case TermKind::ambient_temperature:
       if (options.ambient_sensor >= 0 &&
           std::find(sensors.begin(), sensors.end(), options.ambient_sensor) == sensors.end())
         grid.push_back({kind, 0.0, options.ambient_sensor});
       break;
-    case EffectKind::missing_sensor:
+    case TermKind::missing_sensor:
       for (int c = 0; c < sensor_count; ++c)
         if (c != options.ambient_sensor &&
             std::find(sensors.begin(), sensors.end(), c) == sensors.end())
           grid.push_back({kind, 0.0, c});
       break;
-    case EffectKind::drift_in_time:
+    case TermKind::drift_in_time:
       grid.push_back({kind, 0.0, -1});
       break;
   }
@@ -296,7 +296,7 @@ std::pair<int, double> best_of_grid(
       best = static_cast<int>(k);
     }
   }
-  return {best, best_rss / (kMicrometres * kMicrometres)};
+  return {best, best_rss / (kMicrometresPerMetre * kMicrometresPerMetre)};
 }
 
 Workspace workspace(const std::vector<Segment>& segments, int target, const Baseline& baseline,
@@ -326,22 +326,8 @@ void require_segments(const std::vector<Segment>& segments, int target) {
 
 }  // namespace
 
-std::string effect_kind_name(EffectKind kind) {
-  switch (kind) {
-    case EffectKind::speed_dependent_offset:
-      return "speed_dependent_offset";
-    case EffectKind::lagged_speed:
-      return "lagged_speed";
-    case EffectKind::lag:
-      return "lag";
-    case EffectKind::ambient_temperature:
-      return "ambient_temperature";
-    case EffectKind::missing_sensor:
-      return "missing_sensor";
-    case EffectKind::drift_in_time:
-      return "drift_in_time";
-  }
-  return "unknown";
+std::string term_kind_name(TermKind kind) {
+  return std::string(core::name_in(kTermKindNames, kind));
 }
 
 Baseline baseline_of(const FittedModel& model) {
@@ -393,21 +379,21 @@ std::vector<std::string> term_regressor_names(const Baseline& baseline,
     const std::string lp =
         "lp" + std::to_string(static_cast<long>(std::lround(term.time_constant))) + "s(";
     switch (term.kind) {
-      case EffectKind::speed_dependent_offset:
+      case TermKind::speed_dependent_offset:
         names.push_back("speed_krpm");
         names.push_back("speed_krpm^2");
         break;
-      case EffectKind::lagged_speed:
+      case TermKind::lagged_speed:
         names.push_back(lp + "speed_krpm)");
         break;
-      case EffectKind::lag:
+      case TermKind::lag:
         for (int c : baseline_sensors(baseline)) names.push_back(lp + dt(c) + ")");
         break;
-      case EffectKind::ambient_temperature:
-      case EffectKind::missing_sensor:
+      case TermKind::ambient_temperature:
+      case TermKind::missing_sensor:
         names.push_back(dt(term.sensor));
         break;
-      case EffectKind::drift_in_time:
+      case TermKind::drift_in_time:
         names.push_back("time_since_start_h");
         break;
     }
@@ -445,7 +431,7 @@ TermModel fitted_term_model(const std::vector<Segment>& segments, int target,
     total.xx += next.xx;
     total.xy += next.xy;
   }
-  const Eigen::VectorXd beta = solved(total.xx, total.xy, w.form) / kMicrometres;
+  const Eigen::VectorXd beta = solved(total.xx, total.xy, w.form) / kMicrometresPerMetre;
   const Eigen::Index first = w.form.intercept ? 1 : 0;
   model.fit.intercept = w.form.intercept ? beta(0) : 0.0;
   model.fit.coefficients = beta.tail(beta.size() - first);
@@ -462,7 +448,8 @@ double heldout_rss(const std::vector<Segment>& segments, int target, const Basel
   std::vector<Gram> grams;
   for (std::size_t g = 0; g < segments.size(); ++g)
     grams.push_back(gram_of(w.current[g], w.y[g], w.form));
-  return heldout_rss_per_segment(grams, w.form).sum() / (kMicrometres * kMicrometres);
+  return heldout_rss_per_segment(grams, w.form).sum() /
+         (kMicrometresPerMetre * kMicrometresPerMetre);
 }
 
 ChannelStudy residual_study(const std::vector<Segment>& training, int target,
@@ -494,17 +481,17 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   // 2. Greedy: add the term that removes the largest share of the held-out residual, if chance
   //    (phase-randomised surrogates of the same term, searched over the same settings) does not do
   //    as well.
-  const std::vector<EffectKind> kinds{
-      EffectKind::speed_dependent_offset, EffectKind::lagged_speed,   EffectKind::lag,
-      EffectKind::ambient_temperature,    EffectKind::missing_sensor, EffectKind::drift_in_time};
+  const std::vector<TermKind> kinds{
+      TermKind::speed_dependent_offset, TermKind::lagged_speed,   TermKind::lag,
+      TermKind::ambient_temperature,    TermKind::missing_sensor, TermKind::drift_in_time};
   std::vector<EffectTerm> terms;
-  std::vector<EffectKind> used;
+  std::vector<TermKind> used;
   std::uint64_t stream = 0;
   for (int step = 0; step < options.max_effects && rss > 0.0; ++step) {
     const Workspace w = workspace(training, target, baseline, terms);
     std::vector<Effect> tested;
     std::vector<std::vector<EffectTerm>> grids;
-    for (EffectKind kind : kinds) {
+    for (TermKind kind : kinds) {
       if (std::find(used.begin(), used.end(), kind) != used.end()) continue;
       const auto grid = term_grid(kind, sensors, sensor_count, options, has_speed);
       if (grid.empty()) continue;
@@ -548,8 +535,10 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
           nested_gains(grids[order[rank]], sensors, training, w, before_rss);
       e.gain_t = gain_t(gains);
       e.segments_improved = static_cast<int>((gains.array() > 0.0).count());
-      e.heldout_rms_before = std::sqrt(before_rss.sum() / static_cast<double>(rows)) / kMicrometres;
-      e.heldout_rms_after = std::sqrt(with_rss.sum() / static_cast<double>(rows)) / kMicrometres;
+      e.heldout_rms_before =
+          std::sqrt(before_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
+      e.heldout_rms_after =
+          std::sqrt(with_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
       if (margin > e.null_fraction && e.gain_t > options.min_gain_t) {
         e.claimed = true;
         claimed = static_cast<int>(order[rank]);

@@ -24,7 +24,9 @@
 
 namespace tt::fitting {
 
-enum class EffectKind {
+/// A candidate term of the residual study (not calibration::EffectKind, the model-based
+/// calibration's effects on the machine).
+enum class TermKind {
   /// a drift that follows the current speed: n and n² (centrifugal growth, probe runout)
   speed_dependent_offset,
   /// heat input through a first-order lag: low_pass(n, τ)
@@ -40,22 +42,22 @@ enum class EffectKind {
 };
 
 /// The terms' names in calibration.json and reports.
-inline constexpr std::array<core::Named<EffectKind>, 6> kEffectKindNames{{
-    {EffectKind::speed_dependent_offset, "speed_dependent_offset"},
-    {EffectKind::lagged_speed, "lagged_speed"},
-    {EffectKind::lag, "lag"},
-    {EffectKind::ambient_temperature, "ambient_temperature"},
-    {EffectKind::missing_sensor, "missing_sensor"},
-    {EffectKind::drift_in_time, "drift_in_time"},
+inline constexpr std::array<core::Named<TermKind>, 6> kTermKindNames{{
+    {TermKind::speed_dependent_offset, "speed_dependent_offset"},
+    {TermKind::lagged_speed, "lagged_speed"},
+    {TermKind::lag, "lag"},
+    {TermKind::ambient_temperature, "ambient_temperature"},
+    {TermKind::missing_sensor, "missing_sensor"},
+    {TermKind::drift_in_time, "drift_in_time"},
 }};
-static_assert(core::one_to_one(kEffectKindNames));
+static_assert(core::one_to_one(kTermKindNames));
 
-/// The term's name in kEffectKindNames.
-std::string effect_kind_name(EffectKind kind);
+/// The term's name in kTermKindNames.
+std::string term_kind_name(TermKind kind);
 
 /// One candidate term with its setting.
 struct EffectTerm {
-  EffectKind kind = EffectKind::drift_in_time;
+  TermKind kind = TermKind::drift_in_time;
   /// low-pass time constant of lagged_speed and lag [s]
   double time_constant = 0.0;
   /// temperature column of missing_sensor and ambient_temperature

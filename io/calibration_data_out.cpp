@@ -20,7 +20,7 @@ json effect_json(const fitting::Effect& e, const studies::ChannelCalibration& ch
                  const std::vector<std::string>& sensor_names) {
   const fitting::TermModel& with = ch.study.after;
   json parameters = json::object();
-  if (e.term.kind == fitting::EffectKind::lag || e.term.kind == fitting::EffectKind::lagged_speed)
+  if (e.term.kind == fitting::TermKind::lag || e.term.kind == fitting::TermKind::lagged_speed)
     parameters["time_constant_s"] = e.term.time_constant;
   if (e.term.sensor >= 0)
     parameters["sensor"] = sensor_names[static_cast<std::size_t>(e.term.sensor)];
@@ -40,7 +40,7 @@ json effect_json(const fitting::Effect& e, const studies::ChannelCalibration& ch
   json location{{"channel", ch.name}};
   if (e.term.sensor >= 0)
     location["sensor"] = sensor_names[static_cast<std::size_t>(e.term.sensor)];
-  return {{"kind", fitting::effect_kind_name(e.term.kind)},
+  return {{"kind", fitting::term_kind_name(e.term.kind)},
           {"parameters", parameters},
           {"location", location},
           {"explained_fraction", e.explained_fraction},

@@ -175,7 +175,7 @@ TEST(Segments, SegmentsAreReZeroedAndDropIncompleteRows) {
 TEST(ResidualStudy, FindsAMissingSpeedOffsetAndLowersTheHeldOutError) {
   const Outcome o = studied(Missing::speed_offset, "speed_offset");
   ASSERT_FALSE(o.study.effects.empty());
-  EXPECT_EQ(o.study.effects.front().term.kind, fitting::EffectKind::speed_dependent_offset);
+  EXPECT_EQ(o.study.effects.front().term.kind, fitting::TermKind::speed_dependent_offset);
   EXPECT_GT(o.study.effects.front().explained_fraction, 0.5);
   EXPECT_GT(o.study.effects.front().step_fraction, o.study.effects.front().null_fraction);
   EXPECT_LT(o.study.heldout_rss_after, 0.5 * o.study.heldout_rss_before);
@@ -191,7 +191,7 @@ TEST(ResidualStudy, FindsAMissingLagOfTheHeatInput) {
   const Outcome o = studied(Missing::lagged_speed, "lagged_speed");
   ASSERT_FALSE(o.study.effects.empty());
   const auto& first = o.study.effects.front();
-  EXPECT_EQ(first.term.kind, fitting::EffectKind::lagged_speed);
+  EXPECT_EQ(first.term.kind, fitting::TermKind::lagged_speed);
   EXPECT_GE(first.term.time_constant, 1800.0);
   EXPECT_LE(first.term.time_constant, 7200.0);
   EXPECT_LT(o.after_um, 0.5 * o.before_um) << o.before_um << " -> " << o.after_um;
@@ -200,7 +200,7 @@ TEST(ResidualStudy, FindsAMissingLagOfTheHeatInput) {
 TEST(ResidualStudy, ClaimsNothingWhenTheModelLacksNothing) {
   const Outcome o = studied(Missing::nothing, "clean");
   EXPECT_TRUE(o.study.effects.empty())
-      << fitting::effect_kind_name(o.study.effects.front().term.kind);
+      << fitting::term_kind_name(o.study.effects.front().term.kind);
   EXPECT_EQ(o.study.steps.size(), 1u);
   EXPECT_DOUBLE_EQ(o.after_um, o.before_um);
   EXPECT_LT(o.before_um, 0.4);
@@ -254,7 +254,7 @@ TEST(ResidualStudy, TheGainOfTheBestOfManyUnrelatedSensorsIsNested) {
         segments, 0, fitting::least_squares_baseline({0}, segments.front().group.sensor_names),
         options);
     for (const auto& e : study.effects)
-      if (e.term.kind == fitting::EffectKind::missing_sensor) ++claims;
+      if (e.term.kind == fitting::TermKind::missing_sensor) ++claims;
   }
   EXPECT_LE(claims, 8) << claims << " of 40 draws";
 }
@@ -364,7 +364,7 @@ TEST(ResidualStudy, AStudyFromNoCompensationFitsItsTermsWithoutAnIntercept) {
   const auto study = fitting::residual_study(segments, 0, baseline, {});
   EXPECT_EQ(fitting::term_prediction(study.before, segments[0]).cwiseAbs().maxCoeff(), 0.0);
   ASSERT_EQ(study.effects.size(), 1u);
-  EXPECT_EQ(study.effects.front().term.kind, fitting::EffectKind::drift_in_time);
+  EXPECT_EQ(study.effects.front().term.kind, fitting::TermKind::drift_in_time);
   EXPECT_EQ(study.after.fit.intercept, 0.0);
   ASSERT_EQ(study.after.fit.coefficients.size(), 1);
   EXPECT_NEAR(study.after.fit.coefficients(0) * 1e6, 1.0, 0.1);  // µm per hour
@@ -387,7 +387,7 @@ TEST(ResidualStudy, ClaimsADriftInTimeOnTopOfTheChosenModel) {
   const auto study = fitting::residual_study(training, 0, fitting::baseline_of(choice.model),
                                              fitting::ResidualStudyOptions{});
   ASSERT_FALSE(study.effects.empty()) << fitting::model_label(choice.model.spec);
-  EXPECT_EQ(study.effects.front().term.kind, fitting::EffectKind::drift_in_time);
+  EXPECT_EQ(study.effects.front().term.kind, fitting::TermKind::drift_in_time);
   EXPECT_GT(study.effects.front().gain_t, 2.0);
   const double before = rms_um(study.before, testing), after = rms_um(study.after, testing);
   EXPECT_LT(after, 0.7 * before) << before << " -> " << after;
