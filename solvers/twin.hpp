@@ -83,6 +83,9 @@ ErrorIndicator twin_indicator(const FullThermalSystem& full, const ReducedModel&
 Eigen::MatrixXd full_outputs_history(const FullThermalSystem& full, const TwinOutputs& outputs,
                                      const core::CaseSpec& spec, const Progress& progress = {});
 
+/// The largest point-temperature difference a reduced run may show against the full one [K].
+inline constexpr double kTwinTemperatureLimitK = 0.01;
+
 /// A reduced run against the full one on the same duty cycle.
 struct TwinComparison {
   std::string run, shape;
@@ -92,7 +95,7 @@ struct TwinComparison {
   /// t = 0): largest difference, the full run's peak |value| and the limit max(1 % peak, 0.02 um).
   std::vector<std::string> drift_names;
   Eigen::VectorXd drift_error_m, drift_peak_m, drift_limit_m;
-  bool passes(double temperature_limit_k = 0.01) const;
+  bool passes(double temperature_limit_k = kTwinTemperatureLimitK) const;
 };
 
 /// Compares output histories of the same run (#times x #names each, as output_history gives).
