@@ -15,17 +15,13 @@
 //    lacks refuses the stream, naming it.
 // 3. Sample by sample: parse, step the model, write one line; output is buffered and flushed when
 //    the input pauses, per line with --flush or on a terminal.
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <csignal>
-#include <cstring>
 #include <functional>
 #include <limits>
 #include <memory>
-#include <optional>
 
 #include "app/commands.hpp"
 #include "app/observer_options.hpp"
@@ -38,6 +34,7 @@
 #include "io/sample_stream.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/observer_live.hpp"
+#include "studies/observe_run.hpp"
 
 namespace tt::app {
 namespace {
@@ -59,44 +56,17 @@ void stop_on_signals() {
   }
 }
 
-/// Buffered writes to a file descriptor; flush() writes everything held.
-class Output {
- public:
-  Output(int fd, std::string name) : fd_(fd), name_(std::move(name)) { text.reserve(1 << 17); }
-  std::string text;
-  void flush() {
-    std::size_t done = 0;
-    while (done < text.size()) {
-      const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) throw core::IoError(name_ + ": cannot write: " + std::strerror(errno));
-      done += static_cast<std::size_t>(n);
-    }
-    text.clear();
-  }
-
- private:
-  int fd_;
-  std::string name_;
-};
-
-/// A file descriptor closed when it goes out of scope.
-struct Fd {
-  int fd = -1;
-  ~Fd() {
-    if (fd > 2) ::close(fd);
-  }
-};
-
 /// A model bound to a stream's columns: its targets, and its answer to each sample.
 struct BoundModel {
   std::vector<std::string> targets;
   std::function<const core::LiveStep&(double, const Eigen::VectorXd&)> next;
 };
 
-/// fit.json's chosen models, bound to the stream's columns when its header arrives.
-std::function<BoundModel(const std::vector<std::string>&)> fitted_model(
-    const std::filesystem::path& path) {
+/// A model that binds itself to the stream's columns when its header arrives.
+using Binder = std::function<BoundModel(const std::vector<std::string>&)>;
+
+/// fit.json's chosen models.
+Binder fitted_model(const std::filesystem::path& path) {
   const std::vector<io::DeployedModel> deployed = io::read_deployed_models(path);
   std::vector<fitting::FittedModel> models;
   std::vector<std::string> targets;
@@ -108,19 +78,17 @@ std::function<BoundModel(const std::vector<std::string>&)> fitted_model(
   }
   return [models, targets, sigma](const std::vector<std::string>& columns) {
     auto compensator = std::make_shared<fitting::Compensator>(models, columns, sigma);
-    return BoundModel{
-        targets,
-        [compensator](double t,
-                      const Eigen::VectorXd& v) -> const auto& {return compensator->next(t, v);
-  }
-};
-};
+    const auto next = [compensator](double t, const Eigen::VectorXd& v) -> const core::LiveStep& {
+      return compensator->next(t, v);
+    };
+    return BoundModel{targets, next};
+  };
 }
 
-/// The reduced model and its case, checked against each other; the observer bound to the stream's
-/// columns (its sensors: --sensors, or every column the model names) when its header arrives.
-std::function<BoundModel(const std::vector<std::string>&)> observed_model(
-    const CompensateArgs& args) {
+/// The reduced model and the case it was built from (--case, or the one it records), checked
+/// against each other.
+std::shared_ptr<const io::ReducedModelFile> reduced_model(const CompensateArgs& args,
+                                                          std::shared_ptr<core::CaseSpec>& spec) {
   auto rom = std::make_shared<io::ReducedModelFile>(io::read_reduced_model(args.rom));
   const std::filesystem::path case_file =
       args.case_file.empty() ? std::filesystem::path(rom->case_file) : args.case_file;
@@ -128,95 +96,70 @@ std::function<BoundModel(const std::vector<std::string>&)> observed_model(
     throw core::DataError((args.rom / "reduced_model.json").string() +
                           ": the case it was built from, " + case_file.string() +
                           ", is not there; give it with --case");
-  auto spec = std::make_shared<core::CaseSpec>(io::read_case(case_file));
+  spec = std::make_shared<core::CaseSpec>(io::read_case(case_file));
   io::check_reduced_model_fits(*rom, io::reduced_model_key(*spec, mesh::mesh_case(*spec)),
                                args.rom);
   if (args.initial_temperature_c) spec->thermal.initial_temperature_c = *args.initial_temperature_c;
+  return rom;
+}
+
+/// The physics observer on the reduced model, on its sensors: --sensors, or every column the
+/// model names.
+Binder observed_model(const CompensateArgs& args) {
+  std::shared_ptr<core::CaseSpec> spec;
+  const auto rom = reduced_model(args, spec);
   const ObserverOptions options = args.observer;
   return [rom, spec, options](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;
-    if (sensors.empty()) {
-      const auto& names = rom->twin.outputs.names;
-      const auto first = names.begin(), last = first + rom->twin.outputs.temperatures;
-      for (const auto& c : columns)
-        if (std::find(first, last, c) != last) sensors.push_back(c);
-      if (sensors.empty())
-        throw core::DataError(
-            "no column is a named point of the reduced model; name the "
-            "sensors with --sensors");
-    }
+    if (sensors.empty()) sensors = studies::named_by_twin(rom->twin.outputs, columns);
+    if (sensors.empty())
+      throw core::DataError(
+          "no column is a named point of the reduced model; name the sensors with --sensors");
     const solvers::ObserverSetup setup = observer_setup(options, rom->twin, *spec, sensors);
     auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
                                                             sensors, columns, "speed_rpm");
     // The stream's temperatures are in degC (the measured-data format), the observer's in K. The
     // observer refers to the system and the case: they live as long as it.
     auto kelvin = std::make_shared<Eigen::VectorXd>();
-    return BoundModel{setup.target_names,
-                      [ observer, rom, spec,
-                        kelvin ](double t, const Eigen::VectorXd& v) -> const auto& {*kelvin = v;
-    for (int c : observer->sensor_columns()) (*kelvin)(c) += core::kCelsiusOffset;
-    return observer->next(t, *kelvin);
-  }
-};
+    const auto next = [observer, rom, spec, kelvin](
+                          double t, const Eigen::VectorXd& v) -> const core::LiveStep& {
+      *kelvin = v;
+      for (int c : observer->sensor_columns()) (*kelvin)(c) += core::kCelsiusOffset;
+      return observer->next(t, *kelvin);
+    };
+    return BoundModel{setup.target_names, next};
+  };
 }
-;
-}
 
-}  // namespace
-
-int compensate_command(const CompensateArgs& args) {
-  // 1. The model.
-  const auto bind = args.rom.empty() ? fitted_model(args.model) : observed_model(args);
-
-  // 2. The stream and its header.
-  Fd in, out;
-  const std::string in_name = args.in.empty() ? "standard input" : args.in.string();
-  if (args.in.empty()) {
-    in.fd = 0;
-  } else {
-    in.fd = ::open(args.in.c_str(), O_RDONLY | O_CLOEXEC);
-    if (in.fd < 0) throw core::IoError(in_name + ": cannot open: " + std::strerror(errno));
-  }
-  io::FollowOptions follow;
-  follow.follow = !args.in.empty() && !args.until_eof;
-  follow.idle_s = args.idle_s;
-  follow.poll_ms = args.poll_ms;
-  stop_on_signals();
-  io::LineReader reader(in.fd, in_name, follow, &stop_requested);
+/// The stream's header read and the model bound to its columns; `columns` gets them.
+BoundModel bound_to_header(const Binder& bind, io::LineReader& reader, const std::string& in_name,
+                           std::vector<std::string>& columns) {
   std::string_view line;
   if (!reader.next(line, {}))
     throw core::DataError(in_name + ": no header line; expected time_s and the sensor ids");
-  const std::vector<std::string> columns = io::stream_columns(line, in_name);
-  BoundModel model;
+  columns = io::stream_columns(line, in_name);
   try {
-    model = bind(columns);
+    return bind(columns);
   } catch (const core::DataError& e) {
     throw core::DataError(in_name + ": header refused: " + e.what());
   }
-  if (args.out.empty()) {
-    out.fd = 1;
-  } else {
-    out.fd = ::open(args.out.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (out.fd < 0)
-      throw core::IoError(args.out.string() + ": cannot open for writing: " + std::strerror(errno));
-  }
-  Output output(out.fd, args.out.empty() ? "standard output" : args.out.string());
-  const bool per_line = args.flush || ::isatty(out.fd);
-  output.text = io::output_header(model.targets);
-  output.flush();
+}
 
-  // 3. Sample by sample.
-  const auto n = static_cast<Eigen::Index>(columns.size());
-  Eigen::VectorXd values(n);
+/// Sample by sample: parse, step the model, write one line (a torn or foreign line is skipped,
+/// the last prediction repeated). Output is flushed when the input pauses, or per line.
+void predictions(io::LineReader& reader, const BoundModel& model,
+                 const std::vector<std::string>& columns, io::BufferedWriter& output,
+                 bool per_line) {
+  Eigen::VectorXd values(static_cast<Eigen::Index>(columns.size()));
   Eigen::VectorXd last = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(model.targets.size()),
                                                    std::numeric_limits<double>::quiet_NaN());
   Eigen::VectorXd last_sigma = last;
   const auto flush_held = [&] { output.flush(); };
+  std::string_view line;
   while (reader.next(line, flush_held)) {
     if (line.empty()) continue;
     double time = 0.0;
     if (!io::parsed_sample(line, time, values)) {
-      // A torn or foreign line: skipped, the last prediction repeated.
       io::append_output_line(output.text, time, last, last_sigma, "malformed");
     } else {
       const core::LiveStep& step = model.next(time, values);
@@ -229,6 +172,29 @@ int compensate_command(const CompensateArgs& args) {
     if (per_line || output.text.size() >= (std::size_t(1) << 16)) output.flush();
   }
   output.flush();
+}
+
+}  // namespace
+
+int compensate_command(const CompensateArgs& args) {
+  // 1. The model.
+  const Binder bind = args.rom.empty() ? fitted_model(args.model) : observed_model(args);
+  // 2. The stream, its header bound to the model (the output is opened only then).
+  const io::StreamFd in = io::StreamFd::reading(args.in);
+  io::FollowOptions follow;
+  follow.follow = !args.in.empty() && !args.until_eof;
+  follow.idle_s = args.idle_s;
+  follow.poll_ms = args.poll_ms;
+  stop_on_signals();
+  io::LineReader reader(in.fd(), in.name(), follow, &stop_requested);
+  std::vector<std::string> columns;
+  const BoundModel model = bound_to_header(bind, reader, in.name(), columns);
+  const io::StreamFd out = io::StreamFd::writing(args.out);
+  io::BufferedWriter output(out.fd(), out.name());
+  output.text = io::output_header(model.targets);
+  output.flush();
+  // 3. Sample by sample.
+  predictions(reader, model, columns, output, args.flush || ::isatty(out.fd()));
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "io/sample_stream.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -54,6 +55,40 @@ LineReader::LineReader(int fd, std::string name, FollowOptions options,
       options_(options),
       stop_(stop),
       buffer_(std::size_t(1) << 20) {}
+
+StreamFd StreamFd::reading(const std::filesystem::path& path) {
+  if (path.empty()) return StreamFd(0, "standard input");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw core::IoError(path.string() + ": cannot open: " + std::strerror(errno));
+  return StreamFd(fd, path.string());
+}
+
+StreamFd StreamFd::writing(const std::filesystem::path& path) {
+  if (path.empty()) return StreamFd(1, "standard output");
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw core::IoError(path.string() + ": cannot open for writing: " + std::strerror(errno));
+  return StreamFd(fd, path.string());
+}
+
+StreamFd::~StreamFd() {
+  if (fd_ > 2) ::close(fd_);
+}
+
+BufferedWriter::BufferedWriter(int fd, std::string name) : fd_(fd), name_(std::move(name)) {
+  text.reserve(1 << 17);
+}
+
+void BufferedWriter::flush() {
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw core::IoError(name_ + ": cannot write: " + std::strerror(errno));
+    done += static_cast<std::size_t>(n);
+  }
+  text.clear();
+}
 
 bool LineReader::fill(const std::function<void()>& before_wait) {
   // Move the partial line to the front; grow when a line fills the buffer.

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <csignal>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <string_view>
@@ -15,6 +16,43 @@
 #include "core/live_step.hpp"
 
 namespace tt::io {
+
+/// A file descriptor closed when it goes out of scope (standard input and output are not).
+class StreamFd {
+ public:
+  /// `path` opened for reading; empty: standard input. Throws IoError naming it.
+  static StreamFd reading(const std::filesystem::path& path);
+  /// `path` created or truncated for writing; empty: standard output. Throws IoError naming it.
+  static StreamFd writing(const std::filesystem::path& path);
+  StreamFd(StreamFd&& other) noexcept : fd_(other.fd_), name_(std::move(other.name_)) {
+    other.fd_ = -1;
+  }
+  StreamFd(const StreamFd&) = delete;
+  StreamFd& operator=(const StreamFd&) = delete;
+  ~StreamFd();
+  int fd() const { return fd_; }
+  /// the file's name, or "standard input" / "standard output"
+  const std::string& name() const { return name_; }
+
+ private:
+  StreamFd(int fd, std::string name) : fd_(fd), name_(std::move(name)) {}
+  int fd_;
+  std::string name_;
+};
+
+/// Lines held in `text` and written to a file descriptor by flush().
+class BufferedWriter {
+ public:
+  /// fd stays owned by the caller; name is used in messages.
+  BufferedWriter(int fd, std::string name);
+  std::string text;
+  /// Writes everything held. Throws IoError naming the output when a write fails.
+  void flush();
+
+ private:
+  int fd_;
+  std::string name_;
+};
 
 /// How a LineReader treats the end of what has been written so far.
 struct FollowOptions {

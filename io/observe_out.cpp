@@ -1,0 +1,71 @@
+#include "io/observe_out.hpp"
+
+#include <iomanip>
+#include <sstream>
+
+#include "io/atomic_dir.hpp"
+#include "io/reports.hpp"
+
+namespace tt::io {
+namespace {
+
+std::string observer_csv(const solvers::ObserverRun& r,
+                         const std::vector<std::string>& target_names) {
+  std::ostringstream csv;
+  csv << std::setprecision(9) << "time_s";
+  for (const auto& t : target_names) csv << "," << t << "_predicted_um," << t << "_sigma_um";
+  csv << ",nis,readings,window_nis,window_bound,status\n";
+  for (Eigen::Index i = 0; i < r.times.size(); ++i) {
+    csv << r.times(i);
+    for (Eigen::Index k = 0; k < r.drift.cols(); ++k)
+      csv << "," << r.drift(i, k) * 1e6 << "," << r.drift_sigma(i, k) * 1e6;
+    const bool alarm = r.recalibrate && r.times(i) >= r.recalibrate_at_s;
+    csv << "," << r.nis(i) << "," << r.dof(i) << "," << r.window_nis(i) << "," << r.window_bound(i)
+        << "," << (alarm ? "recalibrate" : "ok") << "\n";
+  }
+  return csv.str();
+}
+
+/// Each unknown input's final estimate and sigma (the air offset in K, heat inputs in W).
+nlohmann::json unknown_inputs_json(const solvers::ObserverRun& r) {
+  nlohmann::json unknown = nlohmann::json::object();
+  const Eigen::Index last = r.times.size() - 1;
+  for (std::size_t k = 0; k < r.unknown_input_names.size(); ++k) {
+    const auto j = static_cast<Eigen::Index>(k);
+    const bool air = r.unknown_input_names[k] == "air";
+    unknown[r.unknown_input_names[k]] = {
+        {air ? "final_K" : "final_W", r.unknown_inputs(last, j)},
+        {air ? "sigma_K" : "sigma_W", r.unknown_inputs_sigma(last, j)}};
+  }
+  return unknown;
+}
+
+}  // namespace
+
+void write_observe(const std::filesystem::path& dir, const studies::ObserveReport& report,
+                   const ObserveSource& source) {
+  const solvers::ObserverRun& r = report.result;
+  const solvers::ObserverSetup& setup = report.setup;
+  write_file_atomically(dir / "observer.csv", observer_csv(r, setup.target_names));
+  nlohmann::json doc = {
+      {"run", source.run},
+      {"case", source.case_name},
+      {"model", {{"kind", "reduced"}, {"order", source.order}, {"rom", source.rom.string()}}},
+      {"sensors", report.sensors},
+      {"noise", source.noise},
+      {"consistency",
+       {{"window_s", setup.consistency.window_s},
+        {"sustain_s", setup.consistency.sustain_s},
+        {"probability", setup.consistency.probability}}},
+      {"status", r.recalibrate ? "recalibrate" : "ok"},
+      {"unknown_inputs", unknown_inputs_json(r)},
+      {"recalibrate_since_s", nullptr},
+      {"recalibrate_raised_s", nullptr}};
+  if (r.recalibrate) {
+    doc["recalibrate_since_s"] = r.recalibrate_since_s;
+    doc["recalibrate_raised_s"] = r.recalibrate_at_s;
+  }
+  write_json(dir / "observer.json", doc);
+}
+
+}  // namespace tt::io
