@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "fitting/compensation.hpp"
 
 namespace tt::fitting {
@@ -248,6 +249,20 @@ Eigen::MatrixXd basis_states(const CncModel& model, const std::vector<std::strin
     states.block(t, 1, 1, nf) = step.predicted.transpose();
   }
   return states;
+}
+
+ControllerLaw controller_law(CncFormat format, const CncModel& model, int table_points) {
+  switch (format) {
+    case CncFormat::sinumerik:
+      return line_law(model);
+    case CncFormat::twincat:
+      return table_law(model, table_points, 0.0, false);
+    case CncFormat::heidenhain:
+      return table_law(model, table_points, 1e-7, false);
+    case CncFormat::linuxcnc:
+      return polynomial_law(model, kLinuxcncScaleMm / core::kMillimetresPerMetre, true);
+  }
+  throw core::DataError("unknown controller format");
 }
 
 }  // namespace tt::fitting

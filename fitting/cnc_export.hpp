@@ -15,6 +15,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "fitting/features.hpp"
 #include "fitting/models.hpp"
 
@@ -123,5 +124,27 @@ Eigen::MatrixXd unit_states(const CncModel& model);
 /// #columns. Throws DataError naming a sensor or input the basis reads that `columns` lacks.
 Eigen::MatrixXd basis_states(const CncModel& model, const std::vector<std::string>& columns,
                              const Eigen::VectorXd& times, const Eigen::MatrixXd& values);
+
+/// The four controllers.
+enum class CncFormat { sinumerik, twincat, heidenhain, linuxcnc };
+
+/// The formats' names on the command line and in export.json.
+inline constexpr std::array<core::Named<CncFormat>, 4> kCncFormatNames{{
+    {CncFormat::sinumerik, "sinumerik"},
+    {CncFormat::twincat, "twincat"},
+    {CncFormat::heidenhain, "heidenhain"},
+    {CncFormat::linuxcnc, "linuxcnc"},
+}};
+static_assert(core::one_to_one(kCncFormatNames));
+
+/// axis.L.eoffset-scale of LinuxCNC's HAL file: the external offset's count [mm].
+inline constexpr double kLinuxcncScaleMm = 1e-5;
+
+/// How each controller's law is built from the model (one place: the files and the error figures
+/// use the same law).
+/// sinumerik: line_law; twincat: table_law at `table_points`, no rounding (LREAL);
+/// heidenhain: table_law at `table_points`, rounded to 0.1 µm (PLC module 9231's unit);
+/// linuxcnc: polynomial_law, truncated to the eoffset count (kLinuxcncScaleMm).
+ControllerLaw controller_law(CncFormat format, const CncModel& model, int table_points);
 
 }  // namespace tt::fitting

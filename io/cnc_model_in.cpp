@@ -1,11 +1,13 @@
 #include "io/cnc_model_in.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <optional>
 
 #include "core/errors.hpp"
 #include "io/fit_json_keys.hpp"
 #include "io/fit_model_in.hpp"
+#include "io/sample_stream.hpp"
 #include "solvers/axis_error.hpp"
 
 namespace tt::io {
@@ -82,6 +84,52 @@ AxisSection axis_section(const json& axis, const std::string& origin,
   return a;
 }
 
+/// A CSV of sensor samples: its columns after time_s, times [s] and values (#samples x #columns).
+struct SampleCsv {
+  std::vector<std::string> columns;
+  Eigen::VectorXd times;
+  Eigen::MatrixXd values;
+};
+
+/// The header's columns after time_s, a "_degC" suffix dropped.
+std::vector<std::string> sample_columns(std::istream& in, const std::filesystem::path& path) {
+  std::string line;
+  if (!std::getline(in, line))
+    throw core::DataError(path.string() + ": empty; expected a header time_s,<sensor ids>");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::vector<std::string> columns = stream_columns(line, path.string());
+  for (std::string& c : columns)
+    if (c.size() > 5 && c.compare(c.size() - 5, 5, "_degC") == 0) c.resize(c.size() - 5);
+  return columns;
+}
+
+SampleCsv read_sample_csv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw core::IoError(path.string() + ": cannot read (expected a CSV of sensor samples)");
+  SampleCsv csv{sample_columns(in, path), {}, {}};
+  std::vector<double> times;
+  std::vector<Eigen::VectorXd> rows;
+  Eigen::VectorXd values(static_cast<Eigen::Index>(csv.columns.size()));
+  std::string line;
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    double time = 0.0;
+    if (!parsed_sample(line, time, values))
+      throw core::DataError(path.string() + ": line " + std::to_string(number) + " has not " +
+                            std::to_string(csv.columns.size() + 1) + " fields");
+    times.push_back(time);
+    rows.push_back(values);
+  }
+  if (rows.empty()) throw core::DataError(path.string() + ": no sample after the header");
+  csv.times =
+      Eigen::Map<const Eigen::VectorXd>(times.data(), static_cast<Eigen::Index>(times.size()));
+  csv.values.resize(static_cast<Eigen::Index>(rows.size()), values.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    csv.values.row(static_cast<Eigen::Index>(i)) = rows[i];
+  return csv;
+}
+
 }  // namespace
 
 CncModelFile cnc_model(const json& fit, const std::string& origin) {
@@ -137,6 +185,24 @@ CncModelFile cnc_model(const json& fit, const std::string& origin) {
 
 CncModelFile read_cnc_model(const std::filesystem::path& path) {
   return cnc_model(read_fit_json(path), path.string());
+}
+
+StateSamples read_state_samples(const fitting::CncModel& model,
+                                const std::vector<std::filesystem::path>& paths) {
+  StateSamples samples{Eigen::MatrixXd(0, fitting::unit_states(model).cols()), {}};
+  for (const std::filesystem::path& path : paths) {
+    const SampleCsv csv = read_sample_csv(path);
+    Eigen::MatrixXd s;
+    try {
+      s = fitting::basis_states(model, csv.columns, csv.times, csv.values);
+    } catch (const core::DataError& e) {
+      throw core::DataError(path.string() + ": " + e.what());
+    }
+    samples.states.conservativeResize(samples.states.rows() + s.rows(), Eigen::NoChange);
+    samples.states.bottomRows(s.rows()) = s;
+    samples.per_file.push_back(s.rows());
+  }
+  return samples;
 }
 
 }  // namespace tt::io

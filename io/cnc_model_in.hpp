@@ -4,6 +4,7 @@
 // polynomial `fit` reports, solvers::axis_polynomial of their coefficients).
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -29,5 +30,17 @@ CncModelFile cnc_model(const nlohmann::json& fit, const std::string& origin);
 
 /// cnc_model of the file at `path` (IoError when it cannot be read, DataError when not JSON).
 CncModelFile read_cnc_model(const std::filesystem::path& path);
+
+/// Sensor samples of CSV files (time_s, sensor ids; a "_degC" suffix is dropped) as the model's
+/// basis states, each file from its own first sample (fitting::basis_states).
+struct StateSamples {
+  Eigen::MatrixXd states;              /// #samples x #basis, the files' samples in their order
+  std::vector<Eigen::Index> per_file;  /// #files: how many samples each gave
+};
+
+/// Throws IoError when a file cannot be read, DataError naming the file (and line) when it is
+/// empty, has no sample, a line of the wrong width or lacks a column the basis reads.
+StateSamples read_state_samples(const fitting::CncModel& model,
+                                const std::vector<std::filesystem::path>& paths);
 
 }  // namespace tt::io

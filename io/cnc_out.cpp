@@ -7,13 +7,17 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/units.hpp"
 
 namespace tt::io {
+
+using core::kMillimetresPerMetre;
+using fitting::CncFormat;
+using fitting::kCncFormatNames;
 
 namespace {
 
 constexpr const char* kAxisLetters[3] = {"X", "Y", "Z"};
-constexpr double kMm = 1e3;  // m to mm
 
 std::string num(double v) {
   char buf[40];
@@ -63,8 +67,8 @@ std::string header_lines(const std::string& comment, const std::string& title,
     << comment << " The compensation value is minus the model's predicted thermal error [mm].\n";
   if (!m.feed_axis.empty())
     o << comment << " Position: the " << m.feed_axis << " axis (" << kAxisLetters[m.feed_direction]
-      << " direction), travel " << num(m.travel_min * kMm) << " .. " << num(m.travel_max * kMm)
-      << " mm.\n";
+      << " direction), travel " << num(m.travel_min * kMillimetresPerMetre) << " .. "
+      << num(m.travel_max * kMillimetresPerMetre) << " mm.\n";
   return o.str();
 }
 
@@ -121,7 +125,7 @@ std::vector<CncFile> sinumerik_files(const fitting::CncModel& m, const fitting::
   }
   o << "; Axis names X1, Y1, Z1: replace them with the machine axes of the X, Y and Z "
        "directions.\n\n";
-  const double ref_mm = law.reference * kMm;
+  const double ref_mm = law.reference * kMillimetresPerMetre;
   for (int d : dirs)
     if (law.slope[static_cast<std::size_t>(d)].cwiseAbs().maxCoeff() > 0.0)
       o << "$SA_TEMP_COMP_REF_POSITION[" << kAxisLetters[d] << "1]=" << num(ref_mm) << "\n";
@@ -130,7 +134,7 @@ std::vector<CncFile> sinumerik_files(const fitting::CncModel& m, const fitting::
   for (int d : dirs) {
     const auto di = static_cast<std::size_t>(d);
     o << "IDS=" << id++ << " WHENEVER TRUE DO $SA_TEMP_COMP_ABS_VALUE[" << kAxisLetters[d]
-      << "1]=" << sinumerik_expression(law.value[di], terms, kMm) << "\n";
+      << "1]=" << sinumerik_expression(law.value[di], terms, kMillimetresPerMetre) << "\n";
     if (law.slope[di].cwiseAbs().maxCoeff() > 0.0)
       o << "IDS=" << id++ << " WHENEVER TRUE DO $SA_TEMP_COMP_SLOPE[" << kAxisLetters[d]
         << "1]=" << sinumerik_expression(law.slope[di], terms, 1.0) << "\n";
@@ -151,10 +155,10 @@ std::string table_csv(const fitting::CncModel& m, const fitting::TableLaw& t) {
     for (const auto& b : m.basis) o << "," << kAxisLetters[d] << "_mm_per[" << b << "]";
   o << "\n";
   for (Eigen::Index i = 0; i < t.positions.size(); ++i) {
-    o << num(t.positions(i) * kMm);
+    o << num(t.positions(i) * kMillimetresPerMetre);
     for (int d : dirs)
       for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(m.basis.size()); ++j)
-        o << "," << num(t.values[static_cast<std::size_t>(d)](i, j) * kMm);
+        o << "," << num(t.values[static_cast<std::size_t>(d)](i, j) * kMillimetresPerMetre);
     o << "\n";
   }
   return o.str();
@@ -191,8 +195,10 @@ std::vector<CncFile> twincat_files(const fitting::CncModel& m, const fitting::Ta
        "and "
        "write the value\n// with the axis's position correction (FB_WritePositionCorrection).\n*)\n"
     << "VAR_GLOBAL CONSTANT\n"
-    << "  TT_MIN_POSITION : LREAL := " << num(t.positions(0) * kMm) << ";  (* mm *)\n"
-    << "  TT_MAX_POSITION : LREAL := " << num(t.positions(n - 1) * kMm) << ";  (* mm *)\n"
+    << "  TT_MIN_POSITION : LREAL := " << num(t.positions(0) * kMillimetresPerMetre)
+    << ";  (* mm *)\n"
+    << "  TT_MAX_POSITION : LREAL := " << num(t.positions(n - 1) * kMillimetresPerMetre)
+    << ";  (* mm *)\n"
     << "  TT_NO_OF_TABLE_ELEMENTS : UDINT := " << n << ";\n"
     << "  TT_NO_OF_BASIS : UDINT := " << nb << ";\n"
     << "END_VAR\n"
@@ -205,7 +211,7 @@ std::vector<CncFile> twincat_files(const fitting::CncModel& m, const fitting::Ta
     for (Eigen::Index j = 0; j < nb; ++j) {
       o << "    ";
       for (Eigen::Index i = 0; i < n; ++i)
-        o << num(t.values[static_cast<std::size_t>(d)](i, j) * kMm)
+        o << num(t.values[static_cast<std::size_t>(d)](i, j) * kMillimetresPerMetre)
           << (j == nb - 1 && i == n - 1 ? "" : ", ");
       o << "\n";
     }
@@ -241,8 +247,9 @@ std::vector<CncFile> heidenhain_files(const fitting::CncModel& m, const fitting:
     for (int d : dirs) o << " " << kAxisLetters[d];
     o << "\n";
     for (Eigen::Index i = 0; i < t.positions.size(); ++i) {
-      o << i << " " << num(t.positions(i) * kMm);
-      for (int d : dirs) o << " " << num(t.values[static_cast<std::size_t>(d)](i, j) * kMm);
+      o << i << " " << num(t.positions(i) * kMillimetresPerMetre);
+      for (int d : dirs)
+        o << " " << num(t.values[static_cast<std::size_t>(d)](i, j) * kMillimetresPerMetre);
       o << "\n";
     }
     o << "[END]\n";
@@ -345,7 +352,8 @@ std::vector<std::string> basis_pins(const std::vector<BasisTerm>& terms, HalComp
 std::string coefficient_chain(const std::string& ax, Eigen::Index k, const Eigen::MatrixXd& c,
                               const std::vector<std::string>& pin, HalComponents& comps,
                               HalNets& nets) {
-  const double to_mm = kMm / std::pow(kMm, static_cast<double>(k));  // m/m^k -> mm/mm^k
+  const double to_mm = kMillimetresPerMetre /
+                       std::pow(kMillimetresPerMetre, static_cast<double>(k));  // m/m^k -> mm/mm^k
   std::vector<std::size_t> used;  // basis functions with a coefficient
   for (std::size_t j = 0; j < pin.size(); ++j)
     if (c(k, static_cast<Eigen::Index>(j + 1)) != 0.0) used.push_back(j);
@@ -396,10 +404,10 @@ void axis_offset(const fitting::CncModel& m, const fitting::PolynomialLaw& law, 
   const std::string sc = comps.add(comps.scale, "tt-" + ax + "-counts");
   const std::string cv = comps.add(comps.conv, "tt-" + ax + "-s32");
   nets.connect(v, sc + ".in");
-  nets.text << "setp " << sc << ".gain " << num(1.0 / kLinuxcncScaleMm) << "\n";
+  nets.text << "setp " << sc << ".gain " << num(1.0 / fitting::kLinuxcncScaleMm) << "\n";
   nets.connect(sc + ".out", cv + ".in");
   nets.connect(cv + ".out", "axis." + ax + ".eoffset-counts");
-  nets.text << "setp axis." << ax << ".eoffset-scale " << num(kLinuxcncScaleMm) << "\n"
+  nets.text << "setp axis." << ax << ".eoffset-scale " << num(fitting::kLinuxcncScaleMm) << "\n"
             << "setp axis." << ax << ".eoffset-enable 1\n";
 }
 
@@ -408,7 +416,7 @@ std::string hal_text(const fitting::CncModel& m, const std::string& source,
                      const HalComponents& comps, const HalNets& nets) {
   std::ostringstream hal;
   hal << header_lines("#", "LinuxCNC external offsets (HAL)", source, m)
-      << "# The offset is counts * eoffset-scale: truncated to " << num(kLinuxcncScaleMm)
+      << "# The offset is counts * eoffset-scale: truncated to " << num(fitting::kLinuxcncScaleMm)
       << " mm by conv_float_s32.\n";
   const auto load = [&](const char* comp, const std::vector<std::string>& names) {
     if (names.empty()) return;
@@ -454,21 +462,6 @@ std::string format_name(CncFormat format) {
 CncFormat format_of(const std::string& name) {
   if (const auto format = core::value_in(kCncFormatNames, name)) return *format;
   throw core::DataError("--format '" + name + "': expected " + core::names_list(kCncFormatNames));
-}
-
-fitting::ControllerLaw controller_law(CncFormat format, const fitting::CncModel& model,
-                                      int table_points) {
-  switch (format) {
-    case CncFormat::sinumerik:
-      return fitting::line_law(model);
-    case CncFormat::twincat:
-      return fitting::table_law(model, table_points, 0.0, false);
-    case CncFormat::heidenhain:
-      return fitting::table_law(model, table_points, 1e-7, false);
-    case CncFormat::linuxcnc:
-      return fitting::polynomial_law(model, kLinuxcncScaleMm / kMm, true);
-  }
-  throw core::DataError("unknown controller format");
 }
 
 std::vector<CncFile> cnc_files(CncFormat format, const fitting::CncModel& model,

@@ -99,7 +99,7 @@ TEST(CncLaw, TableMatchesTheModelAtItsPointsAndWithinTheInterpolationBound) {
 
 TEST(CncLaw, PolynomialIsExactToItsCount) {
   const CncModel m = cubic_model();
-  const double q = tt::io::kLinuxcncScaleMm * 1e-3;
+  const double q = tt::fitting::kLinuxcncScaleMm * 1e-3;
   const PolynomialLaw law = polynomial_law(m, q, true);
   Eigen::MatrixXd states(3, 3);
   states << 1, 0, 0, 1, 2.5, -1.0, 1, -3.0, 4.0;
@@ -230,15 +230,16 @@ void expect_consistent_hal(const std::string& hal) {
 
 TEST(CncFiles, EachFormatWritesItsParameters) {
   const CncModel m = cubic_model();
-  for (tt::io::CncFormat f : {tt::io::CncFormat::sinumerik, tt::io::CncFormat::twincat,
-                              tt::io::CncFormat::heidenhain, tt::io::CncFormat::linuxcnc}) {
-    const ControllerLaw law = tt::io::controller_law(f, m, 21);
+  for (tt::fitting::CncFormat f :
+       {tt::fitting::CncFormat::sinumerik, tt::fitting::CncFormat::twincat,
+        tt::fitting::CncFormat::heidenhain, tt::fitting::CncFormat::linuxcnc}) {
+    const ControllerLaw law = tt::fitting::controller_law(f, m, 21);
     const auto files = tt::io::cnc_files(f, m, law, "fit.json");
     ASSERT_FALSE(files.empty());
     std::string all;
     for (const auto& file : files) all += file.text;
     switch (f) {
-      case tt::io::CncFormat::sinumerik:
+      case tt::fitting::CncFormat::sinumerik:
         EXPECT_NE(all.find("MD32750 $MA_TEMP_COMP_TYPE[X1] = 3"), std::string::npos);
         EXPECT_NE(all.find("MD32750 $MA_TEMP_COMP_TYPE[Y1] = 1"), std::string::npos);
         EXPECT_NE(all.find("$SA_TEMP_COMP_SLOPE[X1]="), std::string::npos);
@@ -247,7 +248,7 @@ TEST(CncFiles, EachFormatWritesItsParameters) {
             std::string::npos)
             << all;
         break;
-      case tt::io::CncFormat::twincat: {
+      case tt::fitting::CncFormat::twincat: {
         // The CSV round trip: the table's X column for a at each position is the model's.
         std::istringstream csv(files[1].text);
         std::string line;
@@ -264,13 +265,13 @@ TEST(CncFiles, EachFormatWritesItsParameters) {
         EXPECT_NE(all.find("ST_PositionCompensationTableElement"), std::string::npos);
         break;
       }
-      case tt::io::CncFormat::heidenhain:
+      case tt::fitting::CncFormat::heidenhain:
         EXPECT_EQ(files.size(), 4u);  // a table per basis function and the PLC note
         EXPECT_EQ(files[1].name, "TT_B01.COM");
         EXPECT_NE(files[1].text.find("NR AXISPOS X Y Z"), std::string::npos);
         EXPECT_NE(all.find("CM 9231"), std::string::npos);
         break;
-      case tt::io::CncFormat::linuxcnc:
+      case tt::fitting::CncFormat::linuxcnc:
         expect_consistent_hal(files[0].text);
         EXPECT_NE(all.find("axis.x.eoffset-counts"), std::string::npos);
         EXPECT_NE(all.find("setp axis.z.eoffset-enable 1"), std::string::npos);
