@@ -1,0 +1,84 @@
+#include "io/place_out.hpp"
+
+#include <string>
+#include <vector>
+
+#include "io/placement_out.hpp"
+#include "io/plot.hpp"
+#include "io/reports.hpp"
+#include "io/vtk_out.hpp"
+
+namespace tt::io {
+namespace {
+
+nlohmann::json candidates_json(const studies::Histories& h) {
+  nlohmann::json candidates = nlohmann::json::array();
+  for (size_t c = 0; c < h.names.size(); ++c) {
+    nlohmann::json entry{{"id", c + 1},
+                         {"name", h.names[c]},
+                         {"position_m", {h.positions(c, 0), h.positions(c, 1), h.positions(c, 2)}}};
+    if (h.nodes[c] >= 0) entry["node"] = h.nodes[c];
+    candidates.push_back(std::move(entry));
+  }
+  return candidates;
+}
+
+nlohmann::json estimation_json(const studies::EstimationSettings& e,
+                               const std::filesystem::path& rom) {
+  return {{"order", e.order},
+          {"rom", rom.empty() ? std::string("built on the fly") : rom.string()},
+          {"reading_interval_s", e.reading_interval_s},
+          {"sensor_sigma_K", e.sensor_sigma_k},
+          {"heat_walk_W_per_sqrt_h", e.noise.heat_walk_w},
+          {"air_walk_K_per_sqrt_h", e.noise.air_walk_k}};
+}
+
+/// Each target's single-sensor MI and rank per candidate, for the point cloud.
+std::vector<NamedField> mi_fields(const placement::PlacementResult& result) {
+  std::vector<NamedField> fields;
+  for (const auto& t : result.targets) {
+    fields.push_back({"mi_bits_" + t.target, 1, t.mi_bits});
+    Eigen::VectorXd rank(static_cast<Eigen::Index>(t.mi_rank.size()));
+    for (size_t c = 0; c < t.mi_rank.size(); ++c) rank(static_cast<Eigen::Index>(c)) = t.mi_rank[c];
+    fields.push_back({"mi_rank_" + t.target, 1, rank});
+  }
+  return fields;
+}
+
+/// mi_bars_<target>.png of mi_ranking.csv; thousands of surface candidates make an unreadable
+/// bar chart: then the best 50.
+void plot_mi_bars(const std::filesystem::path& dir, const placement::PlacementResult& result,
+                  std::size_t candidates) {
+  const bool many = candidates > 60;
+  for (const auto& t : result.targets) {
+    std::vector<std::string> bars{"bars",
+                                  (dir / "mi_ranking.csv").string(),
+                                  (dir / ("mi_bars_" + t.target + ".png")).string(),
+                                  "--label",
+                                  "id",
+                                  "--value=mi_bits_" + t.target,
+                                  "--title=" + std::string(many ? "best 50 candidates: " : "") +
+                                      "single-sensor mutual information with " + t.target +
+                                      " (formula 1)"};
+    if (many) bars.insert(bars.end(), {"--sort", "--top", "50"});
+    plot(bars);
+  }
+}
+
+}  // namespace
+
+void write_place(const std::filesystem::path& dir, const studies::PlaceReport& report,
+                 const PlaceSource& source) {
+  const studies::Histories& h = report.histories;
+  nlohmann::json doc = placement_json(report.result);
+  doc["sensor_noise"] = source.sensor_noise;
+  doc["model"] = source.model;
+  if (report.estimation) doc["observer_variance"] = estimation_json(*report.estimation, source.rom);
+  doc["candidates"] = candidates_json(h);
+  write_json(dir / "placement.json", doc);
+  write_mi_ranking_csv(dir / "mi_ranking.csv", report.result);
+  write_point_cloud_vtp(dir / "candidates_mi.vtp", h.names, h.positions, mi_fields(report.result));
+  plot_mi_bars(dir, report.result, h.names.size());
+}
+
+}  // namespace tt::io

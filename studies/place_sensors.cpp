@@ -1,0 +1,82 @@
+#include "studies/place_sensors.hpp"
+
+#include <chrono>
+
+#include "core/timing.hpp"
+#include "fitting/noise.hpp"
+#include "studies/estimation_input.hpp"
+
+namespace tt::studies {
+namespace {
+
+/// The histories as the campaign's sensors would read them (fitting::SensorNoise defaults),
+/// reproducible from `seed`.
+Histories with_sensor_noise(Histories h, std::uint64_t seed) {
+  fitting::Group g;
+  g.name = "place";
+  g.time = h.times;
+  g.temperature = h.temperature;
+  g.error = h.targets;
+  g.sensor_names = h.names;
+  g.target_names = h.target_names;
+  constexpr std::uint64_t kPlaceStream = 0x706c616365;  // "place"
+  const fitting::Group noisy = fitting::noisy_group(g, fitting::SensorNoise{}, seed, kPlaceStream);
+  h.temperature = noisy.temperature;
+  h.targets = noisy.error;
+  return h;
+}
+
+/// The physics observer's model for placement for estimation on `twin`: the case's duty cycle
+/// read at every output time, the campaign's sensor noise and the observer's default process
+/// noise.
+placement::EstimationProblem estimation_problem(const core::CaseSpec& spec, const Histories& h,
+                                                const solvers::Twin& twin,
+                                                EstimationSettings& settings) {
+  const EstimationCandidates candidates{h.names, h.nodes, fitting::SensorNoise{}.temperature_sigma};
+  settings = {twin.model.states(), spec.thermal.output_interval, candidates.sensor_sigma_k, {}};
+  return observer_estimation_problem(twin, {spec}, candidates, h.target_names, settings.noise,
+                                     spec.thermal.output_interval);
+}
+
+placement::PlacementOptions placement_options(const PlaceInput& input) {
+  placement::PlacementOptions options;
+  options.samples = input.samples;
+  options.temperature_bins = input.bins;
+  options.error_bins = input.bins;
+  options.m_max = input.m_max;
+  options.seed = input.spec->seed;
+  options.methods = input.methods;
+  return options;
+}
+
+}  // namespace
+
+placement::PlacementInput placement_input(const Histories& h) {
+  placement::PlacementInput in;
+  for (size_t c = 0; c < h.names.size(); ++c)
+    in.ids.push_back(core::SensorId{static_cast<int>(c) + 1});
+  in.positions_m = h.positions;
+  in.times_s = h.times;
+  in.temperatures_K = h.temperature;
+  for (size_t k = 0; k < h.target_names.size(); ++k)
+    in.targets.push_back({h.target_names[k], h.targets.col(static_cast<Eigen::Index>(k))});
+  return in;
+}
+
+PlaceReport place_sensors(const PlaceInput& input) {
+  PlaceReport report;
+  report.histories =
+      input.sensor_noise ? with_sensor_noise(input.histories, input.spec->seed) : input.histories;
+  placement::PlacementInput in = placement_input(report.histories);
+  if (input.twin) {
+    report.estimation.emplace();
+    in.estimation =
+        estimation_problem(*input.spec, report.histories, *input.twin, *report.estimation);
+  }
+  const auto t = std::chrono::steady_clock::now();
+  report.result = placement::place_all(in, placement_options(input));
+  report.place_s = core::seconds_since(t);
+  return report;
+}
+
+}  // namespace tt::studies

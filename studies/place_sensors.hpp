@@ -1,0 +1,53 @@
+// Where to put temperature sensors (thermotwin place, docs/placement.md): every placement method
+// for each of the case's targets and m = 1..m_max on the candidates' histories, optionally on the
+// readings the campaign's sensors would give (their noise), and, for placement for estimation, on
+// the physics observer's covariance model of a twin. SI units.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/case_spec.hpp"
+#include "placement/place.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/twin.hpp"
+#include "studies/histories.hpp"
+
+namespace tt::studies {
+
+struct PlaceInput {
+  const core::CaseSpec* spec = nullptr;  /// its seed drives every random draw
+  Histories histories;                   /// the candidates' exact (simulated) histories
+  std::vector<placement::Method> methods;
+  int samples = 100, bins = 20, m_max = 6;
+  /// place on readings with the campaign's sensor noise (fitting::SensorNoise), reproducible from
+  /// the case's seed: exact histories of a field driven by a few sources lie in a subspace of few
+  /// dimensions, beyond whose rank no further sensor is admissible
+  bool sensor_noise = false;
+  /// the reduced model whose observer observer_variance places for (give it when that method is
+  /// asked for); nullptr: no estimation problem
+  const solvers::Twin* twin = nullptr;
+};
+
+/// The observer's settings for placement for estimation.
+struct EstimationSettings {
+  int order = 0;  /// the twin's reduced states
+  double reading_interval_s = 0;
+  double sensor_sigma_k = 0;     /// white noise of every reading [K]
+  solvers::ObserverNoise noise;  /// its default process noise
+};
+
+struct PlaceReport {
+  Histories histories;  /// as placed on: with the sensor noise when it was asked for
+  placement::PlacementResult result;
+  std::optional<EstimationSettings> estimation;  /// with observer_variance
+  double place_s = 0;                            /// wall time of the placement [s]
+};
+
+/// The histories as one placement input: candidates numbered 1.. in their order.
+placement::PlacementInput placement_input(const Histories& h);
+
+/// Throws what placement::place_all throws. observer_variance without a twin places nothing.
+PlaceReport place_sensors(const PlaceInput& input);
+
+}  // namespace tt::studies
