@@ -49,6 +49,68 @@ std::string joined(const std::vector<std::string>& names) {
   return text;
 }
 
+/// The file's text without a UTF-8 byte order mark.
+std::string file_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw core::IoError(path.string() +
+                        ": cannot open the CSV file for reading; hint: check the "
+                        "path and its permissions");
+  }
+  std::ostringstream content;
+  content << in.rdbuf();
+  std::string text = content.str();
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte order mark
+  return text;
+}
+
+/// The header's column names (quotes dropped); each must be non-empty and new.
+std::vector<std::string> header_names(const std::vector<std::string_view>& cells,
+                                      const std::string& source, int line_number) {
+  std::vector<std::string> header;
+  std::set<std::string> seen;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    std::string_view name = cells[c];
+    if (name.size() >= 2 && name.front() == '"' && name.back() == '"') {
+      name = trimmed(name.substr(1, name.size() - 2));
+    }
+    if (name.empty()) {
+      throw core::DataError(core::located(
+          source, line_number,
+          "header column " + std::to_string(c + 1) + " has no name: expected a column name"));
+    }
+    if (!seen.insert(std::string(name)).second) {
+      throw core::DataError(core::located(source, line_number,
+                                          "header column " + std::to_string(c + 1) + " '" +
+                                              std::string(name) +
+                                              "' repeats an earlier column name"));
+    }
+    header.emplace_back(name);
+  }
+  return header;
+}
+
+/// One data row's numbers appended to `values` (row-major): one per header column.
+void append_row(const std::vector<std::string_view>& cells, const CsvTable& table, int line_number,
+                std::vector<double>& values) {
+  if (cells.size() != table.header.size()) {
+    throw core::DataError(
+        core::located(table.source, line_number,
+                      "row has " + std::to_string(cells.size()) + " cells: expected " +
+                          std::to_string(table.header.size()) + " (one per header column)"));
+  }
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    double value = 0.0;
+    if (!parsed_number(cells[c], value)) {
+      throw core::DataError(core::located(
+          table.source, line_number,
+          "column " + std::to_string(c + 1) + " (" + table.header[c] + ") = '" +
+              std::string(cells[c]) + "': expected a number; hint: write missing values as nan"));
+    }
+    values.push_back(value);
+  }
+}
+
 }  // namespace
 
 int CsvTable::column_index(const std::string& name) const {
@@ -100,22 +162,11 @@ void write_csv(const fs::path& path, const std::vector<std::string>& header,
 }
 
 CsvTable read_numeric_csv(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw core::IoError(path.string() +
-                        ": cannot open the CSV file for reading; hint: check the "
-                        "path and its permissions");
-  }
-  std::ostringstream content;
-  content << in.rdbuf();
-  std::string text = content.str();
-  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte order mark
-
   CsvTable table;
   table.source = path.string();
   std::vector<double> values;  // row-major
   std::size_t row_count = 0;
-  std::istringstream lines(text);
+  std::istringstream lines(file_text(path));
   std::string line;
   int line_number = 0;
   while (std::getline(lines, line)) {
@@ -124,43 +175,10 @@ CsvTable read_numeric_csv(const fs::path& path) {
     if (content_view.empty() || content_view.starts_with('#')) continue;
     const auto cells = split_cells(content_view);
     if (table.header.empty()) {
-      std::set<std::string> seen;
-      for (std::size_t c = 0; c < cells.size(); ++c) {
-        std::string_view name = cells[c];
-        if (name.size() >= 2 && name.front() == '"' && name.back() == '"') {
-          name = trimmed(name.substr(1, name.size() - 2));
-        }
-        if (name.empty()) {
-          throw core::DataError(core::located(
-              table.source, line_number,
-              "header column " + std::to_string(c + 1) + " has no name: expected a column name"));
-        }
-        if (!seen.insert(std::string(name)).second) {
-          throw core::DataError(core::located(table.source, line_number,
-                                              "header column " + std::to_string(c + 1) + " '" +
-                                                  std::string(name) +
-                                                  "' repeats an earlier column name"));
-        }
-        table.header.emplace_back(name);
-      }
+      table.header = header_names(cells, table.source, line_number);
       continue;
     }
-    if (cells.size() != table.header.size()) {
-      throw core::DataError(
-          core::located(table.source, line_number,
-                        "row has " + std::to_string(cells.size()) + " cells: expected " +
-                            std::to_string(table.header.size()) + " (one per header column)"));
-    }
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      double value = 0.0;
-      if (!parsed_number(cells[c], value)) {
-        throw core::DataError(core::located(
-            table.source, line_number,
-            "column " + std::to_string(c + 1) + " (" + table.header[c] + ") = '" +
-                std::string(cells[c]) + "': expected a number; hint: write missing values as nan"));
-      }
-      values.push_back(value);
-    }
+    append_row(cells, table, line_number, values);
     ++row_count;
   }
   if (table.header.empty()) {

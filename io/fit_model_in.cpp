@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "fitting/features.hpp"
 #include "io/fit_json_keys.hpp"
 
@@ -20,7 +21,7 @@ using fit_keys::vector_at;
 using fitting::ModelKind;
 using nlohmann::json;
 
-constexpr double um = 1e-6;  // micrometres to metres
+constexpr double um = core::kMetresPerMicrometre;
 
 ModelKind kind_of(const std::string& name, const Place& p, const std::string& at) {
   if (const auto kind = core::value_in(fitting::kModelKindNames, name)) return *kind;
@@ -65,6 +66,75 @@ fitting::PprModel ppr_of(const json& c, const Place& p, const std::string& at) {
 }
 
 /// The model `c` (a model_json object) describes; `at` is its key path in messages.
+/// The model's settings (`kind` read): ridge strength and time constants where the kind has them.
+fitting::ModelSpec model_spec(const json& c, ModelKind kind, const Place& p,
+                              const std::string& at) {
+  fitting::ModelSpec spec;
+  spec.kind = kind;
+  const json& settings = member(c, "settings", p, at);
+  spec.use_inputs = settings.value("inputs", false);
+  if (kind == ModelKind::ridge || kind == ModelKind::distributed_lag)
+    spec.ridge_lambda = number_at(settings, "ridge_lambda", p, at + "settings.");
+  if (kind == ModelKind::distributed_lag) {
+    const Eigen::VectorXd taus = vector_at(settings, "time_constants_s", p, at + "settings.");
+    spec.time_constants.assign(taus.data(), taus.data() + taus.size());
+    for (double tau : spec.time_constants)
+      if (!(tau > 0.0))
+        throw core::DataError(p.at(at + "settings.time_constants_s") + " holds " +
+                              std::to_string(tau) + ": every time constant must be > 0");
+  }
+  return spec;
+}
+
+/// The model's regressors: its sensors and operating inputs, in the order fit.json names them.
+fitting::FeatureMap model_features(const json& c, const fitting::ModelSpec& spec, const Place& p,
+                                   const std::string& at) {
+  fitting::FeatureMap f;
+  f.sensor_names = names_at(c, "sensors", p, at);
+  f.input_names = operating_inputs(c, p, at);
+  f.time_constants = spec.time_constants;
+  for (std::size_t k = 0; k < f.sensor_names.size(); ++k) f.sensors.push_back(static_cast<int>(k));
+  for (std::size_t k = 0; k < f.input_names.size(); ++k) f.inputs.push_back(static_cast<int>(k));
+  return f;
+}
+
+/// A projection pursuit model whose inputs are `expected`.
+fitting::PprModel checked_ppr(const json& c, const std::vector<std::string>& expected,
+                              const Place& p, const std::string& at) {
+  const std::vector<std::string> inputs = names_at(c, "inputs", p, at);
+  if (inputs != expected)
+    throw core::DataError(p.at(at + "inputs") + " = " + json(inputs).dump() +
+                          "; the model's sensors and inputs give " + json(expected).dump());
+  fitting::PprModel ppr = ppr_of(c, p, at);
+  if (ppr.center.size() != static_cast<Eigen::Index>(expected.size()))
+    throw core::DataError(p.at(at + "input_center_K") + " has " +
+                          std::to_string(ppr.center.size()) + " entries; expected " +
+                          std::to_string(expected.size()));
+  return ppr;
+}
+
+/// A linear model whose terms are `expected`, in order [m, m/K].
+fitting::LinearFit checked_linear(const json& c, const std::vector<std::string>& expected,
+                                  const Place& p, const std::string& at) {
+  fitting::LinearFit fit;
+  fit.intercept = number_at(c, "intercept_um", p, at) * um;
+  const json& terms = member(c, "terms", p, at);
+  if (!terms.is_array() || terms.size() != expected.size())
+    throw core::DataError(p.at(at + "terms") + " has " + std::to_string(terms.size()) +
+                          " entries; the model's sensors, inputs and time constants give " +
+                          std::to_string(expected.size()) + ": " + json(expected).dump());
+  fit.coefficients.resize(static_cast<Eigen::Index>(terms.size()));
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    const std::string here = at + "terms[" + std::to_string(k) + "].";
+    const std::string name = terms[k].value("name", std::string());
+    if (name != expected[k])
+      throw core::DataError(p.at(here + "name") + " = '" + name + "'; expected '" + expected[k] +
+                            "' (the order feature_names gives)");
+    fit.coefficients(static_cast<Eigen::Index>(k)) = number_at(terms[k], "um_per_K", p, here) * um;
+  }
+  return fit;
+}
+
 fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::string& at) {
   const json& kind_json = member(c, "kind", p, at);
   const ModelKind kind =
@@ -77,58 +147,13 @@ fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::s
                           "projection_pursuit kinds");
   fitting::FittedModel m;
   m.target_name = p.target;
-  m.spec.kind = kind;
-  const json& settings = member(c, "settings", p, at);
-  m.spec.use_inputs = settings.value("inputs", false);
-  if (kind == ModelKind::ridge || kind == ModelKind::distributed_lag)
-    m.spec.ridge_lambda = number_at(settings, "ridge_lambda", p, at + "settings.");
-  if (kind == ModelKind::distributed_lag) {
-    const Eigen::VectorXd taus = vector_at(settings, "time_constants_s", p, at + "settings.");
-    m.spec.time_constants.assign(taus.data(), taus.data() + taus.size());
-    for (double tau : m.spec.time_constants)
-      if (!(tau > 0.0))
-        throw core::DataError(p.at(at + "settings.time_constants_s") + " holds " +
-                              std::to_string(tau) + ": every time constant must be > 0");
-  }
-  m.features.sensor_names = names_at(c, "sensors", p, at);
-  m.features.input_names = operating_inputs(c, p, at);
-  m.features.time_constants = m.spec.time_constants;
-  for (std::size_t k = 0; k < m.features.sensor_names.size(); ++k)
-    m.features.sensors.push_back(static_cast<int>(k));
-  for (std::size_t k = 0; k < m.features.input_names.size(); ++k)
-    m.features.inputs.push_back(static_cast<int>(k));
+  m.spec = model_spec(c, kind, p, at);
+  m.features = model_features(c, m.spec, p, at);
   const std::vector<std::string> expected = fitting::feature_names(m.features);
-  if (kind == ModelKind::projection_pursuit) {
-    const std::vector<std::string> inputs = names_at(c, "inputs", p, at);
-    if (inputs != expected)
-      throw core::DataError(p.at(at + "inputs") + " = " + json(inputs).dump() +
-                            "; the model's sensors and inputs give " + json(expected).dump());
-    m.body = ppr_of(c, p, at);
-    if (std::get<fitting::PprModel>(m.body).center.size() !=
-        static_cast<Eigen::Index>(expected.size()))
-      throw core::DataError(p.at(at + "input_center_K") + " has " +
-                            std::to_string(std::get<fitting::PprModel>(m.body).center.size()) +
-                            " entries; expected " + std::to_string(expected.size()));
-  } else {
-    fitting::LinearFit fit;
-    fit.intercept = number_at(c, "intercept_um", p, at) * um;
-    const json& terms = member(c, "terms", p, at);
-    if (!terms.is_array() || terms.size() != expected.size())
-      throw core::DataError(p.at(at + "terms") + " has " + std::to_string(terms.size()) +
-                            " entries; the model's sensors, inputs and time constants give " +
-                            std::to_string(expected.size()) + ": " + json(expected).dump());
-    fit.coefficients.resize(static_cast<Eigen::Index>(terms.size()));
-    for (std::size_t k = 0; k < terms.size(); ++k) {
-      const std::string here = at + "terms[" + std::to_string(k) + "].";
-      const std::string name = terms[k].value("name", std::string());
-      if (name != expected[k])
-        throw core::DataError(p.at(here + "name") + " = '" + name + "'; expected '" + expected[k] +
-                              "' (the order feature_names gives)");
-      fit.coefficients(static_cast<Eigen::Index>(k)) =
-          number_at(terms[k], "um_per_K", p, here) * um;
-    }
-    m.body = fit;
-  }
+  if (kind == ModelKind::projection_pursuit)
+    m.body = checked_ppr(c, expected, p, at);
+  else
+    m.body = checked_linear(c, expected, p, at);
   return m;
 }
 

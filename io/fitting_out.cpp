@@ -35,8 +35,8 @@ using fitting::Evaluation;
 using fitting::FittedModel;
 using nlohmann::json;
 
-constexpr double um = 1e6;  // metres to micrometres
-constexpr double mm = 1e3;  // metres to millimetres
+constexpr double um = core::kMicrometresPerMetre;
+constexpr double mm = core::kMillimetresPerMetre;
 
 json vector_json(const Eigen::VectorXd& v, double factor = 1.0) {
   json list = json::array();
@@ -177,75 +177,65 @@ std::string equation_text(const FittedModel& model) {
   return out.str();
 }
 
-}  // namespace
+/// A linear model's intercept and terms [um, um/K].
+void add_linear(json& j, const FittedModel& model, const fitting::LinearFit& linear) {
+  const std::vector<std::string> names = fitting::feature_names(model.features);
+  json terms = json::array();
+  for (std::size_t k = 0; k < names.size(); ++k)
+    terms.push_back(
+        {{"name", names[k]},
+         {"um_per_K", finite_or_null(linear.coefficients(static_cast<Eigen::Index>(k)) * um)}});
+  j["intercept_um"] = finite_or_null(linear.intercept * um);
+  j["terms"] = terms;
+}
 
-json model_json(const FittedModel& model) {
-  json j{{"kind", fitting::kind_name(model.spec.kind)},
-         {"label", fitting::model_label(model.spec)},
-         {"settings", settings_json(model.spec)},
-         {"target", model.target_name},
-         {"sensors", model.features.sensor_names},
-         {"operating_inputs", model.features.input_names},
-         {"fitted_on", model.fitted_on},
-         {"gross_error_rejection",
-          {{"samples", model.rejection.samples},
-           {"rejected", model.rejection.rejected},
-           {"passes", model.rejection.passes}}}};
-  if (const auto* linear = std::get_if<fitting::LinearFit>(&model.body)) {
+/// The network's inputs, windows, standardisation, linear skip and training, and how to call
+/// its TorchScript file.
+void add_network(json& j, const FittedModel& model, const torchnet::Network& net) {
+  const auto& o = net.options();
+  const auto& r = net.report();
+  j["inputs"] = fitting::feature_names(model.features);
+  j["output"] = model.output;  // of the network's outputs, the one this target reads
+  j["window_steps"] = o.window_steps;
+  j["window_stride_samples"] = o.window_stride;
+  j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;
+  j["input_mean_K"] = vector_json(net.input_mean());
+  j["input_scale_K"] = vector_json(net.input_scale());
+  j["output_mean_um"] = vector_json(net.output_mean(), um);
+  j["output_scale_um"] = vector_json(net.output_scale(), um);
+  if (const auto& skip = net.linear_skip()) {
+    // The fixed linear part: per output, intercept + Σ weight·input at the sample predicted.
+    json outputs = json::array();
     const std::vector<std::string> names = fitting::feature_names(model.features);
-    json terms = json::array();
-    for (std::size_t k = 0; k < names.size(); ++k)
-      terms.push_back(
-          {{"name", names[k]},
-           {"um_per_K", finite_or_null(linear->coefficients(static_cast<Eigen::Index>(k)) * um)}});
-    j["intercept_um"] = finite_or_null(linear->intercept * um);
-    j["terms"] = terms;
-    return j;
-  }
-  if (const auto* network = std::get_if<torchnet::Network>(&model.body)) {
-    const auto& o = network->options();
-    const auto& r = network->report();
-    j["inputs"] = fitting::feature_names(model.features);
-    j["output"] = model.output;  // of the network's outputs, the one this target reads
-    j["window_steps"] = o.window_steps;
-    j["window_stride_samples"] = o.window_stride;
-    j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;
-    j["input_mean_K"] = vector_json(network->input_mean());
-    j["input_scale_K"] = vector_json(network->input_scale());
-    j["output_mean_um"] = vector_json(network->output_mean(), um);
-    j["output_scale_um"] = vector_json(network->output_scale(), um);
-    if (const auto& skip = network->linear_skip()) {
-      // The fixed linear part: per output, intercept + Σ weight·input at the sample predicted.
-      json outputs = json::array();
-      const std::vector<std::string> names = fitting::feature_names(model.features);
-      for (Eigen::Index k = 0; k < skip->weights.rows(); ++k) {
-        json terms = json::array();
-        for (std::size_t c = 0; c < names.size(); ++c)
-          terms.push_back(
-              {{"name", names[c]},
-               {"um_per_K", finite_or_null(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
-        json o{{"intercept_um", finite_or_null(skip->intercept(k) * um)}, {"terms", terms}};
-        if (k < skip->ridge_lambda.size()) o["ridge_lambda"] = skip->ridge_lambda(k);
-        outputs.push_back(o);
-      }
-      j["linear_skip"] = outputs;
+    for (Eigen::Index k = 0; k < skip->weights.rows(); ++k) {
+      json terms = json::array();
+      for (std::size_t c = 0; c < names.size(); ++c)
+        terms.push_back(
+            {{"name", names[c]},
+             {"um_per_K", finite_or_null(skip->weights(k, static_cast<Eigen::Index>(c)) * um)}});
+      json o{{"intercept_um", finite_or_null(skip->intercept(k) * um)}, {"terms", terms}};
+      if (k < skip->ridge_lambda.size()) o["ridge_lambda"] = skip->ridge_lambda(k);
+      outputs.push_back(o);
     }
-    j["training"] = {{"epochs", r.epochs},
-                     {"best_epoch", r.best_epoch},
-                     {"validation_loss_standardised", finite_or_null(r.validation_loss)},
-                     {"seconds", finite_or_null(r.seconds)},
-                     {"time_budget_reached", r.budget_reached},
-                     {"training_windows", r.training_windows},
-                     {"validation_windows", r.validation_windows}};
-    j["note"] =
-        "TorchScript forward(x): x float32 batch x window_steps x inputs, the increments dT [K] "
-        "of the inputs at rows i - (window_steps-1-j)*window_stride_samples (the first row "
-        "repeated before the group's start); returns batch x 1 error [m]; standardisation inside, "
-        "and the linear skip (buffers skip_w, skip_b; zero without one) applied to the "
-        "window's last row";
-    return j;
+    j["linear_skip"] = outputs;
   }
-  const auto& ppr = std::get<fitting::PprModel>(model.body);
+  j["training"] = {{"epochs", r.epochs},
+                   {"best_epoch", r.best_epoch},
+                   {"validation_loss_standardised", finite_or_null(r.validation_loss)},
+                   {"seconds", finite_or_null(r.seconds)},
+                   {"time_budget_reached", r.budget_reached},
+                   {"training_windows", r.training_windows},
+                   {"validation_windows", r.validation_windows}};
+  j["note"] =
+      "TorchScript forward(x): x float32 batch x window_steps x inputs, the increments dT [K] "
+      "of the inputs at rows i - (window_steps-1-j)*window_stride_samples (the first row "
+      "repeated before the group's start); returns batch x 1 error [m]; standardisation inside, "
+      "and the linear skip (buffers skip_w, skip_b; zero without one) applied to the "
+      "window's last row";
+}
+
+/// The projection pursuit regression's standardisation and ridge functions.
+void add_ppr(json& j, const FittedModel& model, const fitting::PprModel& ppr) {
   j["inputs"] = fitting::feature_names(model.features);
   j["input_center_K"] = vector_json(ppr.center);
   j["input_scale_K"] = vector_json(ppr.scale);
@@ -263,6 +253,28 @@ json model_json(const FittedModel& model) {
       "inputs standardised as (dT - center)/scale; z = direction . input; t = (2z - z_low - "
       "z_high)/(z_high - z_low); f(t) = sum polynomial_um[k] t^k, continued along its tangent "
       "outside [-1, 1]; prediction = mean_um + sum f";
+}
+
+}  // namespace
+
+json model_json(const FittedModel& model) {
+  json j{{"kind", fitting::kind_name(model.spec.kind)},
+         {"label", fitting::model_label(model.spec)},
+         {"settings", settings_json(model.spec)},
+         {"target", model.target_name},
+         {"sensors", model.features.sensor_names},
+         {"operating_inputs", model.features.input_names},
+         {"fitted_on", model.fitted_on},
+         {"gross_error_rejection",
+          {{"samples", model.rejection.samples},
+           {"rejected", model.rejection.rejected},
+           {"passes", model.rejection.passes}}}};
+  if (const auto* linear = std::get_if<fitting::LinearFit>(&model.body))
+    add_linear(j, model, *linear);
+  else if (const auto* network = std::get_if<torchnet::Network>(&model.body))
+    add_network(j, model, *network);
+  else
+    add_ppr(j, model, std::get<fitting::PprModel>(model.body));
   return j;
 }
 

@@ -49,82 +49,101 @@ std::string str(long long value) {
   return std::to_string(value);
 }
 
-/// Throws MeshError when the arrays of `mesh` disagree in size or index out of range; the writers
-/// would otherwise read past an array or write a file ParaView rejects.
-void check_mesh(const mesh::TetMesh& mesh) {
-  auto fail = [](const std::string& what) {
-    throw core::MeshError("cannot write mesh: " + what +
-                          "; hint: the mesher must fill every per-tet and per-face array");
-  };
+[[noreturn]] void fail_mesh(const std::string& what) {
+  throw core::MeshError("cannot write mesh: " + what +
+                        "; hint: the mesher must fill every per-tet and per-face array");
+}
+
+/// The order, the tets' node indices and regions.
+void check_tets(const mesh::TetMesh& mesh) {
   if (mesh.order != 1 && mesh.order != 2) {
-    fail("order = " + str(mesh.order) + ": expected 1 or 2");
+    fail_mesh("order = " + str(mesh.order) + ": expected 1 or 2");
   }
   const long long node_count = mesh.nodes.rows();
   const long long tet_count = mesh.tets.rows();
   if (tet_count > 0 && mesh.tets.cols() != mesh.nodes_per_tet()) {
-    fail("tets have " + str(mesh.tets.cols()) + " columns: expected " + str(mesh.nodes_per_tet()) +
-         " for order " + str(mesh.order));
+    fail_mesh("tets have " + str(mesh.tets.cols()) + " columns: expected " +
+              str(mesh.nodes_per_tet()) + " for order " + str(mesh.order));
   }
   if (static_cast<long long>(mesh.tet_region.size()) != tet_count) {
-    fail("tet_region has " + str(mesh.tet_region.size()) + " entries: expected one per tet (" +
-         str(tet_count) + ")");
+    fail_mesh("tet_region has " + str(mesh.tet_region.size()) + " entries: expected one per tet (" +
+              str(tet_count) + ")");
   }
   for (long long t = 0; t < tet_count; ++t) {
     for (int k = 0; k < mesh.tets.cols(); ++k) {
       const int node = mesh.tets(t, k);
       if (node < 0 || node >= node_count) {
-        fail("tet " + str(t) + " node " + str(k) + " = " + str(node) + ": expected 0.." +
-             str(node_count - 1));
+        fail_mesh("tet " + str(t) + " node " + str(k) + " = " + str(node) + ": expected 0.." +
+                  str(node_count - 1));
       }
     }
     const int region = core::index_of(mesh.tet_region[t]);
     if (region < 0 ||
         (!mesh.region_names.empty() && region >= static_cast<int>(mesh.region_names.size()))) {
-      fail("tet " + str(t) + " region = " + str(region) + ": expected 0.." +
-           str(static_cast<long long>(mesh.region_names.size()) - 1));
+      fail_mesh("tet " + str(t) + " region = " + str(region) + ": expected 0.." +
+                str(static_cast<long long>(mesh.region_names.size()) - 1));
     }
   }
+}
+
+/// The per-face arrays' sizes.
+void check_face_arrays(const mesh::TetMesh& mesh) {
   const long long face_count = mesh.faces.rows();
   if (face_count > 0 && mesh.faces.cols() != mesh.nodes_per_face()) {
-    fail("faces have " + str(mesh.faces.cols()) + " columns: expected " +
-         str(mesh.nodes_per_face()) + " for order " + str(mesh.order));
+    fail_mesh("faces have " + str(mesh.faces.cols()) + " columns: expected " +
+              str(mesh.nodes_per_face()) + " for order " + str(mesh.order));
   }
   const auto face_array_size = [&](const char* name, std::size_t size) {
     if (static_cast<long long>(size) != face_count) {
-      fail(std::string(name) + " has " + str(size) + " entries: expected one per face (" +
-           str(face_count) + ")");
+      fail_mesh(std::string(name) + " has " + str(size) + " entries: expected one per face (" +
+                str(face_count) + ")");
     }
   };
   face_array_size("face_tet", mesh.face_tet.size());
   face_array_size("face_other_tet", mesh.face_other_tet.size());
   face_array_size("face_group", mesh.face_group.size());
-  for (long long f = 0; f < face_count; ++f) {
+}
+
+/// Each face's nodes, tets and group.
+void check_faces(const mesh::TetMesh& mesh) {
+  check_face_arrays(mesh);
+  const long long node_count = mesh.nodes.rows();
+  const long long tet_count = mesh.tets.rows();
+  for (long long f = 0; f < mesh.faces.rows(); ++f) {
     for (int k = 0; k < mesh.faces.cols(); ++k) {
       const int node = mesh.faces(f, k);
       if (node < 0 || node >= node_count) {
-        fail("face " + str(f) + " node " + str(k) + " = " + str(node) + ": expected 0.." +
-             str(node_count - 1));
+        fail_mesh("face " + str(f) + " node " + str(k) + " = " + str(node) + ": expected 0.." +
+                  str(node_count - 1));
       }
     }
     if (mesh.face_tet[f] < 0 || mesh.face_tet[f] >= tet_count) {
-      fail("face_tet[" + str(f) + "] = " + str(mesh.face_tet[f]) + ": expected 0.." +
-           str(tet_count - 1));
+      fail_mesh("face_tet[" + str(f) + "] = " + str(mesh.face_tet[f]) + ": expected 0.." +
+                str(tet_count - 1));
     }
     if (mesh.face_other_tet[f] < -1 || mesh.face_other_tet[f] >= tet_count) {
-      fail("face_other_tet[" + str(f) + "] = " + str(mesh.face_other_tet[f]) + ": expected -1.." +
-           str(tet_count - 1));
+      fail_mesh("face_other_tet[" + str(f) + "] = " + str(mesh.face_other_tet[f]) +
+                ": expected -1.." + str(tet_count - 1));
     }
     const int group = core::index_of(mesh.face_group[f]);
     if (group < -1 || group >= static_cast<int>(mesh.group_names.size())) {
-      fail("face_group[" + str(f) + "] = " + str(group) + ": expected -1.." +
-           str(static_cast<long long>(mesh.group_names.size()) - 1));
+      fail_mesh("face_group[" + str(f) + "] = " + str(group) + ": expected -1.." +
+                str(static_cast<long long>(mesh.group_names.size()) - 1));
     }
   }
+}
+
+/// Throws MeshError when the arrays of `mesh` disagree in size or index out of range; the writers
+/// would otherwise read past an array or write a file ParaView rejects.
+void check_mesh(const mesh::TetMesh& mesh) {
+  check_tets(mesh);
+  check_faces(mesh);
+  const long long node_count = mesh.nodes.rows();
   for (std::size_t p = 0; p < mesh.points.size(); ++p) {
     const int node = mesh.points[p].node;
     if (node < -1 || node >= node_count) {
-      fail("points[" + str(p) + "] (" + mesh.points[p].id + ") node = " + str(node) +
-           ": expected -1.." + str(node_count - 1));
+      fail_mesh("points[" + str(p) + "] (" + mesh.points[p].id + ") node = " + str(node) +
+                ": expected -1.." + str(node_count - 1));
     }
   }
 }
