@@ -201,28 +201,31 @@ Command place_line(CLI::App& cli) {
           }};
 }
 
+/// fit's options that only fit --data reads: the test window and the held-out runs.
+void add_fit_data_options(CLI::App& fit, FitDataArgs& args, CLI::Option* fit_case) {
+  auto* data =
+      fit.add_option("--data", args.runs, "measured runs (docs/measured-data.md) instead of a case")
+          ->check(CLI::ExistingDirectory);
+  fit_case->excludes(data);
+  fit.add_option("--test-from-s", args.test_from_s,
+                 "with --data: test window start (default: published)")
+      ->check(finite_number());
+  fit.add_option("--test-to-s", args.test_to_s, "with --data: test window end")
+      ->check(finite_number());
+  fit.add_option("--test", args.test_runs, "with --data: held-out measured runs, tested whole")
+      ->check(CLI::ExistingDirectory);
+}
+
 /// `fit CASE --out DIR` or `fit --data RUN... --out DIR`.
 Command fit_line(CLI::App& cli) {
   auto args = std::make_shared<FitArgs>();
   auto data_args = std::make_shared<FitDataArgs>();
   FitArgs& fit_args = *args;
-  FitDataArgs& fit_data_args = *data_args;
   auto* fit = cli.add_subcommand(
       "fit", "Thermal-error models on placed sensors, judged on held-out duty cycles");
   auto* fit_case =
       fit->add_option("case", fit_args.case_file, "case file (TOML)")->check(CLI::ExistingFile);
-  auto* fit_data = fit->add_option("--data", fit_data_args.runs,
-                                   "measured runs (docs/measured-data.md) instead of a case")
-                       ->check(CLI::ExistingDirectory);
-  fit_case->excludes(fit_data);
-  fit->add_option("--test-from-s", fit_data_args.test_from_s,
-                  "with --data: test window start (default: published)")
-      ->check(finite_number());
-  fit->add_option("--test-to-s", fit_data_args.test_to_s, "with --data: test window end")
-      ->check(finite_number());
-  fit->add_option("--test", fit_data_args.test_runs,
-                  "with --data: held-out measured runs, tested whole")
-      ->check(CLI::ExistingDirectory);
+  add_fit_data_options(*fit, *data_args, fit_case);
   fit->add_option("--out", fit_args.out, "output directory")->required();
   fit->add_option("--hours", fit_args.hours,
                   "length of each campaign run (the standard's minimum: 5)")
@@ -299,6 +302,32 @@ Command calibrate_line(CLI::App& cli) {
           }};
 }
 
+/// compensate's input and output stream options: --in, --out, --until-eof, --idle-s, --poll-ms,
+/// --flush.
+void add_stream_options(CLI::App& compensate, CompensateArgs& compensate_args) {
+  auto* compensate_in = compensate.add_option(
+      "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
+  compensate.add_option("--out", compensate_args.out, "output CSV (default: standard output)");
+  auto* until_eof = compensate
+                        .add_flag("--until-eof", compensate_args.until_eof,
+                                  "with --in: stop at the file's end, do not follow it")
+                        ->needs(compensate_in);
+  compensate
+      .add_option("--idle-s", compensate_args.idle_s,
+                  "with --in: stop when the file has not grown for this long [s]")
+      ->check(positive_number())
+      ->excludes(until_eof)
+      ->needs(compensate_in);
+  compensate
+      .add_option("--poll-ms", compensate_args.poll_ms,
+                  "with --in: how often to look for new lines at its end [ms] (default 5)")
+      ->check(CLI::Range(1, 10000))
+      ->needs(compensate_in);
+  compensate.add_flag("--flush", compensate_args.flush,
+                      "flush after every line (default: when the input pauses; always on a "
+                      "terminal)");
+}
+
 /// `compensate --model FIT.json | --rom DIR`.
 Command compensate_line(CLI::App& cli) {
   auto args = std::make_shared<CompensateArgs>();
@@ -330,27 +359,7 @@ Command compensate_line(CLI::App& cli) {
       ->check(finite_number())
       ->needs(compensate_rom);
   add_observer_options(*compensate, compensate_args.observer);
-  auto* compensate_in = compensate->add_option(
-      "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
-  compensate->add_option("--out", compensate_args.out, "output CSV (default: standard output)");
-  auto* until_eof = compensate
-                        ->add_flag("--until-eof", compensate_args.until_eof,
-                                   "with --in: stop at the file's end, do not follow it")
-                        ->needs(compensate_in);
-  compensate
-      ->add_option("--idle-s", compensate_args.idle_s,
-                   "with --in: stop when the file has not grown for this long [s]")
-      ->check(positive_number())
-      ->excludes(until_eof)
-      ->needs(compensate_in);
-  compensate
-      ->add_option("--poll-ms", compensate_args.poll_ms,
-                   "with --in: how often to look for new lines at its end [ms] (default 5)")
-      ->check(CLI::Range(1, 10000))
-      ->needs(compensate_in);
-  compensate->add_flag("--flush", compensate_args.flush,
-                       "flush after every line (default: when the input pauses; always on a "
-                       "terminal)");
+  add_stream_options(*compensate, compensate_args);
   return {compensate, [args] {
             const CompensateArgs& a = *args;
             if (a.model.empty() == a.rom.empty())
