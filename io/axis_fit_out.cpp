@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/directions.hpp"
 #include "io/fitting_out.hpp"
 #include "io/reports.hpp"
 
@@ -36,7 +37,7 @@ nlohmann::json axis_fit_json(const studies::AxisFit& fit) {
   nlohmann::json polynomial = nlohmann::json::object();
   for (const auto& c : fit.compensation)
     for (int d = 0; d < 3; ++d) {
-      polynomial[c.source][studies::kAxisDirections[d]] = {
+      polynomial[c.source][core::kDirectionNames[d]] = {
           {"rms_um", um(c.rms_m[static_cast<std::size_t>(d)])},
           {"max_um", um(c.max_m[static_cast<std::size_t>(d)])}};
     }

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/directions.hpp"
 #include "io/csv_out.hpp"
 
 namespace tt::io {
 namespace {
-
-constexpr const char* kDirections[3] = {"dx", "dy", "dz"};
 
 std::string coefficient_name(const std::string& d, int k) {
   if (k == 0) return d + "_c0_um";
@@ -20,7 +19,8 @@ std::string coefficient_name(const std::string& d, int k) {
 std::vector<std::string> axis_error_header(const solvers::AxisError& e) {
   std::vector<std::string> h;
   for (size_t i = 0; i < e.points.size(); ++i)
-    for (const char* d : kDirections) h.push_back("axis" + std::to_string(i + 1) + "_" + d + "_um");
+    for (const char* d : core::kDirectionNames)
+      h.push_back("axis" + std::to_string(i + 1) + "_" + d + "_um");
   return h;
 }
 
@@ -30,7 +30,7 @@ Eigen::MatrixXd axis_error_rows_um(const solvers::AxisError& e) {
 
 std::vector<std::string> axis_polynomial_header(int degree) {
   std::vector<std::string> h{"time_s"};
-  for (const char* d : kDirections) {
+  for (const char* d : core::kDirectionNames) {
     for (int k = 0; k <= degree; ++k) h.push_back(coefficient_name(d, k));
     h.push_back(std::string(d) + "_fit_rms_um");
     h.push_back(std::string(d) + "_fit_max_um");
@@ -66,9 +66,9 @@ nlohmann::json axis_summary_json(const solvers::AxisError& e, const solvers::Axi
     double spread = 0;  // largest |error| over the points at the end [m]
     for (Eigen::Index i = 0; i < e.positions.size(); ++i)
       spread = std::max(spread, std::abs(last(3 * i + d)));
-    j[kDirections[d]] = {{"fit_rms_um_max_over_time", poly.rms[d].maxCoeff() * 1e6},
-                         {"fit_max_um_max_over_time", poly.max[d].maxCoeff() * 1e6},
-                         {"largest_point_error_at_end_um", spread * 1e6}};
+    j[core::kDirectionNames[d]] = {{"fit_rms_um_max_over_time", poly.rms[d].maxCoeff() * 1e6},
+                                   {"fit_max_um_max_over_time", poly.max[d].maxCoeff() * 1e6},
+                                   {"largest_point_error_at_end_um", spread * 1e6}};
   }
   return j;
 }

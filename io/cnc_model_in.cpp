@@ -4,6 +4,7 @@
 #include <fstream>
 #include <optional>
 
+#include "core/directions.hpp"
 #include "core/errors.hpp"
 #include "io/fit_json_keys.hpp"
 #include "io/fit_model_in.hpp"
@@ -21,11 +22,9 @@ using fit_keys::Place;
 using fit_keys::vector_at;
 using nlohmann::json;
 
-constexpr const char* kDirections[3] = {"dx", "dy", "dz"};
-
 int direction_of(const std::string& name) {
   for (int d = 0; d < 3; ++d)
-    if (name == kDirections[d]) return d;
+    if (name == core::kDirectionNames[d]) return d;
   return -1;
 }
 
@@ -68,7 +67,7 @@ AxisSection axis_section(const json& axis, const std::string& origin,
   a.name = name.get<std::string>();
   const json& axis_targets = member(axis, "targets", p, "axis.");
   for (const std::string& point : a.points)
-    for (const char* d : kDirections) {
+    for (const char* d : core::kDirectionNames) {
       const std::string target = point + "_" + d;
       const std::string key = "axis.targets." + target;
       const json& t = member(axis_targets, target, p, "axis.targets.");

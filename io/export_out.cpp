@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/directions.hpp"
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/cnc_out.hpp"
@@ -10,14 +11,12 @@
 namespace tt::io {
 namespace {
 
-constexpr const char* kDirections[3] = {"dx", "dy", "dz"};
-
 nlohmann::json error_json(const fitting::LawError& e) {
   nlohmann::json j{{"positions", e.positions}, {"states", e.states}};
   for (std::size_t d = 0; d < 3; ++d)
-    j[kDirections[d]] = {{"max_um", e.max[d] * core::kMicrometresPerMetre},
-                         {"rms_um", e.rms[d] * core::kMicrometresPerMetre},
-                         {"model_max_um", e.model_max[d] * core::kMicrometresPerMetre}};
+    j[core::kDirectionNames[d]] = {{"max_um", e.max[d] * core::kMicrometresPerMetre},
+                                   {"rms_um", e.rms[d] * core::kMicrometresPerMetre},
+                                   {"model_max_um", e.model_max[d] * core::kMicrometresPerMetre}};
   return j;
 }
 
@@ -29,7 +28,7 @@ std::string error_rows(const std::string& format, const std::string& states,
   for (std::size_t d = 0; d < 3; ++d) {
     if (e.model_max[d] == 0.0) continue;
     std::snprintf(buf, sizeof buf, "| %s | %s | %s | %.4g | %.4g | %.4g |\n", format.c_str(),
-                  states.c_str(), kDirections[d], e.max[d] * core::kMicrometresPerMetre,
+                  states.c_str(), core::kDirectionNames[d], e.max[d] * core::kMicrometresPerMetre,
                   e.rms[d] * core::kMicrometresPerMetre,
                   e.model_max[d] * core::kMicrometresPerMetre);
     rows += buf;

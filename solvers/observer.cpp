@@ -3,8 +3,10 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 
+#include "core/directions.hpp"
 #include "core/errors.hpp"
 #include "core/units.hpp"
 #include "solvers/loads.hpp"
@@ -86,7 +88,7 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
   const Eigen::Index axis = static_cast<Eigen::Index>(out.names.size()) - first - 9;
   s.target_rows.resize(3 + axis, out.rows.cols());
   s.target_rows.topRows(3) = out.rows.middleRows(first, 3);
-  s.target_names = {"dx", "dy", "dz"};
+  s.target_names.assign(std::begin(core::kDirectionNames), std::end(core::kDirectionNames));
   if (axis > 0) {
     s.target_rows.bottomRows(axis) = out.rows.bottomRows(axis);
     for (Eigen::Index k = 0; k < axis; ++k)

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/directions.hpp"
 #include "core/errors.hpp"
 #include "fitting/metrics.hpp"
 #include "solvers/axis_error.hpp"
@@ -42,7 +43,7 @@ struct Tally {
 std::vector<std::string> axis_target_names(const core::CaseSpec& spec) {
   std::vector<std::string> names;
   for (const auto& id : spec.mechanical.axis_points)
-    for (const char* d : kAxisDirections) names.push_back(id + "_" + d);
+    for (const char* d : core::kDirectionNames) names.push_back(id + "_" + d);
   return names;
 }
 

@@ -17,9 +17,6 @@
 
 namespace tt::studies {
 
-/// The error directions at an axis point, in AxisError::values' column order per point.
-inline constexpr const char* kAxisDirections[3] = {"dx", "dy", "dz"};
-
 /// Target names of the axis points' error columns: "<point id>_dx", "_dy", "_dz" per point, in
 /// the case's axis_points order (AxisError::values' column order).
 std::vector<std::string> axis_target_names(const core::CaseSpec& spec);

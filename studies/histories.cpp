@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/directions.hpp"
 #include "core/errors.hpp"
 #include "mesh/surface_vertices.hpp"
 #include "solvers/thermal_error.hpp"
@@ -49,9 +50,8 @@ std::vector<int> candidate_points(const core::CaseSpec& spec) {
 }
 
 int target_column(const std::string& target) {
-  if (target == "dx") return solvers::kDx;
-  if (target == "dy") return solvers::kDy;
-  if (target == "dz") return solvers::kDz;
+  for (int d = 0; d < 3; ++d)  // dx, dy, dz are ThermalError's first three columns
+    if (target == core::kDirectionNames[d]) return solvers::kDx + d;
   throw core::CaseError("target '" + target + "': expected \"dx\", \"dy\" or \"dz\"");
 }
 
