@@ -148,5 +148,37 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
+  // The observer's settings are flags of `observe` and `compensate --rom`, in their --help; a
+  // value that makes no sense is refused before any file is read, naming the flag and the value,
+  // and nothing is written.
+  const fs::path dir = rt::scratch("observe_flags"), out = dir / "out", log = dir / "flags.log";
+  for (const char* command : {"observe", "compensate"}) {
+    ASSERT_EQ(rt::run({command, "--help"}, {}, log), 0) << rt::read_text(log);
+    const std::string help = rt::read_text(log);
+    for (const char* flag :
+         {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
+          "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale"})
+      EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
+  }
+  const std::vector<std::string> base{
+      "observe", rt::kCoarseCase.string(),  "--rom", (dir / "no_rom").string(),
+      "--data",  (dir / "no_run").string(), "--out", out.string()};
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
+      {{"--sensor-offset-k", "-0.5"}, "--sensor-offset-k: -0.5: expected a finite number >= 0"},
+      {{"--sensor-offset-walk-k", "nan"},
+       "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
+      {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},
+      {{"--widen-on-inconsistency=maybe"}, "--widen-on-inconsistency"}};
+  for (const auto& [flags, message] : bad) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), flags.begin(), flags.end());
+    EXPECT_NE(rt::run(args, {}, log), 0) << flags.front();
+    EXPECT_NE(rt::read_text(log).find(message), std::string::npos)
+        << flags.front() << ": " << rt::read_text(log);
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 }  // namespace
 }  // namespace tt::observe_cli_test
