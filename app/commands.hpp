@@ -90,8 +90,8 @@ struct ObserverOptions {
   double air_walk_k = 0.5;              /// random walk of the air offset [K/sqrt(h)]
   double air_initial_k = 0.3;           /// the air offset's spread at t = 0 [K]
   double state_walk_k = 0;              /// white noise on every reduced state [K/sqrt(h)]
-  double sensor_offset_k = 0;           /// per-sensor offset state: spread at t = 0 [K]; 0: none
-  double sensor_offset_walk_k = 0;      /// per-sensor offset state: random walk [K/sqrt(h)]
+  double sensor_offset_k = 0.5;         /// per-sensor offset state: spread at t = 0 [K]
+  double sensor_offset_walk_k = 0.05;   /// per-sensor offset state: random walk [K/sqrt(h)]
   bool widen_on_inconsistency = false;  /// widen sigma by sqrt(window NIS / readings) when > 1
   double drift_relative_sigma = 0.04;   /// the drift rows' own error, relative to the drift [-]
   /// factor on the reported drift sigma: one value for every target or one per target; empty: 1

@@ -60,11 +60,13 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
   command
       .add_option("--sensor-offset-k", o.sensor_offset_k,
                   "an offset state per sensor, estimated beside the heat: its spread at t = 0 [K] "
-                  "(default 0: none; 0.5 is a class B Pt100's tolerance at 40 degC)")
+                  "(default 0.5, a class B Pt100's tolerance at 40 degC; 0 with a walk of 0: "
+                  "none, an offset is read as heat)")
       ->check(non_negative_number());
   command
       .add_option("--sensor-offset-walk-k", o.sensor_offset_walk_k,
-                  "random walk of each sensor's offset state [K per sqrt(h)] (default 0)")
+                  "random walk of each sensor's offset state [K per sqrt(h)] (default 0.05: "
+                  "0.1 K over a 4 h run, a contact or cable changing)")
       ->check(non_negative_number());
   command
       .add_option("--drift-relative-sigma", o.drift_relative_sigma,

@@ -55,13 +55,23 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   io::write_measured_run(
       data, calibration::synthetic_run(mesh, calibration::truth_case(gen, e, duty, 0), e, inst, g,
                                        "offset", rng));
-  // 2. The observer.
+  // 2. The observer without offset states (the offset is read as heat and alarms).
   const fs::path log = dir / "observe.log";
-  ASSERT_EQ(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
-                     data.string(), "--out", out.string(), "--sensor-sigma-k", "0.04", "--quiet"},
-                    {}, log),
-            0)
-      << rt::read_text(log);
+  const std::vector<std::string> no_offsets{"--sensor-offset-k", "0", "--sensor-offset-walk-k",
+                                            "0"};
+  std::vector<std::string> observe_args{"observe",
+                                        rt::kCoarseCase.string(),
+                                        "--rom",
+                                        rom.string(),
+                                        "--data",
+                                        data.string(),
+                                        "--out",
+                                        out.string(),
+                                        "--sensor-sigma-k",
+                                        "0.04",
+                                        "--quiet"};
+  observe_args.insert(observe_args.end(), no_offsets.begin(), no_offsets.end());
+  ASSERT_EQ(rt::run(observe_args, {}, log), 0) << rt::read_text(log);
   const std::string csv = rt::read_text(out / "observer.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "time_s,dx_predicted_um,dx_sigma_um,dy_predicted_um,dy_sigma_um,dz_predicted_um,"
@@ -73,7 +83,23 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(j["recalibrate_since_s"].get<double>(), 900.0);  // the offset is there from t = 0
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
+  EXPECT_FALSE(j["unknown_inputs"].contains("offset:T11"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
+  // With the default offset states the offset is found as T11's, and explained: no alarm.
+  const fs::path with_offsets = dir / "with_offsets";
+  observe_args.resize(observe_args.size() - no_offsets.size());
+  observe_args[7] = with_offsets.string();
+  ASSERT_EQ(rt::run(observe_args, {}, log), 0) << rt::read_text(log);
+  const auto jo = nlohmann::json::parse(std::ifstream(with_offsets / "observer.json"));
+  EXPECT_EQ(jo["status"], "ok");
+  EXPECT_EQ(jo["noise"]["sensor_offset_K"], 0.5);
+  ASSERT_TRUE(jo["unknown_inputs"].contains("offset:T11"));
+  for (const auto& [key, value] : jo["unknown_inputs"]["offset:T11"].items())
+    if (key.starts_with("final")) EXPECT_NEAR(value.get<double>(), 0.6, 0.1) << key;
+  for (const char* other : {"offset:T02", "offset:T17"})
+    for (const auto& [key, value] : jo["unknown_inputs"][other].items())
+      if (key.starts_with("final")) EXPECT_LT(std::abs(value.get<double>()), 0.1) << other;
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", with_offsets));
   // 3. The recorded run streamed through compensate --rom: the offline observer's figures.
   const io::MeasuredRun measured = io::read_measured_run(data);
   const fs::path live = dir / "live.csv", live_log = dir / "live.log";
@@ -89,6 +115,7 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
                                      live.string(),
                                      "--sensor-sigma-k",
                                      "0.04"};
+  live_args.insert(live_args.end(), no_offsets.begin(), no_offsets.end());
   if (measured.initial_temperature_c) {
     std::ostringstream t0;
     t0 << std::setprecision(17) << *measured.initial_temperature_c;
@@ -162,8 +189,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
-      "observe", rt::kCoarseCase.string(),  "--rom", (dir / "no_rom").string(),
-      "--data",  (dir / "no_run").string(), "--out", out.string()};
+      "observe",   rt::kCoarseCase.string(), "--rom", dir.string(), "--data", dir.string(), "--out",
+      out.string()};
   const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
       {{"--sensor-offset-k", "-0.5"}, "--sensor-offset-k: -0.5: expected a finite number >= 0"},
       {{"--sensor-offset-walk-k", "nan"},
