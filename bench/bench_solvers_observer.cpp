@@ -14,7 +14,9 @@
 //     random draws are still made, so gen_k is the run the whole bench draws (to look into one).
 //   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
 //   SENSOR_OFFSET_K, SENSOR_OFFSET_WALK_K: an offset state per sensor, its spread at t = 0 [K]
-//     and its random walk [K per sqrt(h)] (ObserverNoise::sensor_offset_*; 0 0: none)
+//     and its random walk [K per sqrt(h)] (ObserverNoise::sensor_offset_*; 0 0: none).
+//     SENSOR_OFFSET_WALK_K < 0: the walk is chosen on the campaign's training runs among 0, 0.02,
+//     0.05 and 0.1, the one with the least RMS dy^2 + RMS dz^2 there (ties: the larger walk).
 //   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
 //     correlation     the four best by the standard's correlation for dy and for dz, together
 //     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
@@ -384,6 +386,26 @@ int main(int argc, char** argv) {
       }
       return out;
     };
+    if (campaign_noise.sensor_offset_walk_k < 0) {
+      // The offsets' walk chosen on the training runs (never the held-out or generator runs).
+      double best = std::numeric_limits<double>::infinity(), chosen_walk = 0;
+      std::cout << "offset walk on the training runs, RMS dy, dz [um]:";
+      for (double walk : {0.0, 0.02, 0.05, 0.1}) {
+        solvers::ObserverNoise n = campaign_noise;
+        n.sensor_offset_walk_k = walk;
+        Score sc;
+        const std::vector<solvers::ObserverRun> tr = observe_training(n, {});
+        for (std::size_t k = 0; k < fitted.size(); ++k) {
+          const auto [p, sd] = dy_dz(tr[k]);
+          sc.add(p, sd, clean[static_cast<std::size_t>(fitted[k])].error);
+        }
+        const double v = sc.rms_um().squaredNorm();
+        std::cout << " " << walk << ": " << fmt(sc.rms_um()(0)) << ", " << fmt(sc.rms_um()(1));
+        if (v <= best) best = v, chosen_walk = walk;
+      }
+      campaign_noise.sensor_offset_walk_k = chosen_walk;
+      std::cout << " -> walk " << chosen_walk << " K/sqrt(h)\n";
+    }
     const std::vector<solvers::ObserverRun> training = observe_training(campaign_noise, {});
     std::vector<Eigen::MatrixXd> training_truth;
     for (int i : fitted)
