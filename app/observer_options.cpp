@@ -39,15 +39,39 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
   command
       .add_option("--heat-walk-w", o.heat_walk_w,
                   "random walk of each unknown heat input [W per sqrt(h)] (default 4)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
+  command
+      .add_option("--heat-initial-w", o.heat_initial_w,
+                  "each unknown heat input's spread at t = 0 [W] (default 2)")
+      ->check(non_negative_number());
   command
       .add_option("--air-walk-k", o.air_walk_k,
                   "random walk of the air temperature offset [K per sqrt(h)] (default 0.5)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
+  command
+      .add_option("--air-initial-k", o.air_initial_k,
+                  "the air temperature offset's spread at t = 0 [K] (default 0.3)")
+      ->check(non_negative_number());
+  command
+      .add_option("--state-walk-k", o.state_walk_k,
+                  "white process noise on every reduced state [K per sqrt(h)]: model-form error "
+                  "no unknown input explains (default 0)")
+      ->check(non_negative_number());
+  command
+      .add_option("--sensor-offset-k", o.sensor_offset_k,
+                  "an offset state per sensor, estimated beside the heat: its spread at t = 0 [K] "
+                  "(default 0.5, a class B Pt100's tolerance at 40 degC; 0 with a walk of 0: "
+                  "none, an offset is read as heat)")
+      ->check(non_negative_number());
+  command
+      .add_option("--sensor-offset-walk-k", o.sensor_offset_walk_k,
+                  "random walk of each sensor's offset state [K per sqrt(h)] (default 0.05: "
+                  "0.1 K over a 4 h run, a contact or cable changing)")
+      ->check(non_negative_number());
   command
       .add_option("--drift-relative-sigma", o.drift_relative_sigma,
                   "error of the drift rows (elastic model) relative to the drift (default 0.04)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   command
       .add_option("--drift-sigma-scale", o.drift_sigma_scale,
                   "factor on the reported drift sigma, calibrated on training runs: one value for "
@@ -62,11 +86,15 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
       .add_option("--sustain-s", o.sustain_s,
                   "consistency test: how long an exceedance lasts before recalibrate [s] "
                   "(default 900)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative_number());
   command
       .add_option("--probability", o.probability,
                   "consistency test: chi-square quantile of the bound (default 0.999)")
       ->check(CLI::Range(0.5, 0.999999));
+  command.add_flag("--widen-on-inconsistency", o.widen_on_inconsistency,
+                   "widen the reported drift sigma by sqrt(window NIS / window readings) while "
+                   "that is above 1: the consistency window's innovations say by how much the "
+                   "noise model is off (default: off)");
 }
 
 solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
@@ -75,8 +103,14 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   solvers::ObserverNoise noise;
   noise.sensor_sigma_k = per_name(o.sensor_sigma_k, sensors, "--sensor-sigma-k", "sensors");
   noise.heat_walk_w = o.heat_walk_w;
+  noise.heat_initial_w = o.heat_initial_w;
   noise.air_walk_k = o.air_walk_k;
+  noise.air_initial_k = o.air_initial_k;
+  noise.state_walk_k = o.state_walk_k;
+  noise.sensor_offset_initial_k = o.sensor_offset_k;
+  noise.sensor_offset_walk_k = o.sensor_offset_walk_k;
   noise.drift_relative_sigma = o.drift_relative_sigma;
+  noise.widen_on_inconsistency = o.widen_on_inconsistency;
   solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
   if (!o.drift_sigma_scale.empty())
     setup.noise.drift_sigma_scale =
@@ -94,9 +128,15 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
                                     : Eigen::VectorXd::Ones(setup.target_rows.rows());
   return {{"sensor_sigma_K", as_vector(n.sensor_sigma_k)},
           {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
+          {"heat_initial_W", n.heat_initial_w},
           {"air_walk_K_per_sqrt_h", n.air_walk_k},
+          {"air_initial_K", n.air_initial_k},
+          {"state_walk_K_per_sqrt_h", n.state_walk_k},
+          {"sensor_offset_K", n.sensor_offset_initial_k},
+          {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
           {"drift_relative_sigma", n.drift_relative_sigma},
-          {"drift_sigma_scale", as_vector(scale)}};
+          {"drift_sigma_scale", as_vector(scale)},
+          {"widen_on_inconsistency", n.widen_on_inconsistency}};
 }
 
 }  // namespace tt::app

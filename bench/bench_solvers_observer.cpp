@@ -5,7 +5,7 @@
 // Usage: bench_solvers_observer [CASE=cases/sb1_coarse.toml] [HOURS=5] [GEN_HOURS=4]
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
 //                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT=0]
-//                               [GEN_ONLY=-1]
+//                               [GEN_ONLY=-1] [SENSOR_OFFSET_K=0] [SENSOR_OFFSET_WALK_K=0]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
 //   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
 //   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
@@ -13,6 +13,10 @@
 //   GEN_ONLY = k >= 0: only the generator's run k (gen_k) is simulated and observed; the others'
 //     random draws are still made, so gen_k is the run the whole bench draws (to look into one).
 //   HEAT_WALK_W, AIR_WALK_K: the observer's random walks (solvers::ObserverNoise) [per sqrt(h)]
+//   SENSOR_OFFSET_K, SENSOR_OFFSET_WALK_K: an offset state per sensor, its spread at t = 0 [K]
+//     and its random walk [K per sqrt(h)] (ObserverNoise::sensor_offset_*; 0 0: none).
+//     SENSOR_OFFSET_WALK_K < 0: the walk is chosen on the campaign's training runs among 0, 0.02,
+//     0.05 and 0.1, the one with the least RMS dy^2 + RMS dz^2 there (ties: the larger walk).
 //   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
 //     correlation     the four best by the standard's correlation for dy and for dz, together
 //     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
@@ -223,6 +227,8 @@ int main(int argc, char** argv) {
     const std::string sensor_choice = argc > 9 ? argv[9] : "correlation";
     const int count = argc > 10 ? std::stoi(argv[10]) : 0;
     const int gen_only = argc > 11 ? std::stoi(argv[11]) : -1;
+    if (argc > 12) campaign_noise.sensor_offset_initial_k = std::stod(argv[12]);
+    if (argc > 13) campaign_noise.sensor_offset_walk_k = std::stod(argv[13]);
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
         sensor_choice != "estimation" && sensor_choice != "estimation_exact")
       throw std::runtime_error("SENSORS '" + sensor_choice +
@@ -239,7 +245,9 @@ int main(int argc, char** argv) {
               << twin.model.states() << " (" << fmt(seconds_since(t_all))
               << " s); observer walks: heat " << campaign_noise.heat_walk_w << " W/sqrt(h), air "
               << campaign_noise.air_walk_k << " K/sqrt(h), drift relative sigma "
-              << campaign_noise.drift_relative_sigma << "\n";
+              << campaign_noise.drift_relative_sigma << ", sensor offsets "
+              << campaign_noise.sensor_offset_initial_k << " K at t = 0, walk "
+              << campaign_noise.sensor_offset_walk_k << " K/sqrt(h)\n";
 
     // 2. The campaign in full order, noisy readings.
     const auto t_camp = Clock::now();
@@ -378,6 +386,26 @@ int main(int argc, char** argv) {
       }
       return out;
     };
+    if (campaign_noise.sensor_offset_walk_k < 0) {
+      // The offsets' walk chosen on the training runs (never the held-out or generator runs).
+      double best = std::numeric_limits<double>::infinity(), chosen_walk = 0;
+      std::cout << "offset walk on the training runs, RMS dy, dz [um]:";
+      for (double walk : {0.0, 0.02, 0.05, 0.1}) {
+        solvers::ObserverNoise n = campaign_noise;
+        n.sensor_offset_walk_k = walk;
+        Score sc;
+        const std::vector<solvers::ObserverRun> tr = observe_training(n, {});
+        for (std::size_t k = 0; k < fitted.size(); ++k) {
+          const auto [p, sd] = dy_dz(tr[k]);
+          sc.add(p, sd, clean[static_cast<std::size_t>(fitted[k])].error);
+        }
+        const double v = sc.rms_um().squaredNorm();
+        std::cout << " " << walk << ": " << fmt(sc.rms_um()(0)) << ", " << fmt(sc.rms_um()(1));
+        if (v <= best) best = v, chosen_walk = walk;
+      }
+      campaign_noise.sensor_offset_walk_k = chosen_walk;
+      std::cout << " -> walk " << chosen_walk << " K/sqrt(h)\n";
+    }
     const std::vector<solvers::ObserverRun> training = observe_training(campaign_noise, {});
     std::vector<Eigen::MatrixXd> training_truth;
     for (int i : fitted)
@@ -581,6 +609,18 @@ int main(int argc, char** argv) {
         if (effect.present)
           what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
         line(name, "generator, " + what, o, rr, run);
+        if (campaign_noise.sensor_offset_initial_k > 0 || campaign_noise.sensor_offset_walk_k > 0) {
+          // The sensor offsets' estimates at the run's end (sigma) [K].
+          const Eigen::Index last = run.times.size() - 1;
+          std::cout << name << ": offsets at the end [K]:";
+          for (std::size_t b = 0; b < run.unknown_input_names.size(); ++b)
+            if (run.unknown_input_names[b].starts_with("offset:"))
+              std::cout << " " << run.unknown_input_names[b].substr(7) << " "
+                        << fmt(run.unknown_inputs(last, static_cast<Eigen::Index>(b)), 2) << " ("
+                        << fmt(run.unknown_inputs_sigma(last, static_cast<Eigen::Index>(b)), 2)
+                        << ")";
+          std::cout << "\n";
+        }
         if (gen_only >= 0) {
           // The one run looked into: the effect's place, the unknown inputs' estimates, the
           // innovations per sensor and the error's course.

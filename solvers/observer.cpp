@@ -95,6 +95,7 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
       s.target_names.push_back(out.names[static_cast<std::size_t>(first + 9 + k)]);
   }
   s.air_entries = air_entries(spec);
+  s.sensor_names = sensors;
   s.noise = noise;
   return s;
 }
@@ -173,7 +174,7 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
          " sensors; expected one finite sigma > 0 K each");
   const ObserverNoise& n = setup_.noise;
   for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
-                   n.drift_relative_sigma})
+                   n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
   const Eigen::VectorXd& scale = n.drift_sigma_scale;
@@ -189,14 +190,29 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       fail("air entry " + std::to_string(c) + " is not a convection entry (the case has " +
            std::to_string(conv.size()) + ")");
 
+  const Eigen::Index m = setup_.sensor_rows.rows();
+  if (!setup_.sensor_names.empty() && setup_.sensor_names.size() != static_cast<std::size_t>(m))
+    fail(std::to_string(setup_.sensor_names.size()) + " sensor names for " + std::to_string(m) +
+         " sensor rows");
+
   heat_columns_ = unknown_heat_columns(system, spec, bias_names_);
   const bool air = !setup_.air_entries.empty();
   if (air) bias_names_.push_back("air");
+  const bool offsets = n.sensor_offset_initial_k > 0 || n.sensor_offset_walk_k > 0;
+  offsets_ = offsets ? static_cast<Eigen::Index>(bias_names_.size()) : -1;
+  if (offsets)
+    for (Eigen::Index k = 0; k < m; ++k)
+      bias_names_.push_back("offset:" + (setup_.sensor_names.empty()
+                                             ? std::to_string(k)
+                                             : setup_.sensor_names[static_cast<std::size_t>(k)]));
   nb_ = static_cast<Eigen::Index>(bias_names_.size());
   bias_walk_.resize(nb_);
   const Eigen::Index nh = heat_columns_.cols();
   bias_walk_.head(nh).setConstant(n.heat_walk_w * n.heat_walk_w / 3600.0);
   if (air) bias_walk_(nh) = n.air_walk_k * n.air_walk_k / 3600.0;
+  if (offsets)
+    bias_walk_.segment(offsets_, m)
+        .setConstant(n.sensor_offset_walk_k * n.sensor_offset_walk_k / 3600.0);
 
   const double t0_k = std::isnan(setup_.initial_temperature_k)
                           ? spec.thermal.initial_temperature_c + core::kCelsiusOffset
@@ -207,6 +223,10 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
   p_ = Eigen::MatrixXd::Zero(r_ + nb_, r_ + nb_);
   for (Eigen::Index k = 0; k < nh; ++k) p_(r_ + k, r_ + k) = n.heat_initial_w * n.heat_initial_w;
   if (air) p_(r_ + nh, r_ + nh) = n.air_initial_k * n.air_initial_k;
+  if (offsets)
+    p_.diagonal()
+        .segment(r_ + offsets_, m)
+        .setConstant(n.sensor_offset_initial_k * n.sensor_offset_initial_k);
 }
 
 namespace {
@@ -243,7 +263,7 @@ void KalmanObserver::step(double t1) {
   const AffineStep a = stepper_.step(t_, t1, prev_speed_, x_.head(r_));
   const double dt = t1 - t_;
   // Unknown inputs' columns over this step: the air's follows the step's film coefficients.
-  Eigen::MatrixXd b(r_, nb_);
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(r_, nb_);  // the sensor offsets: no heat
   const Eigen::Index nh = heat_columns_.cols();
   b.leftCols(nh) = heat_columns_;
   if (nb_ > nh) {
@@ -309,9 +329,18 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
       y(i) = readings(used[i]);
       r2(i) = setup_.noise.sensor_sigma_k(used[i]) * setup_.noise.sensor_sigma_k(used[i]);
     }
-    const Eigen::VectorXd innovation = y - h * x_.head(r_);
-    const Eigen::MatrixXd pht = p_.leftCols(r_).lazyProduct(h.transpose());  // (r + nb) x nu
+    Eigen::VectorXd innovation = y - h * x_.head(r_);
+    Eigen::MatrixXd pht = p_.leftCols(r_).lazyProduct(h.transpose());  // (r + nb) x nu
+    // With offsets a reading is H z + o: its row has a 1 at its sensor's offset, so P H^T gains
+    // that offset's column of P, and H P H^T that offset's row of P H^T.
+    if (offsets_ >= 0)
+      for (Eigen::Index i = 0; i < nu; ++i) {
+        innovation(i) -= x_(r_ + offsets_ + used[i]);
+        pht.col(i) += p_.col(r_ + offsets_ + used[i]);
+      }
     Eigen::MatrixXd s = h.lazyProduct(pht.topRows(r_));
+    if (offsets_ >= 0)
+      for (Eigen::Index i = 0; i < nu; ++i) s.row(i) += pht.row(r_ + offsets_ + used[i]);
     s.diagonal() += r2;
     const Eigen::LLT<Eigen::MatrixXd> llt(s);
     if (llt.info() != Eigen::Success)

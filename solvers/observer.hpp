@@ -8,11 +8,13 @@
 // State: x = [z; b], z the reduced thermal state (T = V z), b unknown inputs the case does not
 // declare, each a random walk: one heat input per fixed heat source (power added to its shape)
 // and per convection entry (spread over its surface, by area), and one air-temperature offset of
-// the sinks of the chosen convection entries. One step of the case's grid:
+// the sinks of the chosen convection entries; optionally one offset per sensor, which enters that
+// sensor's reading only (ObserverNoise::sensor_offset_initial_k). One step of the case's grid:
 //   z1 = Phi z0 + u + Gamma b0,  b1 = b0 + w,  w ~ N(0, diag(q) dt),
 // Phi and u the stepper's affine map (ReducedStepper), Gamma = (C + theta dt A)^{-1} dt B(h) with
 // B the unknown inputs' columns (the air's column is sum_c h_c(speed) a_c: it follows the film).
-// Readings y = H z + v, H the sensors' rows on the reduced state, v ~ N(0, diag(sigma^2)).
+// Readings y = H z + o + v, H the sensors' rows on the reduced state, o the offsets (0 without
+// them), v ~ N(0, diag(sigma^2)).
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +37,13 @@ struct ObserverNoise {
   double heat_walk_w = 4.0, heat_initial_w = 2.0;
   /// Random walk of the air-temperature offset [K per sqrt(h)], and its spread at t = 0 [K].
   double air_walk_k = 0.5, air_initial_k = 0.3;
+  /// Per sensor an offset of its reading, an unknown input of its own that enters that sensor's
+  /// reading only (y = H z + o + v): an installation error or a fault (a sensor off by a constant,
+  /// or slowly wandering, amount) is then estimated as an offset instead of being read as heat.
+  /// Its spread at t = 0 [K] and its random walk [K per sqrt(h)]; both 0 (the library's default):
+  /// no offset states. The known initial field is what tells an offset (there from the first
+  /// reading) from heat (which takes time to warm a sensor).
+  double sensor_offset_initial_k = 0, sensor_offset_walk_k = 0;
   /// White process noise on every reduced state [K per sqrt(h)] in the capacity norm: model-form
   /// error that no input explains (0: none).
   double state_walk_k = 0;
@@ -70,6 +79,7 @@ struct ObserverSetup {
   Eigen::MatrixXd target_rows;            /// #targets x r: drift [m] = row (z - z(0))
   std::vector<std::string> target_names;  /// e.g. "dx", "dy", "dz", "<axis point>_dx"
   std::vector<int> air_entries;           /// convection entries whose sink the air offset moves
+  std::vector<std::string> sensor_names;  /// the sensors' ids (the offsets' names); empty: indices
   double initial_temperature_k = std::numeric_limits<double>::quiet_NaN();  /// NaN: the case's
   ObserverNoise noise;
   ConsistencyOptions consistency;
@@ -175,7 +185,8 @@ class KalmanObserver {
   ReducedStepper stepper_;
   Eigen::Index r_ = 0, nb_ = 0;
   Eigen::MatrixXd heat_columns_;         /// r x #heat biases [state per W]
-  std::vector<std::string> bias_names_;  /// heat:<source>, heat:<group>, air
+  std::vector<std::string> bias_names_;  /// heat:<source>, heat:<group>, air, offset:<sensor>
+  Eigen::Index offsets_ = 0;             /// the sensor offsets' first index in b (-1: none)
   Eigen::VectorXd bias_walk_;            /// per bias: variance per second
   Eigen::VectorXd x_, z0_;
   Eigen::MatrixXd p_;

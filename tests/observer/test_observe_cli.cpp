@@ -1,7 +1,8 @@
 // `thermotwin observe` on the coarse SB-1: a reduced model from `reduce`, a 3-hour run from the
 // calibration generator (the case's own mesh and step) with an offset of 0.6 K on one sensor,
 // written in the measured-data format. The observer writes its CSV and JSON, raises
-// `recalibrate` with its start, and refuses a sensor the model does not name, writing nothing.
+// `recalibrate` with its start (offset states off; with the default ones the offset is found as
+// the sensor's and explained), and refuses a sensor the model does not name, writing nothing.
 // The same run streamed through `compensate --rom` gives the offline observer's predictions, sigmas
 // and alarm sample by sample; a stream without the observer's sensor columns is refused.
 #include <gtest/gtest.h>
@@ -55,13 +56,23 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   io::write_measured_run(
       data, calibration::synthetic_run(mesh, calibration::truth_case(gen, e, duty, 0), e, inst, g,
                                        "offset", rng));
-  // 2. The observer.
+  // 2. The observer without offset states (the offset is read as heat and alarms).
   const fs::path log = dir / "observe.log";
-  ASSERT_EQ(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
-                     data.string(), "--out", out.string(), "--sensor-sigma-k", "0.04", "--quiet"},
-                    {}, log),
-            0)
-      << rt::read_text(log);
+  const std::vector<std::string> no_offsets{"--sensor-offset-k", "0", "--sensor-offset-walk-k",
+                                            "0"};
+  std::vector<std::string> observe_args{"observe",
+                                        rt::kCoarseCase.string(),
+                                        "--rom",
+                                        rom.string(),
+                                        "--data",
+                                        data.string(),
+                                        "--out",
+                                        out.string(),
+                                        "--sensor-sigma-k",
+                                        "0.04",
+                                        "--quiet"};
+  observe_args.insert(observe_args.end(), no_offsets.begin(), no_offsets.end());
+  ASSERT_EQ(rt::run(observe_args, {}, log), 0) << rt::read_text(log);
   const std::string csv = rt::read_text(out / "observer.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "time_s,dx_predicted_um,dx_sigma_um,dy_predicted_um,dy_sigma_um,dz_predicted_um,"
@@ -73,7 +84,23 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(j["recalibrate_since_s"].get<double>(), 900.0);  // the offset is there from t = 0
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
+  EXPECT_FALSE(j["unknown_inputs"].contains("offset:T11"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
+  // With the default offset states the offset is found as T11's, and explained: no alarm.
+  const fs::path with_offsets = dir / "with_offsets";
+  observe_args.resize(observe_args.size() - no_offsets.size());
+  observe_args[7] = with_offsets.string();
+  ASSERT_EQ(rt::run(observe_args, {}, log), 0) << rt::read_text(log);
+  const auto jo = nlohmann::json::parse(std::ifstream(with_offsets / "observer.json"));
+  EXPECT_EQ(jo["status"], "ok");
+  EXPECT_EQ(jo["noise"]["sensor_offset_K"], 0.5);
+  ASSERT_TRUE(jo["unknown_inputs"].contains("offset:T11"));
+  for (const auto& [key, value] : jo["unknown_inputs"]["offset:T11"].items())
+    if (key.starts_with("final")) EXPECT_NEAR(value.get<double>(), 0.6, 0.1) << key;
+  for (const char* other : {"offset:T02", "offset:T17"})
+    for (const auto& [key, value] : jo["unknown_inputs"][other].items())
+      if (key.starts_with("final")) EXPECT_LT(std::abs(value.get<double>()), 0.1) << other;
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", with_offsets));
   // 3. The recorded run streamed through compensate --rom: the offline observer's figures.
   const io::MeasuredRun measured = io::read_measured_run(data);
   const fs::path live = dir / "live.csv", live_log = dir / "live.log";
@@ -94,27 +121,38 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
     t0 << std::setprecision(17) << *measured.initial_temperature_c;
     live_args.insert(live_args.end(), {"--initial-temperature-c", t0.str()});
   }
-  ASSERT_EQ(rt::run(live_args, {}, live_log), 0) << rt::read_text(live_log);
-  const auto offline = tt::test::csv_rows(out / "observer.csv");
-  const auto streamed = tt::test::csv_rows(live);
-  ASSERT_EQ(streamed.size(), offline.size());
-  double largest = 0, worst = 0;
-  std::size_t alarms = 0;
-  for (std::size_t i = 0; i < offline.size(); ++i) {
-    for (const char* d : {"dx", "dy", "dz"})
-      for (const char* what : {"_predicted_um", "_sigma_um"}) {
-        const std::string key = std::string(d) + what;
-        const double a = std::stod(offline[i].at(key)), b = std::stod(streamed[i].at(key));
-        largest = std::max(largest, std::abs(a));
-        worst = std::max(worst, std::abs(a - b));
-      }
-    const bool raised = offline[i].at("status") == "recalibrate";
-    EXPECT_EQ(streamed[i].at("status").rfind("recalibrate", 0) == 0, raised) << "sample " << i;
-    alarms += raised;
-  }
-  EXPECT_GT(largest, 0.5);           // microns of drift were compared
-  EXPECT_LE(worst, 1e-7 * largest);  // observer.csv holds 9 digits
-  EXPECT_GT(alarms, 0u);
+  // The stream through compensate with `flags` against observe's `offline` CSV: the same
+  // predictions and sigmas, the same alarm; returns how many samples were alarmed.
+  const auto same_as_offline = [&](const fs::path& offline_csv,
+                                   const std::vector<std::string>& flags) -> std::size_t {
+    std::vector<std::string> args = live_args;
+    args.insert(args.end(), flags.begin(), flags.end());
+    EXPECT_EQ(rt::run(args, {}, live_log), 0) << rt::read_text(live_log);
+    const auto offline = tt::test::csv_rows(offline_csv);
+    const auto streamed = tt::test::csv_rows(live);
+    EXPECT_EQ(streamed.size(), offline.size());
+    if (streamed.size() != offline.size()) return 0;
+    double largest = 0, worst = 0;
+    std::size_t alarms = 0;
+    for (std::size_t i = 0; i < offline.size(); ++i) {
+      for (const char* d : {"dx", "dy", "dz"})
+        for (const char* what : {"_predicted_um", "_sigma_um"}) {
+          const std::string key = std::string(d) + what;
+          const double a = std::stod(offline[i].at(key)), b = std::stod(streamed[i].at(key));
+          largest = std::max(largest, std::abs(a));
+          worst = std::max(worst, std::abs(a - b));
+        }
+      const bool raised = offline[i].at("status") == "recalibrate";
+      EXPECT_EQ(streamed[i].at("status").rfind("recalibrate", 0) == 0, raised) << "sample " << i;
+      alarms += raised;
+    }
+    EXPECT_GT(largest, 0.5);           // microns of drift were compared
+    EXPECT_LE(worst, 1e-7 * largest);  // observer.csv holds 9 digits
+    return alarms;
+  };
+  EXPECT_GT(same_as_offline(out / "observer.csv", no_offsets), 0u);
+  // With the default offsets too (no alarm: the offset is explained).
+  EXPECT_EQ(same_as_offline(with_offsets / "observer.csv", {}), 0u);
   // A stream without one of the observer's sensors is refused, naming the column.
   const fs::path cut = dir / "cut.csv", cut_log = dir / "cut.log";
   {
@@ -146,6 +184,38 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
             std::string::npos)
       << rt::read_text(bad_log);
   EXPECT_FALSE(fs::exists(bad));
+}
+
+TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
+  // The observer's settings are flags of `observe` and `compensate --rom`, in their --help; a
+  // value that makes no sense is refused before any file is read, naming the flag and the value,
+  // and nothing is written.
+  const fs::path dir = rt::scratch("observe_flags"), out = dir / "out", log = dir / "flags.log";
+  for (const char* command : {"observe", "compensate"}) {
+    ASSERT_EQ(rt::run({command, "--help"}, {}, log), 0) << rt::read_text(log);
+    const std::string help = rt::read_text(log);
+    for (const char* flag :
+         {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
+          "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale"})
+      EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
+  }
+  const std::vector<std::string> base{
+      "observe",   rt::kCoarseCase.string(), "--rom", dir.string(), "--data", dir.string(), "--out",
+      out.string()};
+  const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
+      {{"--sensor-offset-k", "-0.5"}, "--sensor-offset-k: -0.5: expected a finite number >= 0"},
+      {{"--sensor-offset-walk-k", "nan"},
+       "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
+      {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},
+      {{"--widen-on-inconsistency=maybe"}, "--widen-on-inconsistency"}};
+  for (const auto& [flags, message] : bad) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), flags.begin(), flags.end());
+    EXPECT_NE(rt::run(args, {}, log), 0) << flags.front();
+    EXPECT_NE(rt::read_text(log).find(message), std::string::npos)
+        << flags.front() << ": " << rt::read_text(log);
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 }  // namespace

@@ -314,6 +314,112 @@ TEST_F(Observer, CoverageCalibrationAndWideningOnInconsistency) {
   EXPECT_LE(clean_widest, 1.3);
 }
 
+/// The final estimate and sigma of the unknown input `name` of a run.
+std::pair<double, double> final_input(const solvers::ObserverRun& run, const std::string& name) {
+  const auto& names = run.unknown_input_names;
+  const auto it = std::find(names.begin(), names.end(), name);
+  EXPECT_NE(it, names.end()) << name;
+  if (it == names.end()) return {std::numeric_limits<double>::quiet_NaN(), 0};
+  const auto b = it - names.begin();
+  const Eigen::Index last = run.times.size() - 1;
+  return {run.unknown_inputs(last, b), run.unknown_inputs_sigma(last, b)};
+}
+
+/// The largest |heat input| at a run's end [W].
+double largest_heat(const solvers::ObserverRun& run) {
+  double out = 0;
+  for (std::size_t b = 0; b < run.unknown_input_names.size(); ++b)
+    if (run.unknown_input_names[b].starts_with("heat:"))
+      out = std::max(
+          out, std::abs(run.unknown_inputs(run.times.size() - 1, static_cast<Eigen::Index>(b))));
+  return out;
+}
+
+TEST_F(Observer, ASensorOffsetIsEstimatedAsAnOffsetNotAsHeat) {
+  // The clean run with 0.5 K added to T17's readings from t = 0. Without offset states the filter
+  // reads it as heat (large heat inputs, a drift error many times the clean run's); with them
+  // the offset is estimated as T17's (0.5 K within 3 sigma, the others near 0), the heat inputs
+  // stay as small as on the clean run, and the drift is as good as on the clean run.
+  const core::CaseSpec c = run_spec();
+  const Eigen::Index faulty = 4;  // T17
+  ASSERT_EQ(kSensors[faulty], "T17");
+  Eigen::MatrixXd y = s_->clean.temperature;
+  y.col(faulty).array() += 0.5;
+  solvers::ObserverNoise with = default_noise();
+  with.sensor_offset_initial_k = 0.5;
+  with.sensor_offset_walk_k = 0.05;
+  const auto& sys = s_->twin.model.system;
+  const solvers::ObserverRun plain =
+      solvers::observe(sys, c, setup(default_noise()), s_->clean.time, y);
+  const solvers::ObserverRun offset = solvers::observe(sys, c, setup(with), s_->clean.time, y);
+  const solvers::ObserverRun clean =
+      solvers::observe(sys, c, setup(with), s_->clean.time, s_->clean.temperature);
+  // Names: the offsets follow the heat inputs and the air, one per sensor; none without them.
+  for (const auto& n : plain.unknown_input_names) EXPECT_FALSE(n.starts_with("offset:")) << n;
+  ASSERT_EQ(offset.unknown_input_names.size(), plain.unknown_input_names.size() + kSensors.size());
+  EXPECT_EQ(offset.unknown_input_names.back(), "offset:" + kSensors.back());
+
+  const auto [o, so] = final_input(offset, "offset:T17");
+  std::cerr << "T17 offset " << o << " (" << so << "); largest heat: plain " << largest_heat(plain)
+            << " W, with offsets " << largest_heat(offset) << " W, clean " << largest_heat(clean)
+            << " W\n";
+  EXPECT_NEAR(o, 0.5, std::max(3 * so, 0.03));
+  EXPECT_LT(so, 0.1);
+  for (const auto& id : kSensors) {
+    if (id == "T17") continue;
+    const auto [v, sv] = final_input(offset, "offset:" + id);
+    EXPECT_LT(std::abs(v), std::max(3 * sv, 0.05)) << id;
+    const auto [vc, svc] = final_input(clean, "offset:" + id);
+    EXPECT_LT(std::abs(vc), std::max(3 * svc, 0.05)) << id << " on the clean run";
+  }
+  EXPECT_LT(largest_heat(offset), 0.25 * largest_heat(plain));
+  EXPECT_LT(largest_heat(offset), 2 * largest_heat(clean) + 1.0);
+
+  const auto rms = [&](const solvers::ObserverRun& run, int d) {
+    return std::sqrt((run.drift.col(d) - s_->clean_truth.displacement.col(d)).squaredNorm() /
+                     static_cast<double>(run.drift.rows()));
+  };
+  for (int d = 1; d < 3; ++d) {
+    std::cerr << "d" << d << " RMS: plain " << rms(plain, d) << ", with offsets " << rms(offset, d)
+              << ", clean " << rms(clean, d) << "\n";
+    EXPECT_LT(rms(offset, d), 0.5 * rms(plain, d)) << "direction " << d;
+    EXPECT_LT(rms(offset, d), 1.5 * rms(clean, d) + 0.02e-6) << "direction " << d;
+  }
+  const Eigen::Vector3d cov = coverage(offset, s_->clean_truth);
+  EXPECT_GE(cov(1), 0.85);
+  EXPECT_GE(cov(2), 0.85);
+  EXPECT_FALSE(offset.recalibrate)
+      << "the offset is explained: alarm at " << offset.recalibrate_at_s << " s";
+  EXPECT_FALSE(clean.recalibrate);
+  // A negative or infinite offset spread is refused.
+  solvers::ObserverSetup bad = setup(with);
+  bad.noise.sensor_offset_walk_k = -0.1;
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
+}
+
+TEST_F(Observer, DriftSigmaGrowsWithTheDriftRowsRelativeError) {
+  // The drift rows' own error e (ObserverNoise::drift_relative_sigma): the reported sigma is
+  // sqrt(sigma_0^2 + (e d)^2), sigma_0 the filter's; the estimate is the same.
+  const core::CaseSpec c = run_spec();
+  solvers::ObserverNoise rel = default_noise();
+  rel.drift_relative_sigma = 0.05;
+  const auto& sys = s_->twin.model.system;
+  const solvers::ObserverRun plain =
+      solvers::observe(sys, c, setup(default_noise()), s_->clean.time, s_->clean.temperature);
+  const solvers::ObserverRun wide =
+      solvers::observe(sys, c, setup(rel), s_->clean.time, s_->clean.temperature);
+  EXPECT_EQ(wide.drift, plain.drift);
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i)
+    for (int d = 0; d < 3; ++d) {
+      const double s0 = plain.drift_sigma(i, d), e = 0.05 * plain.drift(i, d);
+      EXPECT_NEAR(wide.drift_sigma(i, d), std::sqrt(s0 * s0 + e * e), 1e-9 * s0 + 1e-15)
+          << "sample " << i << " direction " << d;
+    }
+  // Where the drift is large against the filter's sigma, the relative part dominates.
+  const Eigen::Index last = plain.times.size() - 1;
+  EXPECT_GT(wide.drift_sigma(last, 2), plain.drift_sigma(last, 2));
+}
+
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
   // The run sample by sample, its speed column read as it comes and two readings missing, gives
   // what the observer gives on the whole recorded run (its duty cycle from the same column).
