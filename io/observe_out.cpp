@@ -26,16 +26,17 @@ std::string observer_csv(const solvers::ObserverRun& r,
   return csv.str();
 }
 
-/// Each unknown input's final estimate and sigma (the air offset in K, heat inputs in W).
+/// Each unknown input's final estimate and sigma (heat inputs in W, the air's and the sensors'
+/// offsets in K).
 nlohmann::json unknown_inputs_json(const solvers::ObserverRun& r) {
   nlohmann::json unknown = nlohmann::json::object();
   const Eigen::Index last = r.times.size() - 1;
   for (std::size_t k = 0; k < r.unknown_input_names.size(); ++k) {
     const auto j = static_cast<Eigen::Index>(k);
-    const bool air = r.unknown_input_names[k] == "air";
+    const bool kelvin = r.unknown_input_kinds[k] != solvers::UnknownInputKind::heat;
     unknown[r.unknown_input_names[k]] = {
-        {air ? "final_K" : "final_W", r.unknown_inputs(last, j)},
-        {air ? "sigma_K" : "sigma_W", r.unknown_inputs_sigma(last, j)}};
+        {kelvin ? "final_K" : "final_W", r.unknown_inputs(last, j)},
+        {kelvin ? "sigma_K" : "sigma_W", r.unknown_inputs_sigma(last, j)}};
   }
   return unknown;
 }

@@ -308,6 +308,17 @@ void KalmanObserver::advance_to(double t) {
   }
 }
 
+std::vector<UnknownInputKind> KalmanObserver::unknown_input_kinds() const {
+  const Eigen::Index nh = heat_columns_.cols();
+  std::vector<UnknownInputKind> kinds(static_cast<std::size_t>(nb_));
+  for (Eigen::Index k = 0; k < nb_; ++k)
+    kinds[static_cast<std::size_t>(k)] =
+        k < nh ? UnknownInputKind::heat
+               : (offsets_ >= 0 && k >= offsets_ ? UnknownInputKind::sensor_offset
+                                                 : UnknownInputKind::air);
+  return kinds;
+}
+
 ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& readings) {
   const Eigen::Index m = setup_.sensor_rows.rows();
   if (readings.size() != m)
@@ -409,6 +420,7 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
   run.unknown_inputs.resize(n, nb);
   run.unknown_inputs_sigma.resize(n, nb);
   run.unknown_input_names = kf.unknown_inputs();
+  run.unknown_input_kinds = kf.unknown_input_kinds();
   for (Eigen::Index i = 0; i < n; ++i) {
     const ObserverEstimate e = kf.assimilate(times(i), readings.row(i).transpose());
     run.drift.row(i) = e.drift.transpose();

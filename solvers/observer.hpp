@@ -148,6 +148,9 @@ struct CovarianceMap {
   Eigen::MatrixXd process;     /// the same size: Q [K^2, W^2, ...]
 };
 
+/// What an unknown input is: a heat input [W], the air's offset [K] or a sensor's offset [K].
+enum class UnknownInputKind { heat, air, sensor_offset };
+
 /// The filter. Steps the case's loads (its duty cycle, feed axis, sinks and fluxes are its inputs)
 /// in steps of at most the case's step, equal between the load's switches and the readings, and
 /// assimilates readings as they come. It looks no further ahead than the next reading: the duty
@@ -171,6 +174,9 @@ class KalmanObserver {
   const Eigen::VectorXd& state() const { return x_; }  /// [z; b]
   const Eigen::MatrixXd& covariance() const { return p_; }
   const std::vector<std::string>& unknown_inputs() const { return bias_names_; }
+  /// Per unknown input, in the order of unknown_inputs(): heat inputs, then the air, then the
+  /// sensors' offsets.
+  std::vector<UnknownInputKind> unknown_input_kinds() const;
   Eigen::Index states() const { return r_; }
   const InnovationMonitor& monitor() const { return monitor_; }
 
@@ -205,6 +211,7 @@ struct ObserverRun {
   Eigen::MatrixXd states;                         /// r x #samples: the estimated reduced states
   Eigen::MatrixXd unknown_inputs, unknown_inputs_sigma;  /// #samples x #biases
   std::vector<std::string> unknown_input_names;
+  std::vector<UnknownInputKind> unknown_input_kinds;  /// per bias, in the order of the names
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// change point
   double recalibrate_at_s = std::numeric_limits<double>::quiet_NaN();     /// when it was raised
