@@ -71,6 +71,8 @@ struct Naming {
   std::vector<std::string> channel_ids;
   std::vector<TrainingRun> runs;
 };
+/// `cat`'s names: its first run's case, its readout's ids, its runs. (Inline, as `reported`: io
+/// describes a catalogue's fits with them without linking the choice.)
 inline Naming naming(const Catalogue& cat) {
   Naming n;
   if (!cat.runs.empty()) n.spec = cat.runs.front().spec;
@@ -93,8 +95,6 @@ struct ReportedEffect {
   std::vector<TestSink> test_sinks;  /// a claimed per-run air: per test run
 };
 /// `fit` of `cat`'s candidate as reported.
-/// (Inline, as the other two: io's descriptions of a catalogue's fits use them without linking the
-/// choice.)
 inline ReportedEffect reported(const Catalogue& cat, const EffectFit& fit, bool claimed) {
   const Candidate& c = cat.candidates.at(static_cast<size_t>(fit.candidate));
   // The candidate without its responses: what it is, where it acts, its parameters' names.

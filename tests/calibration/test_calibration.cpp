@@ -117,7 +117,7 @@ TEST(Augment, HeatInputCaseReadsBackAndMeshesWithTheNewGroup) {
     if (again.groups[k].name.rfind("heat_input_", 0) == 0) g = static_cast<int>(k);
   ASSERT_GE(g, 0);
   // The new group holds exactly the patch's faces (same mesh: groups do not change TetGen's input).
-  EXPECT_NEAR(rep.group_areas[g], patch->area, 1e-9);
+  EXPECT_NEAR(rep.group_areas[g], std::get<HeatInput>(patch->effect).area, 1e-9);
   EXPECT_EQ(m.nodes.rows(), s.mesh.nodes.rows());
 }
 
