@@ -489,16 +489,7 @@ std::vector<Patch> box_patches(const mesh::TetMesh& m, const ExteriorFaces& ext,
 /// A heat-input candidate on patch `p` under `law`, without columns.
 Candidate heat_candidate(const Patch& p, HeatLaw law, double ref_speed) {
   Candidate c;
-  HeatInput h;
-  h.law = law;
-  h.box_min = p.box_min;
-  h.box_max = p.box_max;
-  h.centre = p.centre;
-  h.area = p.area;
-  h.groups = p.groups;
-  h.body = p.body;
-  h.ref_speed_rpm = ref_speed;
-  c.effect = h;
+  c.effect = HeatInput{law, ref_speed, p.box_min, p.box_max, p.centre, p.area, p.groups, p.body};
   char buf[160];
   std::snprintf(buf, sizeof buf, "heat input at (%.3f, %.3f, %.3f) m, %s", p.centre(0), p.centre(1),
                 p.centre(2), law_name(law).c_str());
