@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -27,12 +26,16 @@ struct SensorCorrection {
 struct AugmentedCase {
   core::CaseSpec spec;
   std::vector<SensorCorrection> sensors;
+  /// Index in `spec.groups` of each boundary group of the case it was made from (a heat input
+  /// inserts groups); empty: the same indices.
+  std::vector<int> group_at;
 };
 
-/// `spec` with one fitted effect declared. Heat inputs become boundary groups (the patch's box
-/// intersected with each group it covers, inserted just before that group so they take its
-/// faces) with the covered group's convection and a surface flux; air temperature becomes sink
-/// tables; conductances, gains, coefficients and material values are changed in place.
+/// `spec` with one fitted effect declared (its indices those of the case `base` was made from).
+/// Heat inputs become boundary groups (the patch's box intersected with each group it covers,
+/// inserted just before that group so they take its faces) with the covered group's convection
+/// and a surface flux; air temperature becomes sink tables; conductances, gains, coefficients and
+/// material values are changed in place.
 AugmentedCase augmented_case(const AugmentedCase& base, const Candidate& c,
                              const std::vector<double>& parameters, const Readout& r);
 
@@ -55,37 +58,90 @@ struct TestRun {
   AugmentedCase augmented;
 };
 
+/// A training run as the report names it.
+struct TrainingRun {
+  std::string name;
+  bool air_from_sensor = false;  /// the run's air read from its ambient sensor, not fitted
+};
+
+/// What a report needs to name the places of a catalogue's candidates: the declared case (its
+/// groups, bodies, sources and materials), the channels' ids and the training runs.
+struct Naming {
+  core::CaseSpec spec;
+  std::vector<std::string> channel_ids;
+  std::vector<TrainingRun> runs;
+};
+/// `cat`'s names: its first run's case, its readout's ids, its runs. (Inline, as `reported`: io
+/// describes a catalogue's fits with them without linking the choice.)
+inline Naming naming(const Catalogue& cat) {
+  Naming n;
+  if (!cat.runs.empty()) n.spec = cat.runs.front().spec;
+  n.channel_ids = cat.readout.ids;
+  for (const auto& run : cat.runs) n.runs.push_back({run.name, run.air.size() > 0});
+  return n;
+}
+
+/// A claimed air's change on one test run: the sink of its first entry in the augmented case.
+struct TestSink {
+  std::string run;
+  core::TimeTable sink;  /// as the case holds it: [s], [degC]
+};
+
+/// A fitted candidate as reported: the candidate (without its columns and unit loads) and its fit.
+struct ReportedEffect {
+  Candidate candidate;
+  EffectFit fit;
+  bool claimed = false;
+  std::vector<TestSink> test_sinks;  /// a claimed per-run air: per test run
+};
+/// `fit` of `cat`'s candidate as reported.
+inline ReportedEffect reported(const Catalogue& cat, const EffectFit& fit, bool claimed) {
+  const Candidate& c = cat.candidates.at(static_cast<size_t>(fit.candidate));
+  // The candidate without its responses: what it is, where it acts, its parameters' names.
+  Candidate what{c.name, c.effect, c.parameters, c.per_run, c.fixed, {}, {}, {}, {}};
+  return {std::move(what), fit, claimed, {}};
+}
+
+/// Selection::ambiguous with its candidates.
+struct ReportedAmbiguity {
+  ReportedEffect first, second;
+  double difference = 0, spread = 0;  /// as in Ambiguity
+  int channel = -1;                   /// index into the channels
+  double channel_difference = 0;      /// [sigmas]
+};
+inline ReportedAmbiguity reported(const Catalogue& cat, const Ambiguity& a) {
+  return {reported(cat, a.first, false),
+          reported(cat, a.second, false),
+          a.difference,
+          a.spread,
+          a.channel,
+          a.channel_difference};
+}
+
+/// Selection::pairs with their candidates (the members' fits with the joint parameters).
+struct ReportedPair {
+  ReportedEffect first, second;
+  double score = 0, heldout_gain = 0;
+  std::vector<double> fold_gains;
+  double adds_first = 0, adds_second = 0;
+  bool admissible = false;
+};
+
 struct CalibrationResult {
   Selection selection;
   std::vector<TestRun> tests;
   RmsFigures before, after;
   std::vector<std::vector<double>> training_run_parameters;  /// per claimed effect, per-run fits
-  nlohmann::json effects;  /// claimed: {kind, parameters, location, explained_fraction, ...}
-  nlohmann::json runners_up;
-  /// Mechanisms the choice could not tell apart (Selection::ambiguous): each {candidates: [two
-  /// descriptions as in `effects`], score_difference, spread, distinguishing_channel, hint}.
-  nlohmann::json ambiguous;
-  /// Claims whose size refitted about the updated model is unphysical (Selection::refit_rejected),
-  /// described as in `effects`: not claimed.
-  nlohmann::json refit_rejected;
-  /// Selection::pairs: each {candidates: [two descriptions with the joint parameters], score,
-  /// heldout_gain, heldout_gain_per_training_run, adds_to_second_alone, adds_to_first_alone,
-  /// admissible}.
-  nlohmann::json pairs;
+  Naming naming;                        /// of the catalogue the claims were chosen from
+  std::vector<ReportedEffect> effects;  /// claimed, most important first
+  std::vector<ReportedEffect> runners_up;
+  /// Mechanisms the choice could not tell apart (Selection::ambiguous).
+  std::vector<ReportedAmbiguity> ambiguous;
+  /// Claims whose size refitted about the updated model is unphysical (Selection::refit_rejected):
+  /// not claimed.
+  std::vector<ReportedEffect> refit_rejected;
+  std::vector<ReportedPair> pairs;
 };
-
-/// The description of a fitted candidate in calibration.json (`effects`, `runners_up`): kind, name,
-/// location, parameters (a per-run air's per training run, with where its air came from), scores,
-/// `unphysical` when it is. A claimed air's test-run sink tables are added by calibrate().
-nlohmann::json effect_json(const Catalogue& cat, const EffectFit& fit, bool claimed);
-
-/// calibration.json's `ambiguous`: per Selection::ambiguous, {candidates: [two effect_json],
-/// score_difference, spread, distinguishing_channel {channel, rms_difference_sigmas}, hint}.
-nlohmann::json ambiguity_json(const Catalogue& cat, const Selection& selection);
-
-/// What measurement would tell candidates of kinds `a` and `b` apart (`a_candidate` and
-/// `b_candidate` their descriptions as in CalibrationResult::effects).
-std::string telling_apart(const nlohmann::json& a_candidate, const nlohmann::json& b_candidate);
 
 /// Selects effects on `train` (a catalogue built from the training runs) and evaluates the
 /// declared and the augmented model on `test` runs as the written case file reads back (the

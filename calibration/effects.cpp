@@ -51,16 +51,69 @@ Eigen::VectorXd solve_ridge(const Eigen::MatrixXd& g, const Eigen::VectorXd& b, 
 }
 
 bool nonlinear_in_parameter(const Candidate& c) {
-  switch (c.kind) {
+  switch (kind(c)) {
     case EffectKind::speed_dependent_convection:
     case EffectKind::boundary_conductance:
     case EffectKind::temperature_dependent_heat:
       return true;
     case EffectKind::material_parameter:
-      return c.field != "expansion";  // the readout's change is exact in it
+      return !changes_expansion(c);  // the readout's change is exact in it
     default:
       return false;
   }
+}
+
+bool changes_expansion(const Candidate& c) {
+  const auto* m = std::get_if<MaterialParameter>(&c.effect);
+  return m && m->field == MaterialField::expansion;
+}
+
+int sensor_of(const Candidate& c) {
+  if (const auto* o = std::get_if<SensorOffset>(&c.effect)) return o->sensor;
+  if (const auto* l = std::get_if<SensorLag>(&c.effect)) return l->sensor;
+  return -1;
+}
+
+namespace {
+
+/// Whether two alternatives of one kind act at one place.
+bool same_place_as(const AmbientTemperature& a, const AmbientTemperature& b) {
+  return a.entries == b.entries;
+}
+bool same_place_as(const HeatInput& a, const HeatInput& b) {
+  return a.centre == b.centre && a.box_min == b.box_min && a.box_max == b.box_max &&
+         a.area == b.area && a.groups == b.groups && a.body == b.body;
+}
+bool same_place_as(const SpeedDependentConvection& a, const SpeedDependentConvection& b) {
+  return a.entries == b.entries;
+}
+bool same_place_as(const TemperatureDependentHeat& a, const TemperatureDependentHeat& b) {
+  return a.sources == b.sources;
+}
+bool same_place_as(const BoundaryConductance& a, const BoundaryConductance& b) {
+  return a.entries == b.entries;
+}
+bool same_place_as(const MaterialParameter& a, const MaterialParameter& b) {
+  return a.material == b.material && a.field == b.field;
+}
+bool same_place_as(const SensorOffset& a, const SensorOffset& b) {
+  return a.sensor == b.sensor;
+}
+bool same_place_as(const SensorLag& a, const SensorLag& b) {
+  return a.sensor == b.sensor;
+}
+
+}  // namespace
+
+bool same_place(const Candidate& a, const Candidate& b) {
+  return std::visit(
+      [](const auto& x, const auto& y) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, std::decay_t<decltype(y)>>)
+          return same_place_as(x, y);
+        else
+          return false;
+      },
+      a.effect, b.effect);
 }
 
 namespace {
@@ -100,7 +153,7 @@ double knot_spacing(const std::vector<double>& knots) {
 
 /// The air change at `c`'s knots that the run's ambient sensor reads: least squares of the hats
 /// to the reading minus the sink of the candidate's first entry [K].
-Eigen::VectorXd air_from_sensor(const Candidate& c, const RunModel& run) {
+Eigen::VectorXd air_from_sensor(const AmbientTemperature& c, const RunModel& run) {
   const Eigen::Index p = static_cast<Eigen::Index>(c.knots.size());
   const double dk = knot_spacing(c.knots);
   const auto& sink = run.spec.thermal.convection.at(static_cast<size_t>(c.entries.at(0))).sink;
@@ -121,8 +174,9 @@ Eigen::VectorXd air_from_sensor(const Candidate& c, const RunModel& run) {
 /// normal equations (g, b).
 Eigen::VectorXd per_run_theta(const Candidate& c, const RunModel& run, const Eigen::MatrixXd& g,
                               const Eigen::VectorXd& b, const CalibrationOptions& o) {
-  if (run.air.size() > 0) return air_from_sensor(c, run);
-  return bounded_air(g, b, c.knots, o);
+  const auto& air = std::get<AmbientTemperature>(c.effect);
+  if (run.air.size() > 0) return air_from_sensor(air, run);
+  return bounded_air(g, b, air.knots, o);
 }
 
 /// Parameters of `c` fitted on run `ri` as `f` holds them (in-sample).
@@ -158,7 +212,7 @@ std::set<double> speeds_used(const std::vector<RunModel>& runs) {
 
 /// Correlation of a per-run air with the run's speed, each averaged over the knots' hats and
 /// centred per run, pooled over the runs.
-double duty_correlation(const Candidate& c, const std::vector<std::vector<double>>& air,
+double duty_correlation(const AmbientTemperature& c, const std::vector<std::vector<double>>& air,
                         const std::vector<RunModel>& runs) {
   const double dk = knot_spacing(c.knots);
   double sxy = 0, sxx = 0, syy = 0;
@@ -244,11 +298,38 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
                               double* correlation) {
   if (runs.empty()) return {};
   const core::CaseSpec& spec = runs.front().spec;
-  switch (c.kind) {
+  // A film's change on `entries` (weights per entry): the coefficient stays positive at every
+  // speed the runs use, and a gain growing with speed stays >= 0.
+  auto film_reason = [&](const std::vector<int>& entries, const std::vector<double>& weights,
+                         const SpeedDependentConvection* speed_law) -> std::string {
+    for (size_t k = 0; k < entries.size(); ++k) {
+      const core::Convection& cv = spec.thermal.convection.at(static_cast<size_t>(entries[k]));
+      const double change = p.at(0) * weights.at(k);
+      const std::string where =
+          entries.size() > 1 ? " on " + spec.groups.at(static_cast<size_t>(cv.group)).name : "";
+      if (speed_law && cv.h_speed_gain + change < 0)
+        return "a film falling with speed" + where + " (gain " + number(cv.h_speed_gain + change) +
+               " W/m2K at " + number(speed_law->ref_speed_rpm) + " rpm): the gain must be >= 0";
+      for (double n : speeds_used(runs)) {
+        const double h = solvers::film_coefficient(cv, n) +
+                         change * (speed_law ? (n > 0 ? std::pow(n / speed_law->ref_speed_rpm,
+                                                                 speed_law->speed_exponent)
+                                                      : 0.0)
+                                             : 1.0);
+        if (h <= 0)
+          return "film coefficient after the change" + where + " " + number(h) + " W/m2K at " +
+                 number(n) + " rpm: must be > 0";
+      }
+    }
+    return {};
+  };
+  switch (kind(c)) {
     case EffectKind::ambient_temperature: {
       bool fitted = false;  // the air of a run with an ambient sensor is read, not fitted
       for (size_t ri = 0; ri < runs.size(); ++ri) fitted |= runs[ri].air.size() == 0;
-      const double r = fitted ? duty_correlation(c, run_parameters, runs) : 0.0;
+      const double r =
+          fitted ? duty_correlation(std::get<AmbientTemperature>(c.effect), run_parameters, runs)
+                 : 0.0;
       if (correlation) *correlation = r;
       if (std::abs(r) >= o.air_duty_correlation)
         return "the fitted air follows the duty cycle (correlation " + number(r) +
@@ -257,48 +338,35 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
     }
     case EffectKind::heat_input:
       if (p.at(0) < 0)
-        return "a heat input of " + number(p.at(0) * c.area) + " W: heat cannot be negative";
+        return "a heat input of " + number(p.at(0) * std::get<HeatInput>(c.effect).area) +
+               " W: heat cannot be negative";
       return {};
-    case EffectKind::speed_dependent_convection:
-    case EffectKind::boundary_conductance: {
-      const bool speed_law = c.kind == EffectKind::speed_dependent_convection;
-      for (size_t k = 0; k < c.entries.size(); ++k) {
-        const core::Convection& cv = spec.thermal.convection.at(static_cast<size_t>(c.entries[k]));
-        const double change = p.at(0) * c.weights.at(k);
-        const std::string where =
-            c.entries.size() > 1 ? " on " + spec.groups.at(static_cast<size_t>(cv.group)).name : "";
-        if (speed_law && cv.h_speed_gain + change < 0)
-          return "a film falling with speed" + where + " (gain " +
-                 number(cv.h_speed_gain + change) + " W/m2K at " + number(c.ref_speed_rpm) +
-                 " rpm): the gain must be >= 0";
-        for (double n : speeds_used(runs)) {
-          const double h =
-              solvers::film_coefficient(cv, n) +
-              change * (speed_law ? (n > 0 ? std::pow(n / c.ref_speed_rpm, c.speed_exponent) : 0.0)
-                                  : 1.0);
-          if (h <= 0)
-            return "film coefficient after the change" + where + " " + number(h) + " W/m2K at " +
-                   number(n) + " rpm: must be > 0";
-        }
-      }
-      return {};
+    case EffectKind::speed_dependent_convection: {
+      const auto& e = std::get<SpeedDependentConvection>(c.effect);
+      return film_reason(e.entries, e.weights, &e);
     }
-    case EffectKind::temperature_dependent_heat:
-      for (size_t k = 0; k < c.entries.size(); ++k) {
-        const auto& src = spec.thermal.sources.at(static_cast<size_t>(c.entries[k]));
-        const double a = src.temperature_coefficient + p.at(0) * c.weights.at(k);
+    case EffectKind::boundary_conductance: {
+      const auto& e = std::get<BoundaryConductance>(c.effect);
+      return film_reason(e.entries, e.weights, nullptr);
+    }
+    case EffectKind::temperature_dependent_heat: {
+      const auto& e = std::get<TemperatureDependentHeat>(c.effect);
+      for (size_t k = 0; k < e.sources.size(); ++k) {
+        const auto& src = spec.thermal.sources.at(static_cast<size_t>(e.sources[k]));
+        const double a = src.temperature_coefficient + p.at(0) * e.weights.at(k);
         if (a < o.temperature_coefficient_min_per_K || a > o.temperature_coefficient_max_per_K)
           return "temperature coefficient after the change" +
-                 (c.entries.size() > 1 ? " of " + src.name : std::string()) + " " + number(a) +
+                 (e.sources.size() > 1 ? " of " + src.name : std::string()) + " " + number(a) +
                  " 1/K: outside " + number(o.temperature_coefficient_min_per_K) + " .. " +
                  number(o.temperature_coefficient_max_per_K) + " 1/K";
       }
       return {};
+    }
     case EffectKind::material_parameter:
       if (p.at(0) < o.material_change_min || p.at(0) > o.material_change_max)
-        return c.field + " changed by " + number(100 * p.at(0)) + " %: outside " +
-               number(100 * o.material_change_min) + " .. " + number(100 * o.material_change_max) +
-               " %";
+        return field_name(std::get<MaterialParameter>(c.effect).field) + " changed by " +
+               number(100 * p.at(0)) + " %: outside " + number(100 * o.material_change_min) +
+               " .. " + number(100 * o.material_change_max) + " %";
       return {};
     case EffectKind::sensor_offset:
     case EffectKind::sensor_lag:
@@ -309,6 +377,26 @@ std::string unphysical_reason(const Candidate& c, const std::vector<double>& p,
 
 std::string kind_name(EffectKind kind) {
   return std::string(core::name_in(kEffectKindNames, kind));
+}
+
+std::string law_name(HeatLaw law) {
+  return std::string(core::name_in(kHeatLawNames, law));
+}
+
+std::string field_name(MaterialField field) {
+  return std::string(core::name_in(kMaterialFieldNames, field));
+}
+
+double& material_value(core::Material& m, MaterialField field) {
+  switch (field) {
+    case MaterialField::conductivity:
+      return m.conductivity;
+    case MaterialField::heat_capacity:
+      return m.specific_heat;
+    case MaterialField::expansion:
+      break;
+  }
+  return m.expansion;
 }
 
 Eigen::VectorXd lagged(const Eigen::VectorXd& times, const Eigen::VectorXd& x, double tau) {
@@ -398,31 +486,16 @@ std::vector<Patch> box_patches(const mesh::TetMesh& m, const ExteriorFaces& ext,
   return out;
 }
 
-/// A heat-input candidate on patch `p` under `law` ("speed" or "constant"), without columns.
-Candidate heat_candidate(const Patch& p, const std::string& law, double ref_speed,
-                         const core::CaseSpec& spec) {
+/// A heat-input candidate on patch `p` under `law`, without columns.
+Candidate heat_candidate(const Patch& p, HeatLaw law, double ref_speed) {
   Candidate c;
-  c.kind = EffectKind::heat_input;
-  c.law = law;
-  c.box_min = p.box_min;
-  c.box_max = p.box_max;
-  c.area = p.area;
-  c.body = p.body;
-  c.ref_speed_rpm = ref_speed;
+  c.effect = HeatInput{law, ref_speed, p.box_min, p.box_max, p.centre, p.area, p.groups, p.body};
   char buf[160];
   std::snprintf(buf, sizeof buf, "heat input at (%.3f, %.3f, %.3f) m, %s", p.centre(0), p.centre(1),
-                p.centre(2), law.c_str());
+                p.centre(2), law_name(law).c_str());
   c.name = buf;
-  nlohmann::json groups = nlohmann::json::array();
-  for (int g : p.groups) groups.push_back(spec.groups[g].name);
-  c.location = {{"centre_m", {p.centre(0), p.centre(1), p.centre(2)}},
-                {"box_min_m", {p.box_min(0), p.box_min(1), p.box_min(2)}},
-                {"box_max_m", {p.box_max(0), p.box_max(1), p.box_max(2)}},
-                {"area_m2", p.area},
-                {"groups", groups}};
-  if (p.body >= 0) c.location["body"] = spec.bodies[p.body].name;
-  c.parameters = {law == "speed" ? "flux_W_m2 at " + std::to_string(ref_speed) + " rpm"
-                                 : "flux_W_m2"};
+  c.parameters = {law == HeatLaw::speed ? "flux_W_m2 at " + std::to_string(ref_speed) + " rpm"
+                                        : "flux_W_m2"};
   return c;
 }
 
@@ -430,8 +503,9 @@ SeparableColumn heat_column(const mesh::TetMesh& m, const Patch& p, const Candid
   SeparableColumn col;
   col.name = c.name;
   col.shape = face_load(m, p.faces);
-  const double ref_speed = c.ref_speed_rpm;
-  if (c.law == "speed")
+  const HeatInput& h = std::get<HeatInput>(c.effect);
+  const double ref_speed = h.ref_speed_rpm;
+  if (h.law == HeatLaw::speed)
     col.law = [ref_speed](double, double speed) { return speed > 0 ? speed / ref_speed : 0.0; };
   else
     col.law = [](double, double) { return 1.0; };
@@ -441,13 +515,10 @@ SeparableColumn heat_column(const mesh::TetMesh& m, const Patch& p, const Candid
 /// The lag candidate of sensor `s` with time constant `tau` [s]: one fixed column per run.
 Candidate lag_candidate(const std::vector<RunModel>& runs, const Readout& r, int s, double tau) {
   Candidate l;
-  l.kind = EffectKind::sensor_lag;
-  l.sensor = s;
+  l.effect = SensorLag{s, tau};
   l.fixed = true;
-  l.time_constant = tau;
   l.name = "lag of sensor " + r.ids[s] + " (" + std::to_string(static_cast<int>(std::lround(tau))) +
            " s)";
-  l.location = {{"sensor", r.ids[s]}};
   l.parameters = {"time_constant_s"};
   for (const auto& rm : runs) {
     Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
@@ -465,26 +536,29 @@ Candidate lag_candidate(const std::vector<RunModel>& runs, const Readout& r, int
 std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
                                            const core::CaseSpec& declared, double ref_speed) {
   const auto& conv = declared.thermal.convection;
-  auto single = [&](EffectKind kind, int entry) -> const Candidate* {
+  // The places (convection entries, heat sources) a film or heat candidate acts on.
+  auto places = [](const Candidate& c) -> const std::vector<int>* {
+    if (const auto* e = std::get_if<SpeedDependentConvection>(&c.effect)) return &e->entries;
+    if (const auto* e = std::get_if<BoundaryConductance>(&c.effect)) return &e->entries;
+    if (const auto* e = std::get_if<TemperatureDependentHeat>(&c.effect)) return &e->sources;
+    return nullptr;
+  };
+  auto single = [&](EffectKind k, int entry) -> const Candidate* {
     for (const auto& c : cands)
-      if (c.kind == kind && c.entries == std::vector<int>{entry}) return &c;
+      if (kind(c) == k && places(c) && *places(c) == std::vector<int>{entry}) return &c;
     return nullptr;
   };
   std::vector<Candidate> added;
-  auto add = [&](EffectKind kind, const std::vector<int>& entries,
+  auto add = [&](const Effect& effect, const std::vector<int>& entries,
                  const std::vector<double>& weights, const std::string& name,
-                 const nlohmann::json& location, const std::string& parameter) {
+                 const std::string& parameter) {
     if (entries.size() < 2) return;
     Candidate c;
-    c.kind = kind;
-    c.entries = entries;
-    c.weights = weights;
-    c.ref_speed_rpm = ref_speed;
+    c.effect = effect;
     c.name = name;
-    c.location = location;
     c.parameters = {parameter};
     for (size_t k = 0; k < entries.size(); ++k) {
-      const Candidate* one = single(kind, entries[k]);
+      const Candidate* one = single(kind(effect), entries[k]);
       if (!one) return;
       for (size_t ri = 0; ri < one->columns.size(); ++ri) {
         if (c.columns.size() <= ri)
@@ -500,38 +574,32 @@ std::vector<Candidate> with_several_places(std::vector<Candidate> cands,
   };
   std::vector<int> all, free;
   std::vector<double> h_all, h_free;
-  nlohmann::json g_all = nlohmann::json::array(), g_free = nlohmann::json::array();
   const auto& fixed = declared.mechanical.fixed_groups;
   for (size_t e = 0; e < conv.size(); ++e) {
-    const std::string g = declared.groups[conv[e].group].name;
     all.push_back(static_cast<int>(e));
     h_all.push_back(conv[e].h);
-    g_all.push_back(g);
     if (std::find(fixed.begin(), fixed.end(), conv[e].group) == fixed.end()) {
       free.push_back(static_cast<int>(e));
       h_free.push_back(conv[e].h);
-      g_free.push_back(g);
     }
   }
   const std::string at_ref = " at " + std::to_string(ref_speed) + " rpm";
   for (int v = 0; v < 2; ++v) {
     const auto& entries = v ? free : all;
+    const auto& shares = v ? h_free : h_all;
     if (v && free.size() == all.size()) break;
     const std::string which = v ? "every film of an unfixed group" : "every film";
-    const nlohmann::json where = {{"groups", v ? g_free : g_all}, {"share_of_h", true}};
-    add(EffectKind::speed_dependent_convection, entries, v ? h_free : h_all,
-        which + " growing with speed by one share of its h", where, "h_speed_gain / h" + at_ref);
-    add(EffectKind::boundary_conductance, entries, v ? h_free : h_all,
-        which + " changed by one share of its h", where, "delta_h / h");
+    add(SpeedDependentConvection{entries, shares, ref_speed, 1}, entries, shares,
+        which + " growing with speed by one share of its h", "h_speed_gain / h" + at_ref);
+    add(BoundaryConductance{entries, shares}, entries, shares,
+        which + " changed by one share of its h", "delta_h / h");
   }
   std::vector<int> sources;
-  nlohmann::json names = nlohmann::json::array();
-  for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
+  for (size_t i = 0; i < declared.thermal.sources.size(); ++i)
     sources.push_back(static_cast<int>(i));
-    names.push_back(declared.thermal.sources[i].name);
-  }
-  add(EffectKind::temperature_dependent_heat, sources, std::vector<double>(sources.size(), 1.0),
-      "heat of every source growing with its temperature by one coefficient", {{"sources", names}},
+  const std::vector<double> ones(sources.size(), 1.0);
+  add(TemperatureDependentHeat{sources, ones}, sources, ones,
+      "heat of every source growing with its temperature by one coefficient",
       "temperature_coefficient_per_K");
   for (auto& c : added) cands.push_back(std::move(c));
   return cands;
@@ -625,19 +693,14 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
   if (!free.empty() && free.size() != all.size()) variants.push_back(free);
   for (size_t v = 0; v < variants.size(); ++v) {
     Candidate c;
-    c.kind = EffectKind::ambient_temperature;
+    c.effect = AmbientTemperature{variants[v], knots};
     c.per_run = true;
-    c.knots = knots;
-    c.entries = variants[v];
     c.name = v == 0 ? "air temperature on every convective sink"
                     : "air temperature on the sinks of unfixed groups";
-    nlohmann::json groups = nlohmann::json::array();
-    for (int e : c.entries) groups.push_back(declared.groups[conv[e].group].name);
-    c.location = {{"convection_groups", groups}};
     Source src{Source::load, {}};
     for (size_t k = 0; k < knots.size(); ++k) {
       c.parameters.push_back("delta_air_K at t = " + std::to_string(knots[k]) + " s");
-      const std::vector<int> entries = c.entries;
+      const std::vector<int> entries = variants[v];
       const double tk = knots[k], dk = end_max / intervals;
       src.index.push_back(static_cast<int>(loads.size()));
       // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
@@ -653,8 +716,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
   if (!ambient_only) {
     // Heat entering through an undeclared surface patch, under each law.
     for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
-      for (const std::string law : {"speed", "constant"}) {
-        Candidate c = heat_candidate(p, law, ref_speed, declared);
+      for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
+        Candidate c = heat_candidate(p, law, ref_speed);
         sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
         sep.push_back(heat_column(m, p, c));
         c.unit_separable = {sep.back()};
@@ -667,13 +730,12 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       const std::string gname = declared.groups[conv[e].group].name;
       for (int speed_law = 0; speed_law < 2; ++speed_law) {
         Candidate c;
-        c.kind =
-            speed_law ? EffectKind::speed_dependent_convection : EffectKind::boundary_conductance;
-        c.entries = {static_cast<int>(e)};
-        c.weights = {1};
-        c.ref_speed_rpm = ref_speed;
+        const std::vector<int> entry{static_cast<int>(e)};
+        if (speed_law)
+          c.effect = SpeedDependentConvection{entry, {1}, ref_speed, 1};
+        else
+          c.effect = BoundaryConductance{entry, {1}};
         c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
-        c.location = {{"group", gname}};
         c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
                                   : "delta_h_W_m2K"};
         LoadColumn lc;
@@ -691,11 +753,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
       const auto& srcspec = declared.thermal.sources[i];
       Candidate c;
-      c.kind = EffectKind::temperature_dependent_heat;
-      c.entries = {static_cast<int>(i)};
-      c.weights = {1};
+      c.effect = TemperatureDependentHeat{{static_cast<int>(i)}, {1}};
       c.name = "heat of " + srcspec.name + " growing with its temperature";
-      c.location = {{"source", srcspec.name}, {"body", declared.bodies[srcspec.body].name}};
       c.parameters = {"temperature_coefficient_per_K"};
       LoadColumn lc;
       lc.name = c.name;
@@ -717,26 +776,25 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
       const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
       if (km->norm() == 0) continue;  // a material no body uses
       const std::string mname = declared.materials[mi].name;
-      for (const std::string field : {"conductivity", "heat_capacity", "expansion"}) {
-        if (field == "expansion" && (r.displacement.rows() == 0 || !declared.mechanical.enabled))
+      for (const auto& [field, fname] : kMaterialFieldNames) {
+        if (field == MaterialField::expansion &&
+            (r.displacement.rows() == 0 || !declared.mechanical.enabled))
           continue;
         Candidate c;
-        c.kind = EffectKind::material_parameter;
-        c.material = static_cast<int>(mi);
-        c.field = field;
-        c.name = field + " of " + mname;
-        c.location = {{"material", mname}, {"field", field}};
+        c.effect = MaterialParameter{static_cast<int>(mi), field};
+        c.name = std::string(fname) + " of " + mname;
         c.parameters = {"relative_change"};
-        if (field == "expansion") {
+        if (field == MaterialField::expansion) {
           // The probes' rows gain the material's part per unit relative change.
           extra.push_back(r.expansion.at(mi));
           sources.push_back({Source::extra_readout, {static_cast<int>(extra.size()) - 1}});
         } else {
           // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
           OperatorChange change;
-          change.which = field == "conductivity" ? OperatorChange::Operator::conduction
-                                                 : OperatorChange::Operator::capacity;
-          change.full = field == "conductivity" ? km : cm;
+          const bool conductivity = field == MaterialField::conductivity;
+          change.which = conductivity ? OperatorChange::Operator::conduction
+                                      : OperatorChange::Operator::capacity;
+          change.full = conductivity ? km : cm;
           if (model.is_reduced())
             change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
           LoadColumn lc;
@@ -793,10 +851,8 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
   if (!ambient_only) {
     for (int s = 0; s < r.sensors; ++s) {
       Candidate c;
-      c.kind = EffectKind::sensor_offset;
-      c.sensor = s;
+      c.effect = SensorOffset{s};
       c.name = "offset of sensor " + r.ids[s];
-      c.location = {{"sensor", r.ids[s]}};
       c.parameters = {"offset_K"};
       for (const auto& rm : cat.runs) {
         Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
@@ -833,7 +889,7 @@ AirEliminated air_eliminated(const Candidate* air, const RunModel& run, const Re
   out.a = whitened_rows(air->columns[ri], w, sigma);
   out.keep = temperature_rows(w, r);
   if (run.air.size() > 0) {  // read from the ambient sensor: nothing to fit
-    out.y -= out.a * air_from_sensor(*air, run);
+    out.y -= out.a * air_from_sensor(std::get<AmbientTemperature>(air->effect), run);
     return out;
   }
   const Eigen::MatrixXd at = rows_of(out.a, out.keep);
@@ -909,7 +965,7 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
     const Candidate& c = cat.candidates[ci];
     EffectFit& f = fits[fi];
     f.candidate = static_cast<int>(ci);
-    f.kind = c.kind;
+    f.kind = kind(c);
     f.name = c.name;
     const double p = static_cast<double>(c.columns.front().cols());
     std::vector<Normal> normals(nr);
@@ -928,7 +984,7 @@ std::vector<EffectFit> score_all(const Catalogue& cat, const std::vector<Whitene
       insample = heldout;
       f.heldout_gain = heldout;
       f.score = heldout - o.penalty_per_parameter;
-      f.parameters = {c.time_constant};
+      f.parameters = {std::get<SensorLag>(c.effect).time_constant_s};
     } else if (c.per_run) {
       for (size_t ri = 0; ri < nr; ++ri) {
         // Fit on the run's temperatures, score on all of its channels.
@@ -1244,20 +1300,19 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
                                    const std::vector<EffectFit>& others) {
   Catalogue out = cat;
   if (out.runs.empty()) return out;
-  const core::CaseSpec& spec = out.runs.front().spec;
   const mesh::TetMesh& m = model.mesh();
   const Eigen::VectorXd sigma = noise_sigma(out.runs, out.readout.sensors, o);
   const auto [ws, all] = whitened_runs(out.runs, sigma);
   const std::vector<Eigen::VectorXd> ys = without_fits(out, ws, all, sigma, others, o);
   const ExteriorFaces ext = exterior_faces(m);
   const double half = o.patch_half_size * o.heat_refine_half_scale;
-  std::set<std::pair<std::string, std::vector<int>>> seen;
+  std::set<std::pair<HeatLaw, std::vector<int>>> seen;
   double spacing = o.patch_spacing;
   for (int level = 0; level < o.heat_refine_levels; ++level) {
     spacing /= 3;
     std::vector<int> heat;
     for (size_t ci = 0; ci < out.candidates.size(); ++ci)
-      if (out.candidates[ci].kind == EffectKind::heat_input) heat.push_back(static_cast<int>(ci));
+      if (kind(out.candidates[ci]) == EffectKind::heat_input) heat.push_back(static_cast<int>(ci));
     if (heat.empty()) return out;
     const std::vector<EffectFit> fits = score_all(out, ws, ys, sigma, o, false, heat);
     std::vector<size_t> order(fits.size());
@@ -1265,11 +1320,12 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
     std::sort(order.begin(), order.end(),
               [&](size_t a, size_t b) { return fits[a].score > fits[b].score; });
     // The best places (a box scored under both laws counts once), each with its best law.
-    std::vector<const Candidate*> parents;
+    std::vector<const HeatInput*> parents;
     for (size_t i : order) {
-      const Candidate& c = out.candidates[static_cast<size_t>(fits[i].candidate)];
+      const auto& c =
+          std::get<HeatInput>(out.candidates[static_cast<size_t>(fits[i].candidate)].effect);
       const Eigen::Vector3d centre = 0.5 * (c.box_min + c.box_max);
-      const bool again = std::any_of(parents.begin(), parents.end(), [&](const Candidate* p) {
+      const bool again = std::any_of(parents.begin(), parents.end(), [&](const HeatInput* p) {
         return (0.5 * (p->box_min + p->box_max) - centre).norm() < 1e-9;
       });
       if (!again) parents.push_back(&c);
@@ -1277,7 +1333,7 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
     }
     std::vector<Candidate> added;
     std::vector<SeparableColumn> sep;
-    for (const Candidate* parent : parents) {
+    for (const HeatInput* parent : parents) {
       const Eigen::Vector3d centre = 0.5 * (parent->box_min + parent->box_max);
       std::vector<Eigen::Vector3d> centres;
       for (int i = -1; i <= 1; ++i)
@@ -1286,7 +1342,7 @@ Catalogue with_refined_heat_inputs(const MarchModel& model, const Catalogue& cat
             centres.push_back(centre + spacing * Eigen::Vector3d(i, j, k));
       for (const Patch& p : box_patches(m, ext, centres, half)) {
         if (!seen.insert({parent->law, p.faces}).second) continue;
-        Candidate c = heat_candidate(p, parent->law, parent->ref_speed_rpm, spec);
+        Candidate c = heat_candidate(p, parent->law, parent->ref_speed_rpm);
         sep.push_back(heat_column(m, p, c));
         c.unit_separable = {sep.back()};
         c.unit_weights = {1};
@@ -1310,13 +1366,14 @@ Catalogue with_speed_exponents(const MarchModel& model, const Catalogue& cat, in
                                const CalibrationOptions& o) {
   Catalogue out = cat;
   const Candidate& parent = cat.candidates.at(static_cast<size_t>(candidate));
-  if (parent.kind != EffectKind::speed_dependent_convection) return out;
+  const auto* film = std::get_if<SpeedDependentConvection>(&parent.effect);
+  if (!film) return out;
   std::vector<Candidate> added;
   std::vector<LoadColumn> loads;
   for (double x : o.speed_exponent_grid) {
-    if (std::abs(x - parent.speed_exponent) < 1e-9) continue;
+    if (std::abs(x - film->speed_exponent) < 1e-9) continue;
     Candidate c = parent;
-    c.speed_exponent = x;
+    std::get<SpeedDependentConvection>(c.effect).speed_exponent = x;
     c.name = parent.name + " (speed^" + number(x) + ")";
     c.columns.clear();
     for (auto& lc : c.unit_loads) {
@@ -1445,11 +1502,13 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     if (round == 0) {
       first_fits = fits;
       first_order = order;
-      std::set<std::string> places;
+      std::vector<const Candidate*> places;
       for (int i : order) {
         const Candidate& c = cat.candidates[i];
-        const std::string key = kind_name(c.kind) + c.location.dump();
-        if (!places.insert(key).second) continue;
+        if (std::any_of(places.begin(), places.end(),
+                        [&](const Candidate* p) { return same_place(*p, c); }))
+          continue;
+        places.push_back(&c);
         sel.ranking.push_back(fits[i]);
         if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
       }

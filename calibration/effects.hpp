@@ -6,9 +6,10 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "calibration/model.hpp"
@@ -116,30 +117,110 @@ struct RunModel {
   Eigen::VectorXd air;       /// #samples: the run's ambient sensor [K], NaN missing; empty: none
 };
 
-/// A candidate effect: its identity, where it acts, and its channel responses per run.
+/// How a heat input's flux follows the spindle: in proportion to speed, or constant.
+enum class HeatLaw { speed, constant };
+/// The laws' names in calibration.json and candidate names.
+inline constexpr std::array<core::Named<HeatLaw>, 2> kHeatLawNames{{
+    {HeatLaw::speed, "speed"},
+    {HeatLaw::constant, "constant"},
+}};
+static_assert(core::one_to_one(kHeatLawNames));
+/// The law's name in kHeatLawNames.
+std::string law_name(HeatLaw law);
+
+/// The material value a material_parameter candidate changes.
+enum class MaterialField { conductivity, heat_capacity, expansion };
+/// The fields' names in calibration.json and candidate names.
+inline constexpr std::array<core::Named<MaterialField>, 3> kMaterialFieldNames{{
+    {MaterialField::conductivity, "conductivity"},
+    {MaterialField::heat_capacity, "heat_capacity"},
+    {MaterialField::expansion, "expansion"},
+}};
+static_assert(core::one_to_one(kMaterialFieldNames));
+/// The field's name in kMaterialFieldNames.
+std::string field_name(MaterialField field);
+/// The value of `m` that `field` changes: conductivity [W/(m K)], specific heat [J/(kg K)] (the
+/// heat capacity's relative change at a fixed density), expansion [1/K].
+double& material_value(core::Material& m, MaterialField field);
+
+// Where and how each kind of effect acts: one alternative per EffectKind (in its order), holding
+// indices into the declared case (convection entries, heat sources, boundary groups, bodies,
+// materials) or into the readout (sensors). Names are the edge's business (io/).
+
+/// The air: hat functions at `knots` on the sinks of `entries` (convection entries).
+struct AmbientTemperature {
+  std::vector<int> entries;
+  std::vector<double> knots;  /// [s]
+};
+/// Heat through a patch of the surface: the faces of `groups` (boundary groups) bounding `body`
+/// whose centroids lie in the box.
+struct HeatInput {
+  HeatLaw law = HeatLaw::constant;
+  double ref_speed_rpm = 0;  /// law speed: the flux is the parameter times speed / ref_speed_rpm
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  /// area-weighted face centroid [m]
+  double area = 0;                                   /// [m^2]
+  std::vector<int> groups;
+  int body = -1;  /// -1: every body the groups bound
+};
+/// Films (convection entries `entries`) whose coefficient grows with speed: each entry's gain
+/// changes by the parameter times its weight (1 for a single place; its declared h for one share
+/// of h everywhere), following (speed / ref_speed_rpm)^speed_exponent.
+struct SpeedDependentConvection {
+  std::vector<int> entries;
+  std::vector<double> weights;
+  double ref_speed_rpm = 0, speed_exponent = 1;
+};
+/// Heat of the sources `sources` growing with their temperature: each coefficient [1/K] changes
+/// by the parameter times its weight.
+struct TemperatureDependentHeat {
+  std::vector<int> sources;
+  std::vector<double> weights;
+};
+/// Films (convection entries `entries`) whose h changes by the parameter times its weight
+/// [W/(m^2 K)].
+struct BoundaryConductance {
+  std::vector<int> entries;
+  std::vector<double> weights;
+};
+/// A relative change of one value of material `material`.
+struct MaterialParameter {
+  int material = -1;
+  MaterialField field = MaterialField::conductivity;
+};
+/// A constant added to sensor `sensor`'s reading [K].
+struct SensorOffset {
+  int sensor = -1;
+};
+/// A first-order lag of sensor `sensor`'s reading.
+struct SensorLag {
+  int sensor = -1;
+  double time_constant_s = 0;
+};
+using Effect =
+    std::variant<AmbientTemperature, HeatInput, SpeedDependentConvection, TemperatureDependentHeat,
+                 BoundaryConductance, MaterialParameter, SensorOffset, SensorLag>;
+static_assert(std::variant_size_v<Effect> == kEffectKindNames.size());
+static_assert(
+    std::is_same_v<std::variant_alternative_t<static_cast<size_t>(EffectKind::sensor_lag), Effect>,
+                   SensorLag>);
+static_assert(
+    std::is_same_v<
+        std::variant_alternative_t<static_cast<size_t>(EffectKind::material_parameter), Effect>,
+        MaterialParameter>);
+
+/// The kind an effect's alternative is.
+inline EffectKind kind(const Effect& e) {
+  return static_cast<EffectKind>(e.index());
+}
+
+/// A candidate effect: what it is and where it acts, and its channel responses per run.
 struct Candidate {
-  EffectKind kind = EffectKind::heat_input;
   std::string name;
-  nlohmann::json location;
+  Effect effect = HeatInput{};
   std::vector<std::string> parameters;  /// names with units
   bool per_run = false;                 /// parameters fitted run by run (an unknown signal)
   bool fixed = false;                   /// one column whose amplitude is 1 (a lag filter)
-  // What the augmented case needs.
-  /// Film kinds: the convection entries the change acts on; temperature_dependent_heat: the heat
-  /// sources; the air: the entries whose sinks move. One for a single place, several for a
-  /// mechanism that acts in several places at once with one parameter.
-  std::vector<int> entries;
-  /// Per entry (film kinds, temperature_dependent_heat): its change per unit parameter (gain or
-  /// Δh [W/(m^2 K)], coefficient [1/K]); 1 for a single place.
-  std::vector<double> weights;
-  int material = -1, sensor = -1;
-  int body = -1;           /// heat input: the body whose faces take the heat
-  std::string law, field;  /// heat-input law; material field
-  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  double area = 0, ref_speed_rpm = 0, time_constant = 0;
-  /// speed_dependent_convection: the gain follows (speed / ref_speed_rpm)^speed_exponent.
-  double speed_exponent = 1;
-  std::vector<double> knots;  /// ambient hat knots [s]
   std::vector<Eigen::MatrixXd>
       columns;  /// per run: (#samples #channels) x #parameters (column-major channels)
   /// A one-parameter candidate's unit loads: their responses times `unit_weights` (separable
@@ -150,6 +231,16 @@ struct Candidate {
   std::vector<LoadColumn> unit_loads;
   std::vector<double> unit_weights;
 };
+inline EffectKind kind(const Candidate& c) {
+  return kind(c.effect);
+}
+/// Whether `c` changes a material's expansion (its readout's change is exact: no march).
+bool changes_expansion(const Candidate& c);
+/// The sensor `c` acts on (offset, lag); -1 for other kinds.
+int sensor_of(const Candidate& c);
+/// Whether `a` and `b` are of one kind and act at one place (a heat input under either law, a
+/// sensor's lag at any time constant): the ranking keeps the best of each.
+bool same_place(const Candidate& a, const Candidate& b);
 
 /// Channel histories of the declared model for each run and the catalogue of candidate effects
 /// with their responses (one march per run with every unit load as a column).

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
@@ -166,10 +168,11 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
     }
     case EffectKind::material_parameter: {
       // The materials of the two largest bodies (housing, shaft), where a wrong value matters.
-      const char* fields[] = {"conductivity", "heat_capacity", "expansion"};
       const int body = pick(rng, std::min(2, static_cast<int>(declared.bodies.size())));
       const int mi = declared.bodies[body].material;
-      e.target = declared.materials[mi].name + "." + fields[pick(rng, 3)];
+      const auto field =
+          static_cast<size_t>(pick(rng, static_cast<int>(kMaterialFieldNames.size())));
+      e.target = declared.materials[mi].name + "." + std::string(kMaterialFieldNames[field].name);
       // Within the calibrator's physical bounds (a factor of 1.5 either way), with room for the
       // linearised fit's error.
       e.magnitude = signed_factor(rng, 0.15, 0.4);
@@ -219,15 +222,19 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
     }
     case EffectKind::heat_input: {
       // Every group the box covers gets its part (the case format's way to put heat on faces).
+      HeatInput h;
+      h.box_min = e.box_min;
+      h.box_max = e.box_max;
+      h.law = e.follows_speed ? HeatLaw::speed : HeatLaw::constant;
+      h.ref_speed_rpm = 3000;
+      h.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
+      // The drawn effect names its groups (InjectedEffect is written as truth.json).
+      for (const auto& name : e.groups)
+        for (size_t g = 0; g < s.groups.size(); ++g)
+          if (s.groups[g].name == name) h.groups.push_back(static_cast<int>(g));
       Candidate c;
-      c.kind = EffectKind::heat_input;
-      c.box_min = e.box_min;
-      c.box_max = e.box_max;
-      c.law = e.follows_speed ? "speed" : "constant";
-      c.ref_speed_rpm = 3000;
-      c.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
-      c.location = {{"groups", e.groups}};
-      AugmentedCase a{s, {}};
+      c.effect = h;
+      AugmentedCase a{s, {}, {}};
       a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
       s = a.spec;
       break;
@@ -249,15 +256,13 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
     case EffectKind::material_parameter: {
       const auto dot = e.target.find('.');
       const std::string name = e.target.substr(0, dot), field = e.target.substr(dot + 1);
-      for (auto& mat : s.materials) {
-        if (mat.name != name) continue;
-        if (field == "conductivity")
-          mat.conductivity *= 1 + e.magnitude;
-        else if (field == "heat_capacity")
-          mat.specific_heat *= 1 + e.magnitude;
-        else
-          mat.expansion *= 1 + e.magnitude;
-      }
+      const std::optional<MaterialField> f = core::value_in(kMaterialFieldNames, field);
+      if (!f)
+        throw std::invalid_argument("injected material_parameter target '" + e.target +
+                                    "': field '" + field + "' is not " +
+                                    core::names_list(kMaterialFieldNames));
+      for (auto& mat : s.materials)
+        if (mat.name == name) material_value(mat, *f) *= 1 + e.magnitude;
       break;
     }
     case EffectKind::sensor_offset:

@@ -41,7 +41,7 @@ struct Claims {
   }
   bool changes_operators() const {
     for (size_t k = 0; k < fits.size(); ++k)
-      if (candidate(k).kind == EffectKind::material_parameter && candidate(k).field != "expansion")
+      if (kind(candidate(k)) == EffectKind::material_parameter && !changes_expansion(candidate(k)))
         return true;
     return false;
   }
@@ -52,10 +52,10 @@ struct Claims {
 /// Heat inputs stay out: they need new boundary groups, and the march carries them as columns.
 AugmentedCase updated_case(const core::CaseSpec& base, const Claims& cl,
                            const Eigen::VectorXd& theta, size_t ri) {
-  AugmentedCase aug{base, {}};
+  AugmentedCase aug{base, {}, {}};
   for (size_t k = 0; k < cl.fits.size(); ++k) {
     const Candidate& c = cl.candidate(k);
-    if (c.kind == EffectKind::heat_input) continue;
+    if (kind(c) == EffectKind::heat_input) continue;
     std::vector<double> p = cl.fits[k].parameters;
     if (c.per_run) p = cl.fits[k].run_parameters.at(ri);
     if (cl.slot[k] >= 0) p = {theta(cl.slot[k])};
@@ -103,9 +103,10 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
       where[k].load_w.push_back(c.unit_weights.at(ns + j));
       loads.push_back(c.unit_loads[j]);
     }
-    if (c.kind == EffectKind::material_parameter && c.field == "expansion") {
+    if (changes_expansion(c)) {
       where[k].extra = static_cast<int>(extra.size());
-      extra.push_back(r.expansion.at(static_cast<size_t>(c.material)));
+      extra.push_back(
+          r.expansion.at(static_cast<size_t>(std::get<MaterialParameter>(c.effect).material)));
     }
   }
   const Responses rs = march(model_u, aug.spec, ru, rm.times, sep, loads, extra);
@@ -113,7 +114,7 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
   // The heat inputs' share of the prediction, then the sensors' own corrections.
   Eigen::MatrixXd prediction = rs.base;
   for (size_t k = 0; k < cl.fits.size(); ++k)
-    if (cl.candidate(k).kind == EffectKind::heat_input)
+    if (kind(cl.candidate(k)) == EffectKind::heat_input)
       for (size_t j = 0; j < where[k].sep.size(); ++j)
         prediction += theta(cl.slot[k]) * where[k].sep_w[j] *
                       rs.columns[static_cast<size_t>(where[k].sep[j])];
@@ -130,7 +131,7 @@ Step linearised_on_run(const MarchModel& model_u, const core::CaseSpec& declared
     for (size_t j = 0; j < where[k].load.size(); ++j)
       col += where[k].load_w[j] * rs.columns[sep.size() + static_cast<size_t>(where[k].load[j])];
     if (where[k].extra >= 0) col = rs.extra[static_cast<size_t>(where[k].extra)];
-    if (c.kind == EffectKind::sensor_offset) col.col(c.sensor).setOnes();
+    if (kind(c) == EffectKind::sensor_offset) col.col(sensor_of(c)).setOnes();
     jac.col(cl.slot[k]) = vec(corrected(col, rm.times, r, lags));
   }
   RunModel now = rm;
@@ -397,8 +398,7 @@ Selection refit_claimed(const MarchModel& model, const core::CaseSpec& declared,
       const Candidate& c = cat.candidates.at(static_cast<size_t>(f.candidate));
       const bool shared = !c.per_run && !c.fixed && f.parameters.size() == 1 &&
                           (!c.unit_separable.empty() || !c.unit_loads.empty() ||
-                           c.kind == EffectKind::sensor_offset ||
-                           (c.kind == EffectKind::material_parameter && c.field == "expansion"));
+                           kind(c) == EffectKind::sensor_offset || changes_expansion(c));
       cl.slot.push_back(shared ? next++ : -1);
     }
     if (!wants_refit(cl) || o.refit_max_iterations <= 0) return sel;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "io/atomic_dir.hpp"
+#include "io/calibration_effects_out.hpp"
 #include "io/calibration_head.hpp"
 #include "io/case_reader.hpp"
 #include "io/model_out.hpp"
@@ -141,30 +142,31 @@ void refits_markdown(std::ostream& md, const json& effects) {
          << "\n";
 }
 
-void effects_markdown(std::ostream& md, const calibration::CalibrationResult& res) {
-  if (res.effects.empty()) {
-    if (res.ambiguous.empty())
+/// `sel`: calibration.json's account of the choice (selection_json).
+void effects_markdown(std::ostream& md, const json& sel, double null_score) {
+  if (sel["effects"].empty()) {
+    if (sel["ambiguous"].empty())
       md << "No effect claimed: no physical candidate's held-out gain beat both the noise "
             "threshold ("
-         << res.selection.null_score << ") and its model-form floor.\n\n";
+         << null_score << ") and its model-form floor.\n\n";
   } else {
     md << "## Claimed effects\n\n";
-    for (const auto& e : res.effects)
+    for (const auto& e : sel["effects"])
       md << "- **" << e["kind"].get<std::string>() << "**: " << e["name"].get<std::string>()
          << "; explained fraction " << e["explained_fraction"].get<double>() << "; score "
-         << e["score"].get<double>() << " (noise threshold " << res.selection.null_score
-         << ", floor " << e["model_form_floor"].get<double>() << ")\n  - parameters: `"
-         << e["parameters"].dump() << "`\n  - location: `" << e["location"].dump() << "`\n";
-    refits_markdown(md, res.effects);
+         << e["score"].get<double>() << " (noise threshold " << null_score << ", floor "
+         << e["model_form_floor"].get<double>() << ")\n  - parameters: `" << e["parameters"].dump()
+         << "`\n  - location: `" << e["location"].dump() << "`\n";
+    refits_markdown(md, sel["effects"]);
   }
-  for (const auto& e : res.refit_rejected)
+  for (const auto& e : sel["refit_rejected"])
     md << "- not claimed: " << e["name"].get<std::string>() << ", whose size refitted about "
        << "the updated model is unphysical (" << e.value("unphysical", "") << ")\n";
   md << "\n## Runners-up\n\nA candidate marked unphysical needs a value outside its bounds "
         "(docs/calibration.md) to fit and is never claimed, however well it scores.\n\n"
         "| kind | name | explained fraction | score | unphysical |\n| --- | --- | --- | --- | --- "
         "|\n";
-  for (const auto& e : res.runners_up)
+  for (const auto& e : sel["runners_up"])
     md << "| " << e["kind"].get<std::string>() << " | " << e["name"].get<std::string>() << " | "
        << e["explained_fraction"].get<double>() << " | " << e["score"].get<double>() << " | "
        << e.value("unphysical", "") << " |\n";
@@ -189,8 +191,9 @@ std::string report_markdown(const studies::ModelCalibrationReport& report) {
      << " |\n";
   md << "| after | " << res.after.temperature_rms_K << " | " << res.after.displacement_rms_um
      << " |\n\n";
-  ambiguous_markdown(md, res.ambiguous);
-  effects_markdown(md, res);
+  const json sel = selection_json(res);
+  ambiguous_markdown(md, sel["ambiguous"]);
+  effects_markdown(md, sel, res.selection.null_score);
   md << "\n## Figures\n\n![residual before and after](residual_before_after.png)\n\n![identified "
         "effect](effect.png)\n\n";
   md << "The augmented case for each test run is in `augmented/`; `augmented_case.toml` is the "
@@ -207,11 +210,19 @@ json selection_json(const calibration::CalibrationResult& res) {
   json sigma = json::array();
   for (Eigen::Index c = 0; c < res.selection.sigma.size(); ++c)
     sigma.push_back(res.selection.sigma(c));
-  return {{"effects", res.effects},
-          {"runners_up", res.runners_up},
-          {"ambiguous", res.ambiguous},
-          {"refit_rejected", res.refit_rejected},
-          {"pairs", res.pairs},
+  const calibration::Naming& names = res.naming;
+  json effects = json::array(), runners_up = json::array(), ambiguous = json::array(),
+       refit_rejected = json::array(), pairs = json::array();
+  for (const auto& e : res.effects) effects.push_back(effect_json(e, names));
+  for (const auto& e : res.runners_up) runners_up.push_back(effect_json(e, names));
+  for (const auto& a : res.ambiguous) ambiguous.push_back(ambiguity_json(a, names));
+  for (const auto& e : res.refit_rejected) refit_rejected.push_back(effect_json(e, names));
+  for (const auto& p : res.pairs) pairs.push_back(pair_json(p, names));
+  return {{"effects", effects},
+          {"runners_up", runners_up},
+          {"ambiguous", ambiguous},
+          {"refit_rejected", refit_rejected},
+          {"pairs", pairs},
           {"claimed_by",
            res.selection.by_pair ? "the best pair scored jointly" : "one effect after the other"},
           {"decision",

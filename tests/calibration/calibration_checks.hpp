@@ -7,6 +7,7 @@
 #include <string>
 
 #include "calibration_fixture.hpp"
+#include "io/calibration_model_out.hpp"
 
 namespace tt::calibration::testing {
 
@@ -20,6 +21,11 @@ struct Outcome {
   CalibrationResult result;
   io::MeasuredRun truth;  /// the test run's noise-free readings
 };
+
+/// calibration.json's `effects` of `res`: the claims as written.
+inline nlohmann::json claims_json(const CalibrationResult& res) {
+  return io::selection_json(res)["effects"];
+}
 
 /// Generates the draw `effects` (the first is the one judged for place), calibrates with them
 /// undeclared and returns the outcome, printing the ranking, the claims and the figures.
@@ -65,7 +71,8 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   for (const auto& a : res.selection.ambiguous)
     std::printf("[calibration]   ambiguous: %s / %s (difference %.1f, spread %.1f)\n",
                 a.first.name.c_str(), a.second.name.c_str(), a.difference, a.spread);
-  for (const auto& c : res.effects)
+  const nlohmann::json claims = claims_json(res);
+  for (const auto& c : claims)
     if (c.contains("refit") && c["refit"].contains("linearised"))
       std::printf("[calibration] refit of %s: linearised %s, refitted %s in %d steps%s; %s\n",
                   c["name"].get<std::string>().c_str(), c["refit"]["linearised"].dump().c_str(),
@@ -73,10 +80,10 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
                   c["refit"]["converged"].get<bool>() ? "" : " (cap)",
                   c["refit"].value("heldout_check", nlohmann::json{}).dump().c_str());
   Outcome out;
-  out.first = res.effects.empty() ? "none" : res.effects[0]["kind"].get<std::string>();
+  out.first = claims.empty() ? "none" : claims[0]["kind"].get<std::string>();
   if (out.first == "sensor_lag")
     std::printf("[calibration] lag found %.4g s\n",
-                res.effects[0]["parameters"]["time_constant_s"].get<double>());
+                claims[0]["parameters"]["time_constant_s"].get<double>());
   for (const auto& e : effects)
     std::printf("[calibration] %s magnitude %.4g target '%s'%s\n", kind_name(e.kind).c_str(),
                 e.magnitude, e.target.c_str(),
@@ -87,8 +94,8 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
               before, after, sensor_kind ? "K" : "um");
   out.right = kinds.count(out.first) > 0;
   for (const auto& a : res.selection.ambiguous)
-    out.ambiguous |= res.effects.empty() && (kinds.count(kind_name(a.first.kind)) > 0 ||
-                                             kinds.count(kind_name(a.second.kind)) > 0);
+    out.ambiguous |= claims.empty() && (kinds.count(kind_name(a.first.kind)) > 0 ||
+                                        kinds.count(kind_name(a.second.kind)) > 0);
   out.before = before;
   out.after = after;
   out.units = sensor_kind ? "K" : "um";
@@ -128,10 +135,11 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
   const InjectedEffect e = random_effect(kind, s.declared, s.gen_mesh, s.inst.sensor_points, rng);
   const Outcome out = calibrated(s, {e}, rng);
   const CalibrationResult& res = out.result;
-  ASSERT_FALSE(res.effects.empty()) << "no effect claimed";
-  EXPECT_EQ(out.first, kind_name(kind)) << res.effects.dump(1);
+  const nlohmann::json claims = claims_json(res);
+  ASSERT_FALSE(claims.empty()) << "no effect claimed";
+  EXPECT_EQ(out.first, kind_name(kind)) << claims.dump(1);
   if (kind == EffectKind::heat_input && out.first == "heat_input") {
-    const auto c = res.effects[0]["location"]["centre_m"];
+    const auto c = claims[0]["location"]["centre_m"];
     const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
     const double err = (found - e.centre).norm();
     std::printf(
@@ -148,7 +156,7 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
 /// before.
 inline void check_draw(const Study& s, const InjectedEffects& effects, std::mt19937_64& rng) {
   const Outcome out = calibrated(s, effects, rng);
-  EXPECT_TRUE(out.right || out.ambiguous) << out.result.effects.dump(1);
+  EXPECT_TRUE(out.right || out.ambiguous) << claims_json(out.result).dump(1);
   if (out.right) EXPECT_LE(out.after, 0.3 * out.before);
 }
 

@@ -11,9 +11,14 @@
 
 #include "calibration/calibrate.hpp"
 #include "core/rng.hpp"
+#include "io/calibration_effects_out.hpp"
 
 namespace tt::calibration {
 namespace {
+
+using io::ambiguity_json;
+using io::effect_json;
+using io::telling_apart;
 
 constexpr double kAmbientK = 293.15;
 
@@ -29,6 +34,14 @@ RunModel run_model(const std::string& name, double hours, double block_s, int sh
   int k = shift;
   for (double t = 0; t < rm.spec.duty_cycle.end; t += block_s)
     rm.spec.duty_cycle.segments.push_back({t, speeds[k++ % 4]});
+  // One body of one material, one boundary group with one film, one heat source: the places the
+  // hand-made candidates act on, named in their descriptions.
+  rm.spec.materials.resize(1);
+  rm.spec.materials[0].name = "cast_iron";
+  rm.spec.bodies.resize(1);
+  rm.spec.bodies[0].name = "housing";
+  rm.spec.groups.resize(1);
+  rm.spec.groups[0].name = "film";
   core::Convection cv;
   cv.group = 0;
   cv.h = 8;
@@ -37,6 +50,7 @@ RunModel run_model(const std::string& name, double hours, double block_s, int sh
   rm.spec.thermal.convection = {cv};
   core::HeatSource src;
   src.name = "bearing";
+  src.body = 0;
   rm.spec.thermal.sources = {src};
   rm.base = Eigen::MatrixXd::Constant(n, 1, kAmbientK + 5);
   rm.measured = rm.base;
@@ -67,16 +81,39 @@ void add_noise(RunModel& rm, double sigma, std::uint64_t seed) {
 Candidate candidate(EffectKind kind, const std::string& name,
                     const std::vector<Eigen::VectorXd>& column_per_run) {
   Candidate c;
-  c.kind = kind;
   c.name = name;
-  c.location = {{"name", name}};
   c.parameters = {"p"};
-  c.entries = {0};  // the one film, the one source
-  c.weights = {1};
-  c.material = 0;
-  c.field = "conductivity";
-  c.area = 0.01;
-  c.ref_speed_rpm = 3000;
+  // The one film, the one source, the one material, the one sensor.
+  switch (kind) {
+    case EffectKind::ambient_temperature:
+      c.effect = AmbientTemperature{{0}, {}};
+      break;
+    case EffectKind::heat_input: {
+      HeatInput h;
+      h.area = 0.01;
+      h.ref_speed_rpm = 3000;
+      c.effect = h;
+      break;
+    }
+    case EffectKind::speed_dependent_convection:
+      c.effect = SpeedDependentConvection{{0}, {1}, 3000, 1};
+      break;
+    case EffectKind::temperature_dependent_heat:
+      c.effect = TemperatureDependentHeat{{0}, {1}};
+      break;
+    case EffectKind::boundary_conductance:
+      c.effect = BoundaryConductance{{0}, {1}};
+      break;
+    case EffectKind::material_parameter:
+      c.effect = MaterialParameter{0, MaterialField::conductivity};
+      break;
+    case EffectKind::sensor_offset:
+      c.effect = SensorOffset{0};
+      break;
+    case EffectKind::sensor_lag:
+      c.effect = SensorLag{0, 0};
+      break;
+  }
   for (const auto& col : column_per_run) c.columns.emplace_back(col);
   return c;
 }
@@ -85,23 +122,23 @@ Candidate candidate(EffectKind kind, const std::string& name,
 /// first-order lag of 1200 s, as it follows the films' heat.
 Candidate air_candidate(const std::vector<RunModel>& runs, double spacing) {
   Candidate c;
-  c.kind = EffectKind::ambient_temperature;
   c.name = "air";
   c.per_run = true;
-  c.entries = {0};
+  std::vector<double> knots;
   const double end = runs.front().times(runs.front().times.size() - 1);
-  for (double t = 0; t <= end + 1e-9; t += spacing) c.knots.push_back(t);
+  for (double t = 0; t <= end + 1e-9; t += spacing) knots.push_back(t);
+  c.effect = AmbientTemperature{{0}, knots};
   for (const auto& rm : runs) {
-    Eigen::MatrixXd a(rm.times.size(), static_cast<Eigen::Index>(c.knots.size()));
+    Eigen::MatrixXd a(rm.times.size(), static_cast<Eigen::Index>(knots.size()));
     for (Eigen::Index k = 0; k < a.cols(); ++k) {
       Eigen::VectorXd h(rm.times.size());
       for (Eigen::Index i = 0; i < h.size(); ++i)
-        h(i) = std::max(0.0, 1 - std::abs(rm.times(i) - c.knots[static_cast<size_t>(k)]) / spacing);
+        h(i) = std::max(0.0, 1 - std::abs(rm.times(i) - knots[static_cast<size_t>(k)]) / spacing);
       a.col(k) = lagged(rm.times, h, 1200) - Eigen::VectorXd::Constant(h.size(), h(0));
     }
     c.columns.push_back(a);
   }
-  for (size_t k = 0; k < c.knots.size(); ++k) c.parameters.push_back("delta_air_K");
+  for (size_t k = 0; k < knots.size(); ++k) c.parameters.push_back("delta_air_K");
   return c;
 }
 
@@ -228,8 +265,9 @@ TEST(Air, ReadFromTheAmbientSensor) {
   const Candidate& c = cat.candidates[static_cast<size_t>(read.claimed[0].candidate)];
   const std::vector<double> p =
       fit_run_parameters(c, 1, cat.runs[1], cat.readout, read.sigma, s.options);
-  for (size_t k = 0; k < c.knots.size(); ++k)
-    EXPECT_NEAR(p[k], 1.5 * std::sin(c.knots[k] / 4000.0 + 1), 0.05) << "knot " << k;
+  const std::vector<double>& knots = std::get<AmbientTemperature>(c.effect).knots;
+  for (size_t k = 0; k < knots.size(); ++k)
+    EXPECT_NEAR(p[k], 1.5 * std::sin(knots[k] / 4000.0 + 1), 0.05) << "knot " << k;
 }
 
 // The residual is a conductivity of the housing lowered by 60 %; conductivity, a heat input and a
@@ -286,7 +324,7 @@ TEST(Ambiguity, KindsTheRunsCannotSeparate) {
   auto with = [&](double on_a, double on_b) {
     Catalogue cat = one_channel(runs);
     cat.candidates.push_back(candidate(EffectKind::heat_input, "heat input", x));
-    cat.candidates.back().location = {{"centre_m", {0.1, 0.2, 0.3}}};
+    std::get<HeatInput>(cat.candidates.back().effect).centre = {0.1, 0.2, 0.3};
     cat.candidates.push_back(candidate(EffectKind::material_parameter, "conductivity",
                                        {2.5 * (x[0] + on_a * w[0]), 2.5 * (x[1] + on_b * w[1])}));
     return cat;
@@ -411,22 +449,24 @@ TEST(Pairs, AnAirAndTheMechanismItShadowsAreFittedTogether) {
     ASSERT_EQ(f.run_parameters.size(), runs.size());
     // The hats sum to one and the channel sees the air through a lag from its start: a constant
     // change is not seen here (it is in a thermal model), so the knots are compared to the first.
+    const std::vector<double>& knots = std::get<AmbientTemperature>(air.effect).knots;
     for (size_t r = 0; r < runs.size(); ++r)
-      for (size_t k = 1; k < air.knots.size(); ++k)
-        EXPECT_NEAR(f.run_parameters[r][k] - f.run_parameters[r][0],
-                    ramp_K[r] * air.knots[k] / 10800, 0.05)
+      for (size_t k = 1; k < knots.size(); ++k)
+        EXPECT_NEAR(f.run_parameters[r][k] - f.run_parameters[r][0], ramp_K[r] * knots[k] / 10800,
+                    0.05)
             << "run " << r << " knot " << k;
   }
 }
 
 TEST(Ambiguity, HintNamesTheAmbientSensorAndADutyCycle) {
-  const nlohmann::json air = {{"kind", "ambient_temperature"},
-                              {"location", nlohmann::json::object()},
-                              {"parameters", nlohmann::json::object()}};
-  const nlohmann::json speed = {{"kind", "speed_dependent_convection"},
-                                {"location", {{"group", "air_gap"}}},
-                                {"parameters", nlohmann::json::object()}};
-  const std::string h = telling_apart(air, speed);
+  Naming names;
+  names.spec.groups.resize(1);
+  names.spec.groups[0].name = "air_gap";
+  names.spec.thermal.convection.resize(1);
+  Candidate air, speed;
+  air.effect = AmbientTemperature{{0}, {}};
+  speed.effect = SpeedDependentConvection{{0}, {1}, 3000, 1};
+  const std::string h = telling_apart(air, speed, names);
   EXPECT_NE(h.find("ambient_sensor"), std::string::npos) << h;
   EXPECT_NE(h.find("duty cycle"), std::string::npos) << h;
 }

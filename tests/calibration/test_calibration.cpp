@@ -69,7 +69,9 @@ TEST(Lag, RefinedBetweenGridValues) {
   ASSERT_EQ(fine.candidates.size(), static_cast<size_t>(o.lag_refine_steps - 2));
   const Selection sel = select_effects(fine, o);
   ASSERT_FALSE(sel.claimed.empty());
-  const double tau = fine.candidates[static_cast<size_t>(sel.claimed[0].candidate)].time_constant;
+  const double tau =
+      std::get<SensorLag>(fine.candidates[static_cast<size_t>(sel.claimed[0].candidate)].effect)
+          .time_constant_s;
   EXPECT_NEAR(tau, 269, 0.05 * 269);
 }
 
@@ -99,13 +101,13 @@ TEST(Augment, HeatInputCaseReadsBackAndMeshesWithTheNewGroup) {
   const Study& s = study();
   const Candidate* patch = nullptr;
   for (const auto& c : s.train.candidates)
-    if (c.kind == EffectKind::heat_input && c.location["groups"].size() == 1 &&
-        c.location["groups"][0] == "housing_outer") {
+    if (const auto* h = std::get_if<HeatInput>(&c.effect);
+        h && h->groups.size() == 1 && s.declared.groups.at(h->groups[0]).name == "housing_outer") {
       patch = &c;
       break;
     }
   ASSERT_NE(patch, nullptr);
-  const AugmentedCase a = augmented_case({s.declared, {}}, *patch, {100.0}, s.train.readout);
+  const AugmentedCase a = augmented_case({s.declared, {}, {}}, *patch, {100.0}, s.train.readout);
   const core::CaseSpec again = io::case_from_toml(io::resolved_case_toml(a.spec), "augmented.toml");
   ASSERT_EQ(again.groups.size(), s.declared.groups.size() + 1);
   const mesh::TetMesh m = mesh::mesh_case(again);
@@ -115,7 +117,7 @@ TEST(Augment, HeatInputCaseReadsBackAndMeshesWithTheNewGroup) {
     if (again.groups[k].name.rfind("heat_input_", 0) == 0) g = static_cast<int>(k);
   ASSERT_GE(g, 0);
   // The new group holds exactly the patch's faces (same mesh: groups do not change TetGen's input).
-  EXPECT_NEAR(rep.group_areas[g], patch->area, 1e-9);
+  EXPECT_NEAR(rep.group_areas[g], std::get<HeatInput>(patch->effect).area, 1e-9);
   EXPECT_EQ(m.nodes.rows(), s.mesh.nodes.rows());
 }
 
@@ -185,6 +187,7 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   const auto runs = speed_on_every_film(s, s.inst, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  const nlohmann::json written = io::selection_json(res);  // calibration.json's account
   for (const auto& f : res.selection.ranking)
     std::printf("[calibration]   %s score %.1f duty correlation %.3f %s\n", f.name.c_str(), f.score,
                 f.duty_correlation, f.unphysical.c_str());
@@ -192,15 +195,16 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
   const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
   std::printf("[calibration] claimed %s; test RMS u %.4g -> %.4g um\n",
-              res.effects.empty() ? "none" : res.effects[0]["name"].get<std::string>().c_str(),
+              written["effects"].empty() ? "none"
+                                         : written["effects"][0]["name"].get<std::string>().c_str(),
               b.displacement_rms_um, a.displacement_rms_um);
-  for (const auto& e : res.effects) EXPECT_NE(e["kind"], "ambient_temperature");
+  for (const auto& e : written["effects"]) EXPECT_NE(e["kind"], "ambient_temperature");
   bool air_reported = false;
-  for (const auto& e : res.runners_up)
+  for (const auto& e : written["runners_up"])
     air_reported |= e["kind"] == "ambient_temperature" && e.contains("unphysical");
-  EXPECT_TRUE(air_reported) << res.runners_up.dump(1);
-  ASSERT_FALSE(res.effects.empty()) << io::selection_json(res).dump(1);
-  EXPECT_EQ(res.effects[0]["kind"], "speed_dependent_convection");
+  EXPECT_TRUE(air_reported) << written["runners_up"].dump(1);
+  ASSERT_FALSE(written["effects"].empty()) << io::selection_json(res).dump(1);
+  EXPECT_EQ(written["effects"][0]["kind"], "speed_dependent_convection");
 }
 
 // With an ambient sensor the air is read: a changing shop air is claimed from the sensor (no
@@ -224,9 +228,10 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
   for (size_t k = 0; k < 2; ++k) with_air.runs[k].air = ambient_reading(runs[k]);
   ASSERT_EQ(with_air.runs[0].air.size(), with_air.runs[0].times.size());
   const CalibrationResult res = calibrate(*s.model, s.declared, with_air, {runs[2]}, s.copt);
-  ASSERT_FALSE(res.effects.empty());
-  EXPECT_EQ(res.effects[0]["kind"], "ambient_temperature");
-  for (const auto& run : res.effects[0]["parameters"]["per_training_run"])
+  const nlohmann::json written = io::selection_json(res);  // calibration.json's account
+  ASSERT_FALSE(written["effects"].empty());
+  EXPECT_EQ(written["effects"][0]["kind"], "ambient_temperature");
+  for (const auto& run : written["effects"][0]["parameters"]["per_training_run"])
     EXPECT_EQ(run["air"], "ambient sensor");
   const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
   const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
@@ -255,8 +260,9 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   const auto runs = testing::effect_runs(s, {e}, rng, &clean);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
-  ASSERT_FALSE(res.effects.empty()) << io::selection_json(res).dump(1);
-  const nlohmann::json& claim = res.effects[0];
+  const nlohmann::json written = io::selection_json(res);  // calibration.json's account
+  ASSERT_FALSE(written["effects"].empty()) << io::selection_json(res).dump(1);
+  const nlohmann::json& claim = written["effects"][0];
   ASSERT_EQ(claim["kind"], "temperature_dependent_heat") << claim.dump(1);
   EXPECT_EQ(claim["location"]["source"], "front_bearing_friction");
   ASSERT_TRUE(claim.contains("refit")) << claim.dump(1);
@@ -316,6 +322,7 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
   }
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  const nlohmann::json written = io::selection_json(res);  // calibration.json's account
   const Eigen::MatrixXd truth = measured_channels(clean[2], s.train.readout);
   const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
   const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
@@ -330,14 +337,14 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
     std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f %s\n",
                 p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
                 p.admissible ? "admissible" : "");
-  for (const auto& e : res.effects)
+  for (const auto& e : written["effects"])
     std::printf("[calibration]   claimed %s: %s, refit %s\n", e["name"].get<std::string>().c_str(),
                 e["parameters"].dump().c_str(), e.value("refit", nlohmann::json{}).dump().c_str());
   std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
               res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
               a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
-  ASSERT_EQ(res.effects.size(), 2u) << io::selection_json(res).dump(1);
-  std::set<std::string> kinds{res.effects[0]["kind"], res.effects[1]["kind"]};
+  ASSERT_EQ(written["effects"].size(), 2u) << io::selection_json(res).dump(1);
+  std::set<std::string> kinds{written["effects"][0]["kind"], written["effects"][1]["kind"]};
   EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
   EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
