@@ -2,11 +2,13 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <set>
 #include <string>
 
 #include "calibration_fixture.hpp"
+#include "core/timing.hpp"
 #include "io/calibration_model_out.hpp"
 
 namespace tt::calibration::testing {
@@ -17,6 +19,7 @@ struct Outcome {
   /// Right first, or nothing claimed and reported ambiguous between a true kind and another.
   bool right = false, ambiguous = false;
   double before = 0, after = 0;  /// test-run RMS against the noise-free truth [um, or K]
+  double calibrate_s = 0;        /// wall time of calibrate (choice, refit, test run) [s]
   std::string units;
   CalibrationResult result;
   io::MeasuredRun truth;  /// the test run's noise-free readings
@@ -33,7 +36,9 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   std::vector<io::MeasuredRun> noiseless;
   const auto runs = testing::effect_runs(s, effects, rng, &noiseless);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
+  const auto t0 = std::chrono::steady_clock::now();
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
+  const double calibrate_s = core::seconds_since(t0);
   // RMS against the test run's noise-free truth: no model removes the sensors' noise.
   const io::MeasuredRun& truth = noiseless[2];
   const Eigen::MatrixXd clean = measured_channels(truth, s.train.readout);
@@ -99,6 +104,7 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   out.before = before;
   out.after = after;
   out.units = sensor_kind ? "K" : "um";
+  out.calibrate_s = calibrate_s;
   out.result = res;
   out.truth = truth;
   return out;
