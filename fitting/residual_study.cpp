@@ -452,6 +452,77 @@ double heldout_rss(const std::vector<Segment>& segments, int target, const Basel
          (kMicrometresPerMetre * kMicrometresPerMetre);
 }
 
+namespace {
+
+/// The best setting of every kind not yet used, as an untested effect, with the grid searched.
+struct Candidates {
+  std::vector<Effect> tested;
+  std::vector<std::vector<EffectTerm>> grids;
+};
+
+/// One greedy step's candidates on the workspace `w` whose held-out RSS is `rss` (`baseline_rss`
+/// the baseline's).
+Candidates step_candidates(const std::vector<TermKind>& used, const std::vector<int>& sensors,
+                           int sensor_count, bool has_speed, const std::vector<Segment>& training,
+                           const Workspace& w, double rss, double baseline_rss,
+                           const ResidualStudyOptions& options) {
+  const std::vector<TermKind> kinds{
+      TermKind::speed_dependent_offset, TermKind::lagged_speed,   TermKind::lag,
+      TermKind::ambient_temperature,    TermKind::missing_sensor, TermKind::drift_in_time};
+  Candidates c;
+  for (TermKind kind : kinds) {
+    if (std::find(used.begin(), used.end(), kind) != used.end()) continue;
+    const auto grid = term_grid(kind, sensors, sensor_count, options, has_speed);
+    if (grid.empty()) continue;
+    const auto [best, best_rss] = best_of_grid(grid, sensors, training, w);
+    Effect e;
+    e.term = grid[static_cast<std::size_t>(best)];
+    e.parameters = parameter_count(e.term, sensors);
+    e.step_fraction = (rss - best_rss) / rss;
+    e.explained_fraction = (rss - best_rss) / baseline_rss;
+    e.null_fraction = std::numeric_limits<double>::quiet_NaN();
+    c.tested.push_back(e);
+    c.grids.push_back(grid);
+  }
+  return c;
+}
+
+/// Judges one candidate against chance and across segments: its null share from `null_draws`
+/// surrogate searches over its grid (surrogate streams taken from `stream` on), its per-segment
+/// gain t and held-out RMS before and after [m] over the `rows` training samples. Whether it is
+/// claimed (its margin beyond the parameter penalty, `margin`, exceeds the null and the gain t
+/// exceeds min_gain_t).
+bool claimed_effect(Effect& e, double margin, const std::vector<EffectTerm>& grid,
+                    const std::vector<int>& sensors, const std::vector<Segment>& training,
+                    const Workspace& w, double rss, Eigen::Index rows,
+                    const ResidualStudyOptions& options, std::uint64_t& stream) {
+  double null = -std::numeric_limits<double>::infinity();
+  for (int draw = 0; draw < options.null_draws; ++draw) {
+    const double null_rss =
+        best_of_grid(grid, sensors, training, w, std::make_pair(options.seed, stream++)).second;
+    null = std::max(null, (rss - null_rss) / rss);
+  }
+  // A share that no surrogate reaches is still no evidence when it is negative: the threshold
+  // is never below zero.
+  e.null_fraction = std::max(null, 0.0);
+  // The gain must also hold from segment to segment, not come from one of them: the mean
+  // per-segment held-out gain must exceed min_gain_t standard errors.
+  std::vector<Eigen::MatrixXd> nothing;
+  for (const auto& t : training) nothing.emplace_back(t.group.time.size(), 0);
+  const Eigen::VectorXd before_rss = rss_per_segment_with(w, nothing);
+  const Eigen::VectorXd with_rss = rss_per_segment_with_term(e.term, sensors, training, w);
+  const Eigen::VectorXd gains = nested_gains(grid, sensors, training, w, before_rss);
+  e.gain_t = gain_t(gains);
+  e.segments_improved = static_cast<int>((gains.array() > 0.0).count());
+  e.heldout_rms_before =
+      std::sqrt(before_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
+  e.heldout_rms_after =
+      std::sqrt(with_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
+  return margin > e.null_fraction && e.gain_t > options.min_gain_t;
+}
+
+}  // namespace
+
 ChannelStudy residual_study(const std::vector<Segment>& training, int target,
                             const Baseline& baseline, const ResidualStudyOptions& options) {
   require_segments(training, target);
@@ -481,30 +552,14 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
   // 2. Greedy: add the term that removes the largest share of the held-out residual, if chance
   //    (phase-randomised surrogates of the same term, searched over the same settings) does not do
   //    as well.
-  const std::vector<TermKind> kinds{
-      TermKind::speed_dependent_offset, TermKind::lagged_speed,   TermKind::lag,
-      TermKind::ambient_temperature,    TermKind::missing_sensor, TermKind::drift_in_time};
   std::vector<EffectTerm> terms;
   std::vector<TermKind> used;
   std::uint64_t stream = 0;
   for (int step = 0; step < options.max_effects && rss > 0.0; ++step) {
     const Workspace w = workspace(training, target, baseline, terms);
-    std::vector<Effect> tested;
-    std::vector<std::vector<EffectTerm>> grids;
-    for (TermKind kind : kinds) {
-      if (std::find(used.begin(), used.end(), kind) != used.end()) continue;
-      const auto grid = term_grid(kind, sensors, sensor_count, options, has_speed);
-      if (grid.empty()) continue;
-      const auto [best, best_rss] = best_of_grid(grid, sensors, training, w);
-      Effect e;
-      e.term = grid[static_cast<std::size_t>(best)];
-      e.parameters = parameter_count(e.term, sensors);
-      e.step_fraction = (rss - best_rss) / rss;
-      e.explained_fraction = (rss - best_rss) / baseline_rss;
-      e.null_fraction = std::numeric_limits<double>::quiet_NaN();
-      tested.push_back(e);
-      grids.push_back(grid);
-    }
+    Candidates c = step_candidates(used, sensors, sensor_count, has_speed, training, w, rss,
+                                   baseline_rss, options);
+    std::vector<Effect>& tested = c.tested;
     std::vector<std::size_t> order(tested.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
@@ -515,31 +570,8 @@ ChannelStudy residual_study(const std::vector<Segment>& training, int target,
       Effect& e = tested[order[rank]];
       const double margin = e.step_fraction - options.penalty_per_parameter * e.parameters;
       if (margin <= 0.0) break;
-      double null = -std::numeric_limits<double>::infinity();
-      for (int draw = 0; draw < options.null_draws; ++draw) {
-        const double null_rss = best_of_grid(grids[order[rank]], sensors, training, w,
-                                             std::make_pair(options.seed, stream++))
-                                    .second;
-        null = std::max(null, (rss - null_rss) / rss);
-      }
-      // A share that no surrogate reaches is still no evidence when it is negative: the threshold
-      // is never below zero.
-      e.null_fraction = std::max(null, 0.0);
-      // The gain must also hold from segment to segment, not come from one of them: the mean
-      // per-segment held-out gain must exceed min_gain_t standard errors.
-      std::vector<Eigen::MatrixXd> nothing;
-      for (const auto& t : training) nothing.emplace_back(t.group.time.size(), 0);
-      const Eigen::VectorXd before_rss = rss_per_segment_with(w, nothing);
-      const Eigen::VectorXd with_rss = rss_per_segment_with_term(e.term, sensors, training, w);
-      const Eigen::VectorXd gains =
-          nested_gains(grids[order[rank]], sensors, training, w, before_rss);
-      e.gain_t = gain_t(gains);
-      e.segments_improved = static_cast<int>((gains.array() > 0.0).count());
-      e.heldout_rms_before =
-          std::sqrt(before_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
-      e.heldout_rms_after =
-          std::sqrt(with_rss.sum() / static_cast<double>(rows)) / kMicrometresPerMetre;
-      if (margin > e.null_fraction && e.gain_t > options.min_gain_t) {
+      if (claimed_effect(e, margin, c.grids[order[rank]], sensors, training, w, rss, rows, options,
+                         stream)) {
         e.claimed = true;
         claimed = static_cast<int>(order[rank]);
         break;

@@ -177,6 +177,84 @@ Blocks cross_validation_blocks(const std::vector<Segment>& pieces, int min_block
   return blocks;
 }
 
+namespace {
+
+/// One candidate scored by leaving each block of the pool out in turn: fitted on the others and
+/// its residual S on the block kept; the model is the fold without the first block. A fit that
+/// throws leaves no model and says why.
+CandidateResult scored_candidate(const std::vector<Group>& groups, const std::vector<int>& pool,
+                                 int target, const Candidate& candidate, int index) {
+  CandidateResult c;
+  c.sensor_set = index;
+  c.spec = index;
+  std::vector<double> s;
+  try {
+    for (std::size_t k = 0; k < pool.size(); ++k) {
+      std::vector<int> fit;
+      for (std::size_t j = 0; j < pool.size(); ++j)
+        if (j != k) fit.push_back(pool[j]);
+      const FittedModel m = fitted_model(candidate.spec, group_subset(groups, fit),
+                                         candidate.sensor_set.sensors, target);
+      const Group& held = groups[static_cast<std::size_t>(pool[k])];
+      s.push_back(residual_std(held.error.col(target) - predicted_error(m, held)));
+      if (k == 0) c.model = m;
+    }
+    c.validation = accuracy(s);
+  } catch (const std::exception& e) {
+    c.model.reset();
+    c.failure = e.what();
+  }
+  return c;
+}
+
+/// The index of the lowest held-out mean square S² (the quantity a test RMS measures; a mean of
+/// S would let a candidate that fails badly on one block through when it is good on the others),
+/// ties to the simpler candidate; -1 when every candidate failed.
+int lowest_candidate(const std::vector<CandidateResult>& scored,
+                     const std::vector<Candidate>& candidates, int inputs) {
+  int lowest = -1;
+  for (std::size_t c = 0; c < scored.size(); ++c) {
+    if (!scored[c].model) continue;
+    if (lowest < 0) {
+      lowest = static_cast<int>(c);
+      continue;
+    }
+    const auto low = static_cast<std::size_t>(lowest);
+    const double a = mean_square(scored[c].validation), b = mean_square(scored[low].validation);
+    if (a < b ||
+        (a == b && simplicity(candidates[c], inputs) < simplicity(candidates[low], inputs)))
+      lowest = static_cast<int>(c);
+  }
+  return lowest;
+}
+
+/// sel.best: the lowest, unless a one-standard-error guard against no compensation (when
+/// listed) prefers leaving the machine alone; sets sel.none and the gain over it.
+void guard_against_none(Selection& sel, const std::vector<Candidate>& candidates) {
+  const auto& scored = sel.candidates;
+  sel.best = sel.lowest;
+  for (std::size_t c = 0; c < scored.size(); ++c) {
+    if (candidates[c].spec.kind != ModelKind::no_compensation || !scored[c].model) continue;
+    sel.none = static_cast<int>(c);
+    break;
+  }
+  if (sel.none >= 0 && sel.none != sel.lowest) {
+    // Per block, the gain in S² of the lowest over no compensation: its mean must exceed its
+    // standard error, or the model is not shown to beat leaving the machine alone.
+    const auto& low = scored[static_cast<std::size_t>(sel.lowest)].validation.s;
+    const auto& none = scored[static_cast<std::size_t>(sel.none)].validation.s;
+    std::vector<double> gains;
+    for (std::size_t k = 0; k < low.size(); ++k)
+      gains.push_back(none[k] * none[k] - low[k] * low[k]);
+    const Accuracy g = accuracy(gains);
+    sel.gain_over_none = g.sm;
+    sel.gain_over_none_standard_error = g.s_sigma / std::sqrt(static_cast<double>(gains.size()));
+    if (!(sel.gain_over_none > sel.gain_over_none_standard_error)) sel.best = sel.none;
+  }
+}
+
+}  // namespace
+
 Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vector<int>& pool,
                               const std::vector<int>& test, int target,
                               const std::vector<Candidate>& candidates) {
@@ -201,67 +279,16 @@ Evaluation blocked_evaluation(const std::vector<Group>& groups, const std::vecto
   scored.resize(candidates.size());
   // Candidate scoring is an approved parallel loop: each candidate writes only its own slot.
   core::parallel_for(static_cast<std::ptrdiff_t>(candidates.size()), [&](std::ptrdiff_t i) {
-    CandidateResult& c = scored[static_cast<std::size_t>(i)];
-    c.sensor_set = static_cast<int>(i);
-    c.spec = static_cast<int>(i);
-    const Candidate& candidate = candidates[static_cast<std::size_t>(i)];
-    std::vector<double> s;
-    try {
-      for (std::size_t k = 0; k < pool.size(); ++k) {
-        std::vector<int> fit;
-        for (std::size_t j = 0; j < pool.size(); ++j)
-          if (j != k) fit.push_back(pool[j]);
-        const FittedModel m = fitted_model(candidate.spec, group_subset(groups, fit),
-                                           candidate.sensor_set.sensors, target);
-        const Group& held = groups[static_cast<std::size_t>(pool[k])];
-        s.push_back(residual_std(held.error.col(target) - predicted_error(m, held)));
-        if (k == 0) c.model = m;
-      }
-      c.validation = accuracy(s);
-    } catch (const std::exception& e) {
-      c.model.reset();
-      c.failure = e.what();
-    }
+    scored[static_cast<std::size_t>(i)] = scored_candidate(
+        groups, pool, target, candidates[static_cast<std::size_t>(i)], static_cast<int>(i));
   });
-  // The lowest held-out mean square S² (the quantity a test RMS measures; a mean of S would let
-  // a candidate that fails badly on one block through when it is good on the others), ties to the
-  // simpler candidate; then a one-standard-error guard against no compensation.
   const int inputs = static_cast<int>(groups.front().input_names.size());
   auto& sel = result.selection;
-  for (std::size_t c = 0; c < scored.size(); ++c) {
-    if (!scored[c].model) continue;
-    if (sel.lowest < 0) {
-      sel.lowest = static_cast<int>(c);
-      continue;
-    }
-    const auto low = static_cast<std::size_t>(sel.lowest);
-    const double a = mean_square(scored[c].validation), b = mean_square(scored[low].validation);
-    if (a < b ||
-        (a == b && simplicity(candidates[c], inputs) < simplicity(candidates[low], inputs)))
-      sel.lowest = static_cast<int>(c);
-  }
+  sel.lowest = lowest_candidate(scored, candidates, inputs);
   if (sel.lowest < 0)
     throw core::DataError("target " + result.target_name +
                           ": every candidate failed (first: " + scored.front().failure + ")");
-  sel.best = sel.lowest;
-  for (std::size_t c = 0; c < scored.size(); ++c) {
-    if (candidates[c].spec.kind != ModelKind::no_compensation || !scored[c].model) continue;
-    sel.none = static_cast<int>(c);
-    break;
-  }
-  if (sel.none >= 0 && sel.none != sel.lowest) {
-    // Per block, the gain in S² of the lowest over no compensation: its mean must exceed its
-    // standard error, or the model is not shown to beat leaving the machine alone.
-    const auto& low = scored[static_cast<std::size_t>(sel.lowest)].validation.s;
-    const auto& none = scored[static_cast<std::size_t>(sel.none)].validation.s;
-    std::vector<double> gains;
-    for (std::size_t k = 0; k < low.size(); ++k)
-      gains.push_back(none[k] * none[k] - low[k] * low[k]);
-    const Accuracy g = accuracy(gains);
-    sel.gain_over_none = g.sm;
-    sel.gain_over_none_standard_error = g.s_sigma / std::sqrt(static_cast<double>(gains.size()));
-    if (!(sel.gain_over_none > sel.gain_over_none_standard_error)) sel.best = sel.none;
-  }
+  guard_against_none(sel, candidates);
   const Candidate& chosen = candidates[static_cast<std::size_t>(result.selection.best)];
   result.model =
       fitted_model(chosen.spec, group_subset(groups, pool), chosen.sensor_set.sensors, target);

@@ -10,13 +10,12 @@
 
 namespace tt::placement {
 
-SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span<const int> chosen,
-                                         std::span<const int> pool,
-                                         const SaturationOptions& options, std::uint64_t seed) {
-  const int m = static_cast<int>(chosen.size());
-  if (m < 1 || static_cast<int>(pool.size()) < m)
+namespace {
+
+void require_saturation(int m, std::size_t pool_size, const SaturationOptions& options) {
+  if (m < 1 || static_cast<int>(pool_size) < m)
     throw core::DataError("placement: saturation diagnosis of " + std::to_string(m) +
-                          " sensors from a pool of " + std::to_string(pool.size()) +
+                          " sensors from a pool of " + std::to_string(pool_size) +
                           ": expected 1 <= m <= pool size");
   if (options.sampled_combinations < 1)
     throw core::DataError("placement.saturation.sampled_combinations = " +
@@ -26,14 +25,13 @@ SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span
                           " with alpha = " + std::to_string(options.alpha) +
                           ": the smallest p-value 1/(1 + shuffles) must not exceed alpha; hint: "
                           "use at least 1/alpha − 1 shuffles (99 for alpha = 0.01)");
-  SaturationDiagnosis d;
-  d.m = m;
-  d.margin_bits = options.margin_bits;
-  d.ceiling_bits = binned_entropy_bits(problem.y_bins, problem.error_bins);
-  d.score_bits = joint_mi_bits(problem, chosen);
-  d.singleton_share = singleton_share(problem, chosen);
+}
 
-  // 1. How crowded the top is: scores of many combinations against the ceiling.
+/// How crowded the top is: d.combinations_scored and d.share_near_ceiling from every single
+/// sensor of the pool (m = 1) or sampled combinations of m (drawn from `seed`'s stream 0).
+void score_crowding(SaturationDiagnosis& d, const BinnedProblem& problem, std::span<const int> pool,
+                    const SaturationOptions& options, std::uint64_t seed) {
+  const int m = d.m;
   std::mt19937_64 gen = core::generator(seed, 0);
   int near = 0;
   if (m == 1) {
@@ -56,9 +54,12 @@ SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span
     d.combinations_scored = options.sampled_combinations;
   }
   d.share_near_ceiling = static_cast<double>(near) / d.combinations_scored;
-  d.at_ceiling = d.score_bits >= d.ceiling_bits - options.margin_bits;
+}
 
-  // 2. The shuffle test.
+/// The shuffle test: the chosen set's score against Y shuffled `options.shuffles` times
+/// (permutations from `seed`'s stream 1), into d's shuffle figures and p-value.
+void shuffle_test(SaturationDiagnosis& d, const BinnedProblem& problem, std::span<const int> chosen,
+                  const SaturationOptions& options, std::uint64_t seed) {
   std::mt19937_64 shuffle_gen = core::generator(seed, 1);
   std::vector<std::uint8_t> y(problem.y_bins.size());
   double sum = 0.0, sum2 = 0.0;
@@ -82,8 +83,10 @@ SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span
       std::sqrt(std::max(0.0, sum2 / options.shuffles - d.shuffle_mean_bits * d.shuffle_mean_bits));
   d.excess_bits = d.score_bits - d.shuffle_mean_bits;
   d.p_value = (1.0 + above) / (1.0 + options.shuffles);
+}
 
-  // 3. The verdict.
+/// Why the diagnosis is saturated; empty when it is not.
+std::string saturation_reason(const SaturationDiagnosis& d, const SaturationOptions& options) {
   std::ostringstream why;
   if (d.share_near_ceiling >= options.share_threshold)
     why << d.share_near_ceiling * 100.0 << " % of the " << d.combinations_scored
@@ -100,7 +103,32 @@ SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span
     why << "shuffle p = " << d.p_value << " > " << options.alpha
         << ": the chosen set does not score above Y shuffled against it";
   }
-  d.reason = why.str();
+  return why.str();
+}
+
+}  // namespace
+
+SaturationDiagnosis saturation_diagnosis(const BinnedProblem& problem, std::span<const int> chosen,
+                                         std::span<const int> pool,
+                                         const SaturationOptions& options, std::uint64_t seed) {
+  const int m = static_cast<int>(chosen.size());
+  require_saturation(m, pool.size(), options);
+  SaturationDiagnosis d;
+  d.m = m;
+  d.margin_bits = options.margin_bits;
+  d.ceiling_bits = binned_entropy_bits(problem.y_bins, problem.error_bins);
+  d.score_bits = joint_mi_bits(problem, chosen);
+  d.singleton_share = singleton_share(problem, chosen);
+
+  // 1. How crowded the top is: scores of many combinations against the ceiling.
+  score_crowding(d, problem, pool, options, seed);
+  d.at_ceiling = d.score_bits >= d.ceiling_bits - options.margin_bits;
+
+  // 2. The shuffle test.
+  shuffle_test(d, problem, chosen, options, seed);
+
+  // 3. The verdict.
+  d.reason = saturation_reason(d, options);
   d.saturated = !d.reason.empty();
   return d;
 }

@@ -328,6 +328,67 @@ Eigen::MatrixXd input_columns(const FullThermalSystem& full, const core::CaseSpe
   return b;
 }
 
+namespace {
+
+/// The right-hand sides of the Krylov solves: the input columns `b`, then the output columns
+/// (the inputs' and the outputs' Krylov vectors come from the same factors).
+Eigen::MatrixXd krylov_rhs(const FullThermalSystem& full, const Eigen::MatrixXd& b,
+                           const ReductionOptions& options) {
+  if (options.output_columns.size() && options.output_columns.rows() != full.states())
+    throw core::SolverError("reduction: the output columns have " +
+                            std::to_string(options.output_columns.rows()) +
+                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+  Eigen::MatrixXd rhs(b.rows(), b.cols() + options.output_columns.cols());
+  rhs.leftCols(b.cols()) = b;
+  rhs.rightCols(options.output_columns.cols()) = options.output_columns;
+  return rhs;
+}
+
+/// The shifts of each film state, in the order their Krylov vectors join the basis.
+struct Shifts {
+  std::vector<Sparse> stiffness;                        // K(h) per film state
+  std::vector<std::pair<std::size_t, double>> shifted;  // (film state, shift)
+};
+
+/// The shifts of st.film_states; the distinct shifts are added to st.shifts_per_s.
+Shifts shift_plan(const FullThermalSystem& full, const core::CaseSpec& spec,
+                  const ReductionOptions& options, ReductionStats& st) {
+  Shifts plan;
+  for (const auto& h : st.film_states) {
+    const bool steady = removes_heat(full, h);
+    std::vector<double> shifts =
+        options.shifts_per_s.empty() ? default_shifts(spec, steady) : options.shifts_per_s;
+    plan.stiffness.push_back(film_stiffness(full, h));
+    for (double s : shifts) {
+      if (s == 0 && !steady) continue;  // K alone is singular: no film removes heat
+      if (std::find(st.shifts_per_s.begin(), st.shifts_per_s.end(), s) == st.shifts_per_s.end())
+        st.shifts_per_s.push_back(s);
+      plan.shifted.emplace_back(plan.stiffness.size() - 1, s);
+    }
+  }
+  return plan;
+}
+
+/// K(h) + s C of the i-th shift; all share one pattern.
+Sparse shifted_operator(const FullThermalSystem& full, const Shifts& shifts, std::size_t i) {
+  Sparse a = shifts.stiffness[shifts.shifted[i].first] + shifts.shifted[i].second * full.capacity;
+  a.makeCompressed();
+  return a;
+}
+
+/// The columns of x (solves of the Krylov right-hand sides: `inputs` input columns, then the
+/// outputs) whose second moment is taken: all, or all but the moving sources' `slices` (the last
+/// input columns before the output columns).
+Eigen::MatrixXd second_moment_columns(const Eigen::MatrixXd& x, const ReductionOptions& options,
+                                      Eigen::Index inputs, Eigen::Index slices) {
+  if (options.moving_second_moment || slices == 0) return x;
+  Eigen::MatrixXd kept(x.rows(), x.cols() - slices);
+  kept << x.leftCols(inputs - slices), x.rightCols(options.output_columns.cols());
+  return kept;
+}
+
+}  // namespace
+
 Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseSpec& spec,
                                 const ReductionOptions& options, ReductionStats* stats) {
   const auto t0 = Clock::now();
@@ -342,52 +403,19 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
   // The remaining input columns: the load shapes themselves (the response at s -> infinity).
   st.deflated_columns += v.append(b.rightCols(b.cols() - 1));
   st.candidate_columns = static_cast<int>(b.cols());
-  if (options.output_columns.size() && options.output_columns.rows() != full.states())
-    throw core::SolverError("reduction: the output columns have " +
-                            std::to_string(options.output_columns.rows()) +
-                            " rows, the full system " + std::to_string(full.states()) + " nodes");
+  const Eigen::MatrixXd rhs = krylov_rhs(full, b, options);
   st.output_columns = static_cast<int>(options.output_columns.cols());
-  // The inputs' and the outputs' Krylov vectors come from the same factors.
-  Eigen::MatrixXd rhs(b.rows(), b.cols() + options.output_columns.cols());
-  rhs.leftCols(b.cols()) = b;
-  rhs.rightCols(options.output_columns.cols()) = options.output_columns;
   st.film_states = film_states(spec, options);
-  // The shifts of each film state, in the order their Krylov vectors join the basis.
-  std::vector<Sparse> stiffness;                        // K(h) per film state
-  std::vector<std::pair<std::size_t, double>> shifted;  // (film state, shift)
-  for (const auto& h : st.film_states) {
-    const bool steady = removes_heat(full, h);
-    std::vector<double> shifts =
-        options.shifts_per_s.empty() ? default_shifts(spec, steady) : options.shifts_per_s;
-    stiffness.push_back(film_stiffness(full, h));
-    for (double s : shifts) {
-      if (s == 0 && !steady) continue;  // K alone is singular: no film removes heat
-      if (std::find(st.shifts_per_s.begin(), st.shifts_per_s.end(), s) == st.shifts_per_s.end())
-        st.shifts_per_s.push_back(s);
-      shifted.emplace_back(stiffness.size() - 1, s);
-    }
-  }
+  const Shifts shifts = shift_plan(full, spec, options, st);
+  const auto& shifted = shifts.shifted;
   // Two factors at a time, side by side (each solve needs only its own); the columns join the
   // basis in the fixed order above, so the basis does not depend on the thread count.
   // The shifted operators share one pattern: one analysis (ordering, symbolic factor) for all.
   constexpr std::size_t kWave = 2;
-  const auto shifted_operator = [&](std::size_t i) {
-    Sparse a = stiffness[shifted[i].first] + shifted[i].second * full.capacity;
-    a.makeCompressed();
-    return a;
-  };
-  // The columns whose second moment is taken: all, or all but the moving sources' slices (the
-  // last input columns before the output columns).
   const Eigen::Index slices = b.cols() - fixed_input_columns(full, spec);
-  const auto second_moment_columns = [&](const Eigen::MatrixXd& x) -> Eigen::MatrixXd {
-    if (options.moving_second_moment || slices == 0) return x;
-    Eigen::MatrixXd kept(x.rows(), x.cols() - slices);
-    kept << x.leftCols(b.cols() - slices), x.rightCols(options.output_columns.cols());
-    return kept;
-  };
   std::optional<cholmod::Analysis> analysis;
   if (!shifted.empty())
-    analysis.emplace(shifted_operator(0), "reduction: the pattern of K(h) + s C");
+    analysis.emplace(shifted_operator(full, shifts, 0), "reduction: the pattern of K(h) + s C");
   for (std::size_t first = 0; first < shifted.size(); first += kWave) {
     const auto wave_start = Clock::now();
     const std::size_t count = std::min(kWave, shifted.size() - first);
@@ -396,11 +424,12 @@ Eigen::MatrixXd reduction_basis(const FullThermalSystem& full, const core::CaseS
       const std::size_t at = first + static_cast<std::size_t>(i);
       std::ostringstream what;
       what << "reduction: K(h) + s C at s = " << shifted[at].second << " 1/s";
-      const cholmod::Factor factor(*analysis, shifted_operator(at), what.str());
+      const cholmod::Factor factor(*analysis, shifted_operator(full, shifts, at), what.str());
       auto& out = moments[static_cast<std::size_t>(i)];
       out.push_back(factor.solve(rhs));
       if (options.second_moment)
-        out.push_back(factor.solve(full.capacity * second_moment_columns(out.back())));
+        out.push_back(factor.solve(full.capacity *
+                                   second_moment_columns(out.back(), options, b.cols(), slices)));
     });
     const auto solved = Clock::now();
     st.solve_s += std::chrono::duration<double>(solved - wave_start).count();

@@ -368,6 +368,147 @@ void require_history_fits(const core::CaseSpec& spec, Eigen::Index states, std::
       " (core/limits.hpp). Hint: lengthen output_interval_s or coarsen the mesh.");
 }
 
+/// Int dA of every film: the uniform state's film load (the area in the full space).
+template <class Matrix>
+std::vector<double> film_totals(const LinearThermalSystem<Matrix>& sys) {
+  std::vector<double> film_total;
+  for (const auto& a : sys.film_area) film_total.push_back(a.dot(sys.uniform));
+  return film_total;
+}
+
+/// Checkpoints hold the base states only: refuse them with `nc` caller columns or readouts.
+void require_checkpointable(const Checkpointing& checkpointing, const StepperRequest& q,
+                            Eigen::Index nc, bool reads) {
+  if ((checkpointing.save || checkpointing.resume) && (nc > 0 || reads || !q.record_states))
+    throw core::SolverError(
+        "thermal stepper: checkpoints hold the base states only; they cannot "
+        "be used with caller columns or readouts");
+}
+
+/// Fills the first output time (t = 0) from the start's state, readouts and responses.
+void record_start(SteppedHistory& hist, const Eigen::VectorXd& temp,
+                  const Eigen::VectorXd& read_prev, const Dense& block_prev, bool record_states,
+                  bool reads) {
+  const auto nc = static_cast<Eigen::Index>(hist.responses.size());
+  if (record_states) hist.states.col(0) = temp;
+  if (reads) hist.readout.col(0) = read_prev;
+  for (Eigen::Index j = 0; j < nc; ++j) hist.responses[j].col(0) = block_prev.col(j);
+}
+
+/// The recorded states, energy accumulators and step count of a checkpoint, into `hist`.
+void restore_history(SteppedHistory& hist, const ThermalCheckpoint& c) {
+  hist.states.leftCols(c.outputs.cols()) = c.outputs;
+  hist.heat_in = c.heat_in;
+  hist.lost = c.lost;
+  hist.timings.steps = c.steps;
+}
+
+/// One time step [t_prev, t] of the grid, index `step`; t0_k: the initial temperature [K].
+struct StepTimes {
+  double t_prev, t, t0_k;
+  std::size_t step;
+};
+
+/// The base state at the step's end from `temp` at its start: (C + theta dt K) next =
+/// (C - (1 - theta) dt K) temp + load solved with the step's factor (`kk`: K), then the sources'
+/// iteration when asked for (`source_iterations` keeps the most solves of one step). `rhs`:
+/// scratch, #states. Throws SolverError when the state is not finite.
+template <class Matrix>
+Eigen::VectorXd solved_state(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec,
+                             const StepperRequest& q, const StepFactor<Matrix>& factor,
+                             const Matrix& kk, const Eigen::VectorXd& temp, StepPlan& p,
+                             const StepTimes& st, Eigen::VectorXd& rhs, int& source_iterations) {
+  const double dt = st.t - st.t_prev;
+  rhs = sys.capacity * temp + p.load;
+  if (p.theta != 1) rhs -= (0.5 * dt) * (kk * temp);
+  Eigen::VectorXd next = rhs;
+  factor.solve_in_place(next);
+  if (q.sources.tolerance_K > 0 && next.allFinite())
+    source_iterations = std::max(
+        source_iterations,
+        iterate_sources(spec, sys, q.sources, factor, st.t_prev, st.t, st.t0_k, rhs, p, next));
+  if (!next.allFinite()) throw non_finite_temperature(spec, p.s_new, next, st.step, st.t);
+  return next;
+}
+
+/// The output times (0, then the record times) with the recorded states, readouts and the `nc`
+/// caller columns' responses allocated, none filled.
+SteppedHistory allocated_history(const core::CaseSpec& spec, const StepperRequest& q,
+                                 Eigen::Index n, Eigen::Index nc) {
+  SteppedHistory hist;
+  hist.times.push_back(0.0);
+  hist.times.insert(hist.times.end(), q.record_times.begin(), q.record_times.end());
+  const auto times = static_cast<Eigen::Index>(hist.times.size());
+  if (q.record_states) {
+    require_history_fits(spec, n, static_cast<std::size_t>(times));
+    hist.states.resize(n, times);
+  }
+  hist.readout.resize(q.base_readout.rows(), times);
+  for (Eigen::Index j = 0; j < nc; ++j) hist.responses.emplace_back(q.column_readout.rows(), times);
+  return hist;
+}
+
+/// Adds one step's heat to the history's energy accumulators: in from the sources, moving loads
+/// and surface fluxes, out through the films (`next`: the state at the step's end;
+/// lost_rate_prev: the films' rate at its start, used by Crank–Nicolson).
+template <class Matrix>
+void add_step_heat(SteppedHistory& hist, const LinearThermalSystem<Matrix>& sys,
+                   const core::CaseSpec& spec, const std::vector<double>& film_total,
+                   const StepPlan& plan, const Eigen::VectorXd& next, double dt,
+                   double lost_rate_prev) {
+  const LoadState& s_new = plan.s_new;
+  const bool cn = plan.theta != 1;
+  double power = 0;
+  for (double p : s_new.power) power += p;
+  const double lost_new = convected_rate(sys, film_total, next, s_new);
+  hist.heat_in += dt * (power + plan.f_moving.dot(sys.uniform));
+  hist.lost += cn ? 0.5 * dt * (lost_rate_prev + lost_new) : dt * lost_new;
+  // Surface fluxes enter as heat too.
+  for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {
+    const auto& fl = spec.thermal.fluxes[j];
+    hist.heat_in += dt * fl.flux * flux_scale(fl, s_new.speed) * sys.flux_area[j].dot(sys.uniform);
+  }
+}
+
+/// The base state, readouts and caller-column responses at both ends of one step [t0, t1].
+struct StepEnds {
+  double t0, t1;
+  const Eigen::VectorXd& state0;
+  const Eigen::VectorXd& state1;
+  const Eigen::VectorXd& read0;
+  const Eigen::VectorXd& read1;
+  const Dense& block0;
+  const Dense& block1;
+};
+
+/// Fills the output times from `next_out` on that the step reaches (within 1e-9 `end`), linear
+/// in time between its ends: the next output time's index.
+size_t recorded_outputs(SteppedHistory& hist, size_t next_out, const StepEnds& e, double end,
+                        bool record_states, bool reads) {
+  const double t_prev = e.t0, t = e.t1, dt = t - t_prev;
+  const auto nc = static_cast<Eigen::Index>(hist.responses.size());
+  while (next_out < hist.times.size() && hist.times[next_out] <= t + 1e-9 * end) {
+    const double w = (hist.times[next_out] - t_prev) / dt;
+    const auto k = static_cast<Eigen::Index>(next_out);
+    if (record_states) hist.states.col(k) = (1 - w) * e.state0 + w * e.state1;
+    // Readouts are linear: interpolate them rather than the states (exact at a step end).
+    if (reads) {
+      if (w == 1)
+        hist.readout.col(k) = e.read1;
+      else
+        hist.readout.col(k) = (1 - w) * e.read0 + w * e.read1;
+    }
+    for (Eigen::Index j = 0; j < nc; ++j) {
+      if (w == 1)
+        hist.responses[j].col(k) = e.block1.col(j);
+      else
+        hist.responses[j].col(k) = (1 - w) * e.block0.col(j) + w * e.block1.col(j);
+    }
+    ++next_out;
+  }
+  return next_out;
+}
+
 }  // namespace
 
 template <class Matrix>
@@ -424,32 +565,16 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
   const Eigen::Index ns = static_cast<Eigen::Index>(q.shape_columns.size());
   const Eigen::Index nc = ns + static_cast<Eigen::Index>(q.load_columns.size());
   const bool reads = q.base_readout.rows() > 0;
-  if ((checkpointing.save || checkpointing.resume) && (nc > 0 || reads || !q.record_states))
-    throw core::SolverError(
-        "thermal stepper: checkpoints hold the base states only; they cannot "
-        "be used with caller columns or readouts");
-  // Int dA of every film: the uniform state's film load (the area in the full space).
-  std::vector<double> film_total;
-  for (const auto& a : sys.film_area) film_total.push_back(a.dot(sys.uniform));
+  require_checkpointable(checkpointing, q, nc, reads);
+  const std::vector<double> film_total = film_totals(sys);
 
-  SteppedHistory hist;
-  hist.times.push_back(0.0);
-  hist.times.insert(hist.times.end(), q.record_times.begin(), q.record_times.end());
-  const auto times = static_cast<Eigen::Index>(hist.times.size());
-  if (q.record_states) {
-    require_history_fits(spec, n, static_cast<std::size_t>(times));
-    hist.states.resize(n, times);
-  }
-  hist.readout.resize(q.base_readout.rows(), times);
-  for (Eigen::Index j = 0; j < nc; ++j) hist.responses.emplace_back(q.column_readout.rows(), times);
+  SteppedHistory hist = allocated_history(spec, q, n, nc);
   const Eigen::VectorXd start = t0_k * sys.uniform;
   Eigen::VectorXd temp = start;
   Dense x = Dense::Zero(n, nc);  // responses start from zero
   Eigen::VectorXd read_prev = reads ? read_state(q.base_readout, temp, start) : Eigen::VectorXd();
   Dense block_prev = nc ? read_block(q.column_readout, x) : Dense();
-  if (q.record_states) hist.states.col(0) = temp;
-  if (reads) hist.readout.col(0) = read_prev;
-  for (Eigen::Index j = 0; j < nc; ++j) hist.responses[j].col(0) = block_prev.col(j);
+  record_start(hist, temp, read_prev, block_prev, q.record_states, reads);
   size_t next_out = 1;
 
   StepOperators<Matrix> ops(sys, hist.timings);
@@ -465,10 +590,7 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     prev_speed = c->speed;
     temp = c->temperature;
     next_out = static_cast<size_t>(c->outputs.cols());
-    hist.states.leftCols(c->outputs.cols()) = c->outputs;
-    hist.heat_in = c->heat_in;
-    hist.lost = c->lost;
-    hist.timings.steps = c->steps;
+    restore_history(hist, *c);
   }
   auto t_saved = Clock::now();
   Eigen::VectorXd rhs(n), read_new;
@@ -480,57 +602,21 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     const bool cn = p.theta != 1;
     const double theta = p.theta;
     const Matrix& kk = ops.stiffness(s_new);
-    const Eigen::VectorXd& f_moving = p.f_moving;
-    rhs = sys.capacity * temp + p.load;
-    if (cn) {
-      rhs -= (0.5 * dt) * (kk * temp);
-      lost_rate_prev = convected_rate(sys, film_total, temp, p.s_old);
-    }
+    if (cn) lost_rate_prev = convected_rate(sys, film_total, temp, p.s_old);
     const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
-    Eigen::VectorXd next = rhs;
-    factor.solve_in_place(next);
-    if (q.sources.tolerance_K > 0 && next.allFinite())
-      hist.source_iterations =
-          std::max(hist.source_iterations,
-                   iterate_sources(spec, sys, q.sources, factor, t_prev, t, t0_k, rhs, p, next));
-    if (!next.allFinite()) throw non_finite_temperature(spec, s_new, next, i, t);
+    Eigen::VectorXd next = solved_state(sys, spec, q, factor, kk, temp, p, {t_prev, t, t0_k, i},
+                                        rhs, hist.source_iterations);
 
     if (nc > 0)
       x = stepped_responses(sys, q, {t_prev, t, s_new.speed, theta, &temp, &next}, kk, factor, x);
 
-    double power = 0;
-    for (double p : s_new.power) power += p;
-    const double lost_new = convected_rate(sys, film_total, next, s_new);
-    hist.heat_in += dt * (power + f_moving.dot(sys.uniform));
-    hist.lost += cn ? 0.5 * dt * (lost_rate_prev + lost_new) : dt * lost_new;
-    // Surface fluxes enter as heat too.
-    for (size_t j = 0; j < spec.thermal.fluxes.size(); ++j) {
-      const auto& fl = spec.thermal.fluxes[j];
-      hist.heat_in +=
-          dt * fl.flux * flux_scale(fl, s_new.speed) * sys.flux_area[j].dot(sys.uniform);
-    }
+    add_step_heat(hist, sys, spec, film_total, p, next, dt, lost_rate_prev);
 
     if (reads) read_new = read_state(q.base_readout, next, start);
     if (nc) block_new = read_block(q.column_readout, x);
-    while (next_out < hist.times.size() && hist.times[next_out] <= t + 1e-9 * end) {
-      const double w = (hist.times[next_out] - t_prev) / dt;
-      const auto k = static_cast<Eigen::Index>(next_out);
-      if (q.record_states) hist.states.col(k) = (1 - w) * temp + w * next;
-      // Readouts are linear: interpolate them rather than the states (exact at a step end).
-      if (reads) {
-        if (w == 1)
-          hist.readout.col(k) = read_new;
-        else
-          hist.readout.col(k) = (1 - w) * read_prev + w * read_new;
-      }
-      for (Eigen::Index j = 0; j < nc; ++j) {
-        if (w == 1)
-          hist.responses[j].col(k) = block_new.col(j);
-        else
-          hist.responses[j].col(k) = (1 - w) * block_prev.col(j) + w * block_new.col(j);
-      }
-      ++next_out;
-    }
+    next_out = recorded_outputs(hist, next_out,
+                                {t_prev, t, temp, next, read_prev, read_new, block_prev, block_new},
+                                end, q.record_states, reads);
     temp.swap(next);
     if (reads) read_prev.swap(read_new);
     if (nc) block_prev.swap(block_new);

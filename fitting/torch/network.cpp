@@ -433,6 +433,140 @@ Sequences residual(const Sequences& s, const LinearSkip& skip) {
   return out;
 }
 
+/// The standardisation (x - mean) / scale of the fitting rows, into n.in_mean ... n.out_scale.
+void set_standardisation(Network::Impl& n, const Sequences& fit) {
+  const Eigen::MatrixXd x_all = stacked(fit.inputs), y_all = stacked(fit.outputs);
+  n.in_mean = x_all.colwise().mean().transpose();
+  n.in_scale = column_scale(x_all, n.in_mean);
+  // With a skip the outputs are its residuals, centred by its intercept over every given row:
+  // no mean is added, so that the untrained network (its last layer zero) is the skip exactly.
+  n.out_mean = n.skip ? Eigen::VectorXd::Zero(n.outputs).eval()
+                      : Eigen::VectorXd(y_all.colwise().mean().transpose());
+  n.out_scale = column_scale(y_all, n.out_mean);
+  if (n.options.common_output_scale)
+    n.out_scale.setConstant(
+        std::sqrt(n.out_scale.squaredNorm() / static_cast<double>(n.out_scale.size())));
+}
+
+/// Standardised float windows, flattened: fitting inputs and outputs, validation likewise.
+struct Windows {
+  std::vector<float> xf, yf, xv, yv;
+};
+
+/// Windows: every row of the fitting groups; the validation groups', or the last fifth of each
+/// fitting group's rows when there are none.
+Windows training_windows(const Network::Impl& n, const Sequences& fit,
+                         const Sequences& validation) {
+  Windows w;
+  const auto add = [&](const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, Eigen::Index b,
+                       Eigen::Index e, std::vector<float>& xs, std::vector<float>& ys) {
+    append_windows(x, y, b, e, n.options, n.in_mean, n.in_scale, n.out_mean, n.out_scale, xs, ys);
+  };
+  for (std::size_t g = 0; g < fit.inputs.size(); ++g) {
+    const Eigen::Index rows = fit.inputs[g].rows();
+    const Eigen::Index cut = validation.inputs.empty() ? rows - rows / 5 : rows;
+    add(fit.inputs[g], fit.outputs[g], 0, cut, w.xf, w.yf);
+    add(fit.inputs[g], fit.outputs[g], cut, rows, w.xv, w.yv);
+  }
+  for (std::size_t g = 0; g < validation.inputs.size(); ++g)
+    add(validation.inputs[g], validation.outputs[g], 0, validation.inputs[g].rows(), w.xv, w.yv);
+  return w;
+}
+
+/// Adam, or AdamW when there is weight decay.
+std::unique_ptr<torch::optim::Optimizer> optimiser(Net& net, const NetworkOptions& o) {
+  if (o.weight_decay > 0.0)
+    return std::make_unique<torch::optim::AdamW>(
+        net->parameters(),
+        torch::optim::AdamWOptions(o.learning_rate).weight_decay(o.weight_decay));
+  return std::make_unique<torch::optim::Adam>(net->parameters(),
+                                              torch::optim::AdamOptions(o.learning_rate));
+}
+
+/// The parameters then the buffers of the epoch with the lowest finite validation loss (none
+/// when no epoch had one), and that loss.
+struct BestWeights {
+  std::vector<torch::Tensor> tensors;
+  double loss = std::numeric_limits<double>::infinity();
+};
+
+/// Epochs of shuffled mini-batches (the order drawn from `gen`), stopped after `patience` epochs
+/// without a better validation loss or when the time budget since `start` is spent; records
+/// epochs, best_epoch and budget_reached in `report`.
+BestWeights best_weights(Net& net, at::Generator& gen, const torch::Tensor& x_fit,
+                         const torch::Tensor& y_fit, const torch::Tensor& x_val,
+                         const torch::Tensor& y_val, const NetworkOptions& o,
+                         std::chrono::steady_clock::time_point start, TrainingReport& report) {
+  const std::unique_ptr<torch::optim::Optimizer> adam = optimiser(net, o);
+  const int64_t nf = x_fit.size(0);
+  BestWeights best;
+  const auto keep_if_best = [&](int epoch) {
+    const double loss = mean_squared(net, x_val, y_val);
+    if (!std::isfinite(loss) || loss >= best.loss) return;
+    best.loss = loss;
+    report.best_epoch = epoch;
+    best.tensors.clear();
+    for (const auto& p : net->parameters()) best.tensors.push_back(p.detach().clone());
+    for (const auto& b : net->buffers()) best.tensors.push_back(b.detach().clone());
+  };
+  for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
+    const torch::Tensor order = torch::randperm(nf, gen, torch::TensorOptions(torch::kLong));
+    net->train();
+    for (int64_t b = 0; b < nf; b += o.batch_size) {
+      const torch::Tensor idx = order.slice(0, b, std::min(nf, b + o.batch_size));
+      adam->zero_grad();
+      const torch::Tensor loss =
+          torch::mse_loss(net->forward(x_fit.index_select(0, idx)), y_fit.index_select(0, idx));
+      loss.backward();
+      adam->step();
+    }
+    report.epochs = epoch;
+    keep_if_best(epoch);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (seconds > o.time_budget_s) {
+      report.budget_reached = true;
+      break;
+    }
+    if (epoch - report.best_epoch >= o.patience) break;
+  }
+  return best;
+}
+
+/// Puts the best weights back into `net`, or zeroes its last layer when the skip alone
+/// (`skip_only`, its validation loss) does at least as well (best_epoch 0), and leaves it in
+/// evaluation mode: the validation loss of the weights kept.
+double restored_best(Net& net, const BestWeights& best, double skip_only, TrainingReport& report) {
+  torch::NoGradGuard no_grad;
+  auto params = net->parameters();
+  const auto buffers = net->buffers();
+  for (std::size_t i = 0; i < best.tensors.size() && i < params.size(); ++i)
+    params[i].copy_(best.tensors[i]);
+  for (std::size_t i = 0; i < best.tensors.size() && i < buffers.size(); ++i)
+    buffers[i].copy_(best.tensors[params.size() + i]);
+  double loss = best.loss;
+  if (skip_only <= loss) {
+    net->head->weight.zero_();
+    net->head->bias.zero_();
+    report.best_epoch = 0;
+    loss = skip_only;
+  }
+  net->eval();
+  return loss;
+}
+
+/// Every parameter of `net`, flattened in parameter order.
+std::vector<float> flat_parameters(Net& net) {
+  torch::NoGradGuard no_grad;
+  std::vector<float> out;
+  for (const auto& p : net->parameters()) {
+    const torch::Tensor flat = p.detach().contiguous().view(-1);
+    const float* d = flat.data_ptr<float>();
+    out.insert(out.end(), d, d + flat.numel());
+  }
+  return out;
+}
+
 }  // namespace
 
 Network trained_network(const Sequences& fit_given, const Sequences& validation_given,
@@ -457,36 +591,10 @@ Network trained_network(const Sequences& fit_given, const Sequences& validation_
   impl->inputs = inputs;
   impl->outputs = outputs;
   impl->skip = skip;
-  const Eigen::MatrixXd x_all = stacked(fit.inputs), y_all = stacked(fit.outputs);
-  impl->in_mean = x_all.colwise().mean().transpose();
-  impl->in_scale = column_scale(x_all, impl->in_mean);
-  // With a skip the outputs are its residuals, centred by its intercept over every given row:
-  // no mean is added, so that the untrained network (its last layer zero) is the skip exactly.
-  impl->out_mean = skip ? Eigen::VectorXd::Zero(outputs).eval()
-                        : Eigen::VectorXd(y_all.colwise().mean().transpose());
-  impl->out_scale = column_scale(y_all, impl->out_mean);
-  if (o.common_output_scale)
-    impl->out_scale.setConstant(
-        std::sqrt(impl->out_scale.squaredNorm() / static_cast<double>(impl->out_scale.size())));
-
-  // Windows: every row of the fitting groups; the validation groups', or the last fifth of each
-  // fitting group's rows when there are none.
-  std::vector<float> xf, yf, xv, yv;
-  const auto add = [&](const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, Eigen::Index b,
-                       Eigen::Index e, std::vector<float>& xs, std::vector<float>& ys) {
-    append_windows(x, y, b, e, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
-                   xs, ys);
-  };
-  for (std::size_t g = 0; g < fit.inputs.size(); ++g) {
-    const Eigen::Index n = fit.inputs[g].rows();
-    const Eigen::Index cut = validation.inputs.empty() ? n - n / 5 : n;
-    add(fit.inputs[g], fit.outputs[g], 0, cut, xf, yf);
-    add(fit.inputs[g], fit.outputs[g], cut, n, xv, yv);
-  }
-  for (std::size_t g = 0; g < validation.inputs.size(); ++g)
-    add(validation.inputs[g], validation.outputs[g], 0, validation.inputs[g].rows(), xv, yv);
-  const int64_t nf = static_cast<int64_t>(yf.size()) / outputs;
-  const int64_t nv = static_cast<int64_t>(yv.size()) / outputs;
+  set_standardisation(*impl, fit);
+  Windows w = training_windows(*impl, fit, validation);
+  const int64_t nf = static_cast<int64_t>(w.yf.size()) / outputs;
+  const int64_t nv = static_cast<int64_t>(w.yv.size()) / outputs;
   if (nf < 2 || nv < 1)
     throw core::DataError("network training on " + std::to_string(nf) + " fitting and " +
                           std::to_string(nv) +
@@ -498,81 +606,24 @@ Network trained_network(const Sequences& fit_given, const Sequences& validation_
   const auto start = std::chrono::steady_clock::now();
   try {
     TorchThreads threads(o.threads);
-    const torch::Tensor x_fit = tensor_of(xf, {nf, o.window_steps, inputs});
-    const torch::Tensor y_fit = tensor_of(yf, {nf, outputs});
-    const torch::Tensor x_val = tensor_of(xv, {nv, o.window_steps, inputs});
-    const torch::Tensor y_val = tensor_of(yv, {nv, outputs});
+    const torch::Tensor x_fit = tensor_of(w.xf, {nf, o.window_steps, inputs});
+    const torch::Tensor y_fit = tensor_of(w.yf, {nf, outputs});
+    const torch::Tensor x_val = tensor_of(w.xv, {nv, o.window_steps, inputs});
+    const torch::Tensor y_val = tensor_of(w.yv, {nv, outputs});
     at::Generator gen = at::detail::createCPUGenerator(o.seed);
     Net net(inputs, outputs, o);
     initialise(net, gen, o.gru_hidden);
-    std::unique_ptr<torch::optim::Optimizer> adam;
-    if (o.weight_decay > 0.0)
-      adam = std::make_unique<torch::optim::AdamW>(
-          net->parameters(),
-          torch::optim::AdamWOptions(o.learning_rate).weight_decay(o.weight_decay));
-    else
-      adam = std::make_unique<torch::optim::Adam>(net->parameters(),
-                                                  torch::optim::AdamOptions(o.learning_rate));
-    std::vector<torch::Tensor> best;
-    double best_loss = std::numeric_limits<double>::infinity();
-    const auto keep_if_best = [&](int epoch) {
-      const double loss = mean_squared(net, x_val, y_val);
-      if (!std::isfinite(loss) || loss >= best_loss) return;
-      best_loss = loss;
-      impl->report.best_epoch = epoch;
-      best.clear();
-      for (const auto& p : net->parameters()) best.push_back(p.detach().clone());
-      for (const auto& b : net->buffers()) best.push_back(b.detach().clone());
-    };
+    const BestWeights best =
+        best_weights(net, gen, x_fit, y_fit, x_val, y_val, o, start, impl->report);
+    if (best.tensors.empty() && !skip)
+      throw core::DataError(
+          "network training gave no finite validation loss; hint: lower learning_rate");
     // With a skip, the linear model alone (the network's last layer zero, so that it adds
     // nothing) is a candidate of the early stopping too: epoch 0.
     const double skip_only =
         skip ? y_val.pow(2).mean().item<double>() : std::numeric_limits<double>::infinity();
-    for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
-      const torch::Tensor order = torch::randperm(nf, gen, torch::TensorOptions(torch::kLong));
-      net->train();
-      for (int64_t b = 0; b < nf; b += o.batch_size) {
-        const torch::Tensor idx = order.slice(0, b, std::min(nf, b + o.batch_size));
-        adam->zero_grad();
-        const torch::Tensor loss =
-            torch::mse_loss(net->forward(x_fit.index_select(0, idx)), y_fit.index_select(0, idx));
-        loss.backward();
-        adam->step();
-      }
-      impl->report.epochs = epoch;
-      keep_if_best(epoch);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (seconds > o.time_budget_s) {
-        impl->report.budget_reached = true;
-        break;
-      }
-      if (epoch - impl->report.best_epoch >= o.patience) break;
-    }
-    if (best.empty() && !skip)
-      throw core::DataError(
-          "network training gave no finite validation loss; hint: lower learning_rate");
-    {
-      torch::NoGradGuard no_grad;
-      auto params = net->parameters();
-      const auto buffers = net->buffers();
-      for (std::size_t i = 0; i < best.size() && i < params.size(); ++i) params[i].copy_(best[i]);
-      for (std::size_t i = 0; i < best.size() && i < buffers.size(); ++i)
-        buffers[i].copy_(best[params.size() + i]);
-      if (skip_only <= best_loss) {
-        net->head->weight.zero_();
-        net->head->bias.zero_();
-        impl->report.best_epoch = 0;
-        best_loss = skip_only;
-      }
-      net->eval();
-      for (const auto& p : params) {
-        const torch::Tensor flat = p.detach().contiguous().view(-1);
-        const float* d = flat.data_ptr<float>();
-        impl->weights.insert(impl->weights.end(), d, d + flat.numel());
-      }
-    }
-    impl->report.validation_loss = best_loss;
+    impl->report.validation_loss = restored_best(net, best, skip_only, impl->report);
+    impl->weights = flat_parameters(net);
     impl->script =
         script_module(net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
                       skip.value_or(LinearSkip{Eigen::VectorXd::Zero(outputs),
