@@ -644,14 +644,27 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
   return sigma;
 }
 
-Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
-                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
-                    bool ambient_only, const solvers::Progress& progress) {
-  Catalogue cat;
-  cat.readout = r;
-  const mesh::TetMesh& m = model.mesh();
-  const auto& conv = declared.thermal.convection;
-  const solvers::FullThermalSystem& ops = model.full();
+namespace {
+
+/// Which of the march's responses make a candidate's columns: a separable column, a load column,
+/// an extra readout (indices into each list).
+struct ColumnSource {
+  enum { separable, load, extra_readout, ambient, none } type;
+  std::vector<int> index;
+};
+
+/// The candidates that need a march, with what the march must respond to for their columns:
+/// `sources[i]` names the responses of `cands[i]`.
+struct MarchedCandidates {
+  std::vector<Candidate> cands;
+  std::vector<SeparableColumn> sep;
+  std::vector<LoadColumn> loads;
+  std::vector<Eigen::MatrixXd> extra;
+  std::vector<ColumnSource> sources;
+};
+
+/// The speed a speed law is referred to [rpm]: the sources' own, else the runs' fastest, else 1.
+double reference_speed(const core::CaseSpec& declared, const std::vector<io::MeasuredRun>& runs) {
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
   if (ref_speed <= 0) {
@@ -661,23 +674,16 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     }
   }
   if (ref_speed <= 0) ref_speed = 1;
+  return ref_speed;
+}
 
-  // 1. The candidates' identities and their unit loads.
-  std::vector<Candidate> cands;
-  std::vector<SeparableColumn> sep;
-  std::vector<LoadColumn> loads;
-  std::vector<Eigen::MatrixXd> extra;
-  // Column bookkeeping: candidate -> (kind of column source, indices).
-  struct Source {
-    enum { separable, load, extra_readout, ambient, none } type;
-    std::vector<int> index;
-  };
-  std::vector<Source> sources;
-
+/// Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
+/// whose group is not mechanically fixed (a bed that keeps its own temperature).
+void add_air_candidates(MarchedCandidates& mc, const core::CaseSpec& declared,
+                        const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o) {
+  const auto& conv = declared.thermal.convection;
   double end_max = 0;
   for (const auto& run : runs) end_max = std::max(end_max, run.time(run.time.size() - 1));
-  // Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
-  // whose group is not mechanically fixed (a bed that keeps its own temperature).
   std::vector<double> knots;
   const int intervals = std::max(1, static_cast<int>(std::ceil(end_max / o.ambient_knot_interval)));
   for (int k = 0; k <= intervals; ++k) knots.push_back(end_max * k / intervals);
@@ -697,120 +703,139 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     c.per_run = true;
     c.name = v == 0 ? "air temperature on every convective sink"
                     : "air temperature on the sinks of unfixed groups";
-    Source src{Source::load, {}};
+    ColumnSource src{ColumnSource::load, {}};
     for (size_t k = 0; k < knots.size(); ++k) {
       c.parameters.push_back("delta_air_K at t = " + std::to_string(knots[k]) + " s");
       const std::vector<int> entries = variants[v];
       const double tk = knots[k], dk = end_max / intervals;
-      src.index.push_back(static_cast<int>(loads.size()));
+      src.index.push_back(static_cast<int>(mc.loads.size()));
       // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
       LoadColumn lc;
       lc.name = c.name + " knot " + std::to_string(k);
       lc.form = SinkHat{entries, tk, dk};
-      loads.push_back(std::move(lc));
+      mc.loads.push_back(std::move(lc));
     }
-    cands.push_back(std::move(c));
-    sources.push_back(src);
+    mc.cands.push_back(std::move(c));
+    mc.sources.push_back(src);
   }
+}
 
-  if (!ambient_only) {
-    // Heat entering through an undeclared surface patch, under each law.
-    for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
-      for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
-        Candidate c = heat_candidate(p, law, ref_speed);
-        sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
-        sep.push_back(heat_column(m, p, c));
-        c.unit_separable = {sep.back()};
-        c.unit_weights = {1};
-        cands.push_back(std::move(c));
-      }
+/// Heat entering through an undeclared surface patch, under each law.
+void add_heat_candidates(MarchedCandidates& mc, const mesh::TetMesh& m, const CalibrationOptions& o,
+                         double ref_speed) {
+  for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
+    for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
+      Candidate c = heat_candidate(p, law, ref_speed);
+      mc.sources.push_back({ColumnSource::separable, {static_cast<int>(mc.sep.size())}});
+      mc.sep.push_back(heat_column(m, p, c));
+      c.unit_separable = {mc.sep.back()};
+      c.unit_weights = {1};
+      mc.cands.push_back(std::move(c));
     }
-    // Per convection entry: a wrong conductance, and a conductance growing with speed.
-    for (size_t e = 0; e < conv.size(); ++e) {
-      const std::string gname = declared.groups[conv[e].group].name;
-      for (int speed_law = 0; speed_law < 2; ++speed_law) {
-        Candidate c;
-        const std::vector<int> entry{static_cast<int>(e)};
-        if (speed_law)
-          c.effect = SpeedDependentConvection{entry, {1}, ref_speed, 1};
-        else
-          c.effect = BoundaryConductance{entry, {1}};
-        c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
-        c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
-                                  : "delta_h_W_m2K"};
-        LoadColumn lc;
-        lc.name = c.name;
-        lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
-        sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-        c.unit_loads = {lc};
-        c.unit_weights = {1};
-        loads.push_back(std::move(lc));
-        cands.push_back(std::move(c));
-      }
-    }
-    // Heat that grows with the source's temperature.
-    const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
-    for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
-      const auto& srcspec = declared.thermal.sources[i];
+  }
+}
+
+/// `c` responding to the one load column `lc`, appended with it.
+void add_load_candidate(MarchedCandidates& mc, Candidate c, LoadColumn lc) {
+  mc.sources.push_back({ColumnSource::load, {static_cast<int>(mc.loads.size())}});
+  c.unit_loads = {lc};
+  c.unit_weights = {1};
+  mc.loads.push_back(std::move(lc));
+  mc.cands.push_back(std::move(c));
+}
+
+/// Per convection entry: a wrong conductance, and a conductance growing with speed.
+void add_film_candidates(MarchedCandidates& mc, const core::CaseSpec& declared, double ref_speed) {
+  const auto& conv = declared.thermal.convection;
+  for (size_t e = 0; e < conv.size(); ++e) {
+    const std::string gname = declared.groups[conv[e].group].name;
+    for (int speed_law = 0; speed_law < 2; ++speed_law) {
       Candidate c;
-      c.effect = TemperatureDependentHeat{{static_cast<int>(i)}, {1}};
-      c.name = "heat of " + srcspec.name + " growing with its temperature";
-      c.parameters = {"temperature_coefficient_per_K"};
+      const std::vector<int> entry{static_cast<int>(e)};
+      if (speed_law)
+        c.effect = SpeedDependentConvection{entry, {1}, ref_speed, 1};
+      else
+        c.effect = BoundaryConductance{entry, {1}};
+      c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
+      c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
+                                : "delta_h_W_m2K"};
       LoadColumn lc;
       lc.name = c.name;
-      lc.form = SourceGrowth{static_cast<int>(i), t0_k};
-      sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-      c.unit_loads = {lc};
-      c.unit_weights = {1};
-      loads.push_back(std::move(lc));
-      cands.push_back(std::move(c));
-    }
-    // Material parameters, each as a relative change: conductivity, heat capacity, expansion.
-    for (size_t mi = 0; mi < declared.materials.size(); ++mi) {
-      core::CaseSpec doubled = declared;
-      doubled.materials[mi].conductivity *= 2;
-      doubled.materials[mi].density *= 2;
-      const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
-      const auto km =
-          std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
-      const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
-      if (km->norm() == 0) continue;  // a material no body uses
-      const std::string mname = declared.materials[mi].name;
-      for (const auto& [field, fname] : kMaterialFieldNames) {
-        if (field == MaterialField::expansion &&
-            (r.displacement.rows() == 0 || !declared.mechanical.enabled))
-          continue;
-        Candidate c;
-        c.effect = MaterialParameter{static_cast<int>(mi), field};
-        c.name = std::string(fname) + " of " + mname;
-        c.parameters = {"relative_change"};
-        if (field == MaterialField::expansion) {
-          // The probes' rows gain the material's part per unit relative change.
-          extra.push_back(r.expansion.at(mi));
-          sources.push_back({Source::extra_readout, {static_cast<int>(extra.size()) - 1}});
-        } else {
-          // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
-          OperatorChange change;
-          const bool conductivity = field == MaterialField::conductivity;
-          change.which = conductivity ? OperatorChange::Operator::conduction
-                                      : OperatorChange::Operator::capacity;
-          change.full = conductivity ? km : cm;
-          if (model.is_reduced())
-            change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
-          LoadColumn lc;
-          lc.name = c.name;
-          lc.form = std::move(change);
-          sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-          c.unit_loads = {lc};
-          c.unit_weights = {1};
-          loads.push_back(std::move(lc));
-        }
-        cands.push_back(std::move(c));
-      }
+      lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
+      add_load_candidate(mc, std::move(c), std::move(lc));
     }
   }
+}
 
-  // 2. One march per run with every column; sensors' own effects from the base histories.
+/// Heat that grows with the source's temperature.
+void add_source_growth_candidates(MarchedCandidates& mc, const core::CaseSpec& declared) {
+  const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
+  for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
+    const auto& srcspec = declared.thermal.sources[i];
+    Candidate c;
+    c.effect = TemperatureDependentHeat{{static_cast<int>(i)}, {1}};
+    c.name = "heat of " + srcspec.name + " growing with its temperature";
+    c.parameters = {"temperature_coefficient_per_K"};
+    LoadColumn lc;
+    lc.name = c.name;
+    lc.form = SourceGrowth{static_cast<int>(i), t0_k};
+    add_load_candidate(mc, std::move(c), std::move(lc));
+  }
+}
+
+/// Material parameters, each as a relative change: conductivity, heat capacity, expansion.
+void add_material_candidates(MarchedCandidates& mc, const MarchModel& model,
+                             const core::CaseSpec& declared, const Readout& r) {
+  const mesh::TetMesh& m = model.mesh();
+  const solvers::FullThermalSystem& ops = model.full();
+  for (size_t mi = 0; mi < declared.materials.size(); ++mi) {
+    core::CaseSpec doubled = declared;
+    doubled.materials[mi].conductivity *= 2;
+    doubled.materials[mi].density *= 2;
+    const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
+    const auto km = std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
+    const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
+    if (km->norm() == 0) continue;  // a material no body uses
+    const std::string mname = declared.materials[mi].name;
+    for (const auto& [field, fname] : kMaterialFieldNames) {
+      if (field == MaterialField::expansion &&
+          (r.displacement.rows() == 0 || !declared.mechanical.enabled))
+        continue;
+      Candidate c;
+      c.effect = MaterialParameter{static_cast<int>(mi), field};
+      c.name = std::string(fname) + " of " + mname;
+      c.parameters = {"relative_change"};
+      if (field == MaterialField::expansion) {
+        // The probes' rows gain the material's part per unit relative change.
+        mc.extra.push_back(r.expansion.at(mi));
+        mc.sources.push_back(
+            {ColumnSource::extra_readout, {static_cast<int>(mc.extra.size()) - 1}});
+        mc.cands.push_back(std::move(c));
+        continue;
+      }
+      // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
+      OperatorChange change;
+      const bool conductivity = field == MaterialField::conductivity;
+      change.which =
+          conductivity ? OperatorChange::Operator::conduction : OperatorChange::Operator::capacity;
+      change.full = conductivity ? km : cm;
+      if (model.is_reduced())
+        change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
+      LoadColumn lc;
+      lc.name = c.name;
+      lc.form = std::move(change);
+      add_load_candidate(mc, std::move(c), std::move(lc));
+    }
+  }
+}
+
+/// One march per run with every column of `mc`: the runs (base histories, measured channels) into
+/// `cat.runs`, their responses returned in run order.
+std::vector<Responses> marched_runs(Catalogue& cat, const MarchModel& model,
+                                    const core::CaseSpec& declared, const Readout& r,
+                                    const std::vector<io::MeasuredRun>& runs,
+                                    const MarchedCandidates& mc,
+                                    const solvers::Progress& progress) {
   std::vector<Responses> resp;
   double simulated = 0, total = 0;
   for (const auto& run : runs) total += run.time(run.time.size() - 1);
@@ -820,49 +845,81 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     rm.spec = case_for_run(declared, run);
     rm.times = run.time;
     rm.measured = measured_channels(run, r);
-    Responses rs = march(model, rm.spec, r, run.time, sep, loads, extra);
+    Responses rs = march(model, rm.spec, r, run.time, mc.sep, mc.loads, mc.extra);
     simulated += run.time(run.time.size() - 1);
     if (progress) progress(simulated, total);
     rm.base = rs.base;
     cat.runs.push_back(std::move(rm));
     resp.push_back(std::move(rs));
   }
+  return resp;
+}
+
+/// Each candidate's columns per run, gathered from the runs' responses `resp` by its source.
+void fill_columns(MarchedCandidates& mc, const std::vector<Responses>& resp) {
   auto vec = [](const Eigen::MatrixXd& a) {
     return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size()).eval();
   };
-  for (size_t ci = 0; ci < cands.size(); ++ci) {
-    Candidate& c = cands[ci];
-    for (size_t ri = 0; ri < runs.size(); ++ri) {
+  const auto& sources = mc.sources;
+  for (size_t ci = 0; ci < mc.cands.size(); ++ci) {
+    Candidate& c = mc.cands[ci];
+    for (size_t ri = 0; ri < resp.size(); ++ri) {
       const Responses& rs = resp[ri];
       const Eigen::Index rows = rs.base.size();
       Eigen::MatrixXd a(rows, static_cast<Eigen::Index>(sources[ci].index.size()));
       for (size_t k = 0; k < sources[ci].index.size(); ++k) {
         const int idx = sources[ci].index[k];
-        const Eigen::MatrixXd& m_k = sources[ci].type == Source::separable ? rs.columns[idx]
-                                     : sources[ci].type == Source::load
-                                         ? rs.columns[sep.size() + static_cast<size_t>(idx)]
+        const Eigen::MatrixXd& m_k = sources[ci].type == ColumnSource::separable ? rs.columns[idx]
+                                     : sources[ci].type == ColumnSource::load
+                                         ? rs.columns[mc.sep.size() + static_cast<size_t>(idx)]
                                          : rs.extra[idx];
         a.col(static_cast<Eigen::Index>(k)) = vec(m_k);
       }
       c.columns.push_back(std::move(a));
     }
   }
-  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
-  if (!ambient_only) {
-    for (int s = 0; s < r.sensors; ++s) {
-      Candidate c;
-      c.effect = SensorOffset{s};
-      c.name = "offset of sensor " + r.ids[s];
-      c.parameters = {"offset_K"};
-      for (const auto& rm : cat.runs) {
-        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
-        a.block(s * rm.times.size(), 0, rm.times.size(), 1).setOnes();
-        c.columns.push_back(a);
-      }
-      cands.push_back(std::move(c));
-      for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(cat.runs, r, s, tau));
+}
+
+/// Sensors' own effects, from the base histories of `runs`: an offset and a lag per grid value.
+void add_sensor_candidates(std::vector<Candidate>& cands, const std::vector<RunModel>& runs,
+                           const Readout& r, const CalibrationOptions& o) {
+  for (int s = 0; s < r.sensors; ++s) {
+    Candidate c;
+    c.effect = SensorOffset{s};
+    c.name = "offset of sensor " + r.ids[s];
+    c.parameters = {"offset_K"};
+    for (const auto& rm : runs) {
+      Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
+      a.block(s * rm.times.size(), 0, rm.times.size(), 1).setOnes();
+      c.columns.push_back(a);
     }
+    cands.push_back(std::move(c));
+    for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(runs, r, s, tau));
   }
+}
+
+}  // namespace
+
+Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
+                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
+                    bool ambient_only, const solvers::Progress& progress) {
+  Catalogue cat;
+  cat.readout = r;
+  const double ref_speed = reference_speed(declared, runs);
+  // 1. The candidates' identities and their unit loads.
+  MarchedCandidates mc;
+  add_air_candidates(mc, declared, runs, o);
+  if (!ambient_only) {
+    add_heat_candidates(mc, model.mesh(), o, ref_speed);
+    add_film_candidates(mc, declared, ref_speed);
+    add_source_growth_candidates(mc, declared);
+    add_material_candidates(mc, model, declared, r);
+  }
+  // 2. One march per run with every column; sensors' own effects from the base histories.
+  fill_columns(mc, marched_runs(cat, model, declared, r, runs, mc, progress));
+  std::vector<Candidate> cands = std::move(mc.cands);
+  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
+  if (!ambient_only) add_sensor_candidates(cands, cat.runs, r, o);
   // The air the runs' ambient sensors read (the readout leaves them out of the channels).
   for (size_t k = 0; k < runs.size(); ++k) cat.runs[k].air = ambient_reading(runs[k]);
   cat.candidates = std::move(cands);
