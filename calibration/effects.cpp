@@ -1471,31 +1471,15 @@ Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
   return out;
 }
 
-Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
-                         const Resizer& resize) {
-  if (given.runs.size() < 2)
-    throw core::DataError(
-        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
-        "): effects are chosen by how much they explain on a run held out from the fit");
-  std::map<int, std::vector<double>> linearised;
-  const std::optional<Catalogue> resized =
-      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
-  const Catalogue& cat = resized ? *resized : given;
-  // A resized candidate's fits report the linearised parameters it was found unphysical at.
-  auto mark = [&](std::vector<EffectFit>& fits) {
-    for (auto& f : fits)
-      if (const auto it = linearised.find(f.candidate); it != linearised.end())
-        f.linearised = it->second;
-  };
-  Selection sel;
-  const auto& r = cat.readout;
-  sel.sigma = noise_sigma(cat.runs, r.sensors, o);
-  const auto [ws, ys] = whitened_runs(cat.runs, sel.sigma);
-  for (const auto& y : ys) sel.residual_ss += y.squaredNorm();
-  // Noise alone: the best score over every candidate on white noise at the estimated level.
+namespace {
+
+/// Noise alone: the best score over every candidate on white noise at the estimated level.
+double null_score(const Catalogue& cat, const std::vector<Whitened>& ws,
+                  const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
+                  const CalibrationOptions& o) {
   std::mt19937_64 rng = core::generator(o.seed, 7);
   std::normal_distribution<double> normal(0.0, 1.0);
-  sel.null_score = -1e300;
+  double best = -1e300;
   for (int trial = 0; trial < o.null_trials; ++trial) {
     std::vector<Eigen::VectorXd> noise;
     for (const auto& y : ys) {
@@ -1503,10 +1487,15 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       for (Eigen::Index i = 0; i < e.size(); ++i) e(i) = normal(rng);
       noise.push_back(e);
     }
-    for (const auto& f : score_all(cat, ws, noise, sel.sigma, o, false))
-      sel.null_score = std::max(sel.null_score, f.score);
+    for (const auto& f : score_all(cat, ws, noise, sigma, o, false)) best = std::max(best, f.score);
   }
-  // Model-form allowance per channel [whitened SS per sample].
+  return best;
+}
+
+/// Model-form allowance per channel [whitened SS per sample].
+Eigen::VectorXd channel_allowance(const Catalogue& cat, const Eigen::VectorXd& sigma,
+                                  const CalibrationOptions& o) {
+  const auto& r = cat.readout;
   Eigen::VectorXd allowance(r.channels());
   for (int ch = 0; ch < r.channels(); ++ch) {
     double tol = o.temperature_tolerance_K;
@@ -1518,64 +1507,106 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       }
       tol = o.displacement_tolerance_rel * std::sqrt(ss / cnt) + o.displacement_tolerance_m;
     }
-    allowance(ch) = (tol / sel.sigma(ch)) * (tol / sel.sigma(ch));
+    allowance(ch) = (tol / sigma(ch)) * (tol / sigma(ch));
   }
-  std::vector<Eigen::VectorXd> current = ys;
-  const double total = sel.residual_ss;
-  // Every candidate scored on the residual `left_of` (what the claims so far leave), with its
-  // floor and physical check; `order` ranks them by score.
+  return allowance;
+}
+
+/// What every round of the choice scores against: the catalogue, its whitened runs, the floors.
+struct Scoring {
+  const Catalogue& cat;
+  const std::vector<Whitened>& ws;
+  const Selection& sel;  ///< its sigma and null score
+  const CalibrationOptions& o;
+  /// A resized candidate's fits report the linearised parameters it was found unphysical at.
+  const std::map<int, std::vector<double>>& linearised;
+  Eigen::VectorXd allowance;
+  double total = 0;  ///< the whole training residual [whitened SS]
+};
+
+/// Every candidate's fit, and their indices by descending score.
+struct Ranked {
+  std::vector<EffectFit> fits;
   std::vector<int> order;
-  auto evaluate = [&](const std::vector<Eigen::VectorXd>& left_of) {
-    std::vector<EffectFit> fits = score_all(cat, ws, left_of, sel.sigma, o, true);
-    mark(fits);
-    double left = 0;
-    for (const auto& y : left_of) left += y.squaredNorm();
-    for (auto& f : fits) {
-      const Candidate& c = cat.candidates[f.candidate];
-      const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
-      f.floor = 0;
-      for (const auto& w : ws)
-        for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? allowance(ch) : 0.0;
-      // explained_fraction relative to the whole training residual, not what is left of it.
-      f.explained_fraction *= total > 0 ? left / total : 0;
-      f.unphysical =
-          unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
-    }
-    order.resize(fits.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-    std::sort(order.begin(), order.end(),
-              [&](int a, int b) { return fits[a].score > fits[b].score; });
-    return fits;
-  };
-  // The best physical candidate, claimed when it beats noise and floor and no candidate of
-  // another kind that would be claimed too comes within the spread of their per-run gains.
-  auto claimable = [&](const EffectFit& f) {
-    return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
-  };
-  std::vector<EffectFit> first_fits;
-  std::vector<int> first_order;
+};
+
+/// Every candidate scored on the residual `left_of` (what the claims so far leave), with its
+/// floor and physical check; `order` ranks them by score.
+Ranked evaluated(const Scoring& sc, const std::vector<Eigen::VectorXd>& left_of) {
+  const Catalogue& cat = sc.cat;
+  const auto& r = cat.readout;
+  const CalibrationOptions& o = sc.o;
+  Ranked out;
+  std::vector<EffectFit>& fits = out.fits;
+  fits = score_all(cat, sc.ws, left_of, sc.sel.sigma, o, true);
+  for (auto& f : fits)
+    if (const auto it = sc.linearised.find(f.candidate); it != sc.linearised.end())
+      f.linearised = it->second;
+  double left = 0;
+  for (const auto& y : left_of) left += y.squaredNorm();
+  for (auto& f : fits) {
+    const Candidate& c = cat.candidates[f.candidate];
+    const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
+    f.floor = 0;
+    for (const auto& w : sc.ws)
+      for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? sc.allowance(ch) : 0.0;
+    // explained_fraction relative to the whole training residual, not what is left of it.
+    f.explained_fraction *= sc.total > 0 ? left / sc.total : 0;
+    f.unphysical =
+        unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
+  }
+  out.order.resize(fits.size());
+  for (size_t i = 0; i < out.order.size(); ++i) out.order[i] = static_cast<int>(i);
+  std::sort(out.order.begin(), out.order.end(),
+            [&](int a, int b) { return fits[a].score > fits[b].score; });
+  return out;
+}
+
+/// Whether `f` may be claimed: physical, above noise, above its floor and above zero.
+bool claimable(const EffectFit& f, double null_score) {
+  return f.unphysical.empty() && f.score > null_score && f.score > f.floor && f.score > 0;
+}
+
+/// The first round's ranking: the best fit at each place, best first, at most o.ranking_size.
+std::vector<EffectFit> ranking(const Catalogue& cat, const Ranked& first,
+                               const CalibrationOptions& o) {
+  std::vector<EffectFit> out;
+  std::vector<const Candidate*> places;
+  for (int i : first.order) {
+    const Candidate& c = cat.candidates[i];
+    if (std::any_of(places.begin(), places.end(),
+                    [&](const Candidate* p) { return same_place(*p, c); }))
+      continue;
+    places.push_back(&c);
+    out.push_back(first.fits[i]);
+    if (static_cast<int>(out.size()) >= o.ranking_size) break;
+  }
+  return out;
+}
+
+/// The claims chosen one after the other into sel.claimed (an undecided round into sel.ambiguous):
+/// the best physical candidate, claimed when it beats noise and floor and no candidate of another
+/// kind that would be claimed too comes within the spread of their per-run gains; its fit removed
+/// before the next round. Returns the first round's fits (and sets sel.ranking from them).
+Ranked claimed_greedily(const Scoring& sc, const std::vector<Eigen::VectorXd>& ys, Selection& sel) {
+  const Catalogue& cat = sc.cat;
+  const CalibrationOptions& o = sc.o;
+  std::vector<Eigen::VectorXd> current = ys;
+  Ranked first;
   for (int round = 0; round < o.max_effects; ++round) {
-    std::vector<EffectFit> fits = evaluate(current);
+    const Ranked ranked = evaluated(sc, current);
+    const std::vector<EffectFit>& fits = ranked.fits;
+    const std::vector<int>& order = ranked.order;
     if (round == 0) {
-      first_fits = fits;
-      first_order = order;
-      std::vector<const Candidate*> places;
-      for (int i : order) {
-        const Candidate& c = cat.candidates[i];
-        if (std::any_of(places.begin(), places.end(),
-                        [&](const Candidate* p) { return same_place(*p, c); }))
-          continue;
-        places.push_back(&c);
-        sel.ranking.push_back(fits[i]);
-        if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
-      }
+      first = ranked;
+      sel.ranking = ranking(cat, first, o);
     }
     const auto best_at =
         std::find_if(order.begin(), order.end(), [&](int i) { return fits[i].unphysical.empty(); });
-    if (best_at == order.end() || !claimable(fits[*best_at])) break;
+    if (best_at == order.end() || !claimable(fits[*best_at], sel.null_score)) break;
     const EffectFit& best = fits[*best_at];
     const auto second_at = std::find_if(best_at + 1, order.end(), [&](int i) {
-      return fits[i].kind != best.kind && claimable(fits[i]);
+      return fits[i].kind != best.kind && claimable(fits[i], sel.null_score);
     });
     if (second_at != order.end()) {
       Ambiguity amb{best, fits[*second_at]};
@@ -1589,17 +1620,23 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     }
     sel.claimed.push_back(best);
     // Remove the claimed effect's in-sample fit before looking for the next one.
-    current = without_fits(cat, ws, std::move(current), sel.sigma, {best}, o);
+    current = without_fits(cat, sc.ws, std::move(current), sel.sigma, {best}, o);
   }
-  // Backfitting: each claim's place and size chosen again among the candidates of its kind on the
-  // training residual with the other claims' fits removed, until no claim changes. A claim that
-  // took part of a later one's signal (a heat input placed where an offset sensor pulls it) is
-  // then placed where the rest of the data puts it, and every claim is sized beside the others,
-  // not before them. A claim is replaced only when its replacement scores above it by more than
-  // the noise threshold and the spread of their per-run gains (the ambiguity rule's margin). The
-  // kinds stay the one-after-the-other choice's: letting them change made claims of kinds that
-  // share a signal (an air, a heat law, a conductivity) swap from sweep to sweep, and put a
-  // conductivity first where an air and a heat law were true (docs/calibration.md, §3).
+  return first;
+}
+
+/// Backfitting: each claim's place and size chosen again among the candidates of its kind on the
+/// training residual with the other claims' fits removed, until no claim changes. A claim that
+/// took part of a later one's signal (a heat input placed where an offset sensor pulls it) is
+/// then placed where the rest of the data puts it, and every claim is sized beside the others,
+/// not before them. A claim is replaced only when its replacement scores above it by more than
+/// the noise threshold and the spread of their per-run gains (the ambiguity rule's margin). The
+/// kinds stay the one-after-the-other choice's: letting them change made claims of kinds that
+/// share a signal (an air, a heat law, a conductivity) swap from sweep to sweep, and put a
+/// conductivity first where an air and a heat law were true (docs/calibration.md, §3).
+void backfit(const Scoring& sc, const std::vector<Eigen::VectorXd>& ys, Selection& sel) {
+  const Catalogue& cat = sc.cat;
+  const CalibrationOptions& o = sc.o;
   std::set<std::vector<int>> visited;
   for (int sweep = 0; sweep < o.backfit_sweeps && sel.claimed.size() >= 2; ++sweep) {
     bool changed = false;
@@ -1610,10 +1647,12 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       std::vector<EffectFit> others;
       for (size_t j = 0; j < sel.claimed.size(); ++j)
         if (j != i) others.push_back(sel.claimed[j]);
-      const std::vector<EffectFit> fits = evaluate(without_fits(cat, ws, ys, sel.sigma, others, o));
+      const Ranked ranked = evaluated(sc, without_fits(cat, sc.ws, ys, sel.sigma, others, o));
+      const std::vector<EffectFit>& fits = ranked.fits;
+      const std::vector<int>& order = ranked.order;
       const auto best_at = std::find_if(order.begin(), order.end(), [&](int k) {
         return fits[static_cast<size_t>(k)].kind == sel.claimed[i].kind &&
-               claimable(fits[static_cast<size_t>(k)]) &&
+               claimable(fits[static_cast<size_t>(k)], sel.null_score) &&
                std::none_of(others.begin(), others.end(), [&](const EffectFit& f) {
                  return f.candidate == fits[static_cast<size_t>(k)].candidate;
                });
@@ -1621,7 +1660,7 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       if (best_at == order.end()) continue;  // nothing beats noise under the others: kept
       const EffectFit* chosen = &fits[static_cast<size_t>(*best_at)];
       const EffectFit& now = fits[static_cast<size_t>(sel.claimed[i].candidate)];
-      if (chosen->candidate != now.candidate && claimable(now) &&
+      if (chosen->candidate != now.candidate && claimable(now, sel.null_score) &&
           chosen->score - now.score <=
               std::max(sel.null_score, gain_spread(chosen->fold_gains, now.fold_gains)))
         chosen = &now;
@@ -1634,8 +1673,31 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     }
     if (!changed) break;
   }
-  if (o.max_effects >= 2 && !first_fits.empty())
-    choose_pair(cat, ws, ys, first_fits, first_order, sel, o);
+}
+
+}  // namespace
+
+Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
+                         const Resizer& resize) {
+  if (given.runs.size() < 2)
+    throw core::DataError(
+        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
+        "): effects are chosen by how much they explain on a run held out from the fit");
+  std::map<int, std::vector<double>> linearised;
+  const std::optional<Catalogue> resized =
+      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
+  const Catalogue& cat = resized ? *resized : given;
+  Selection sel;
+  sel.sigma = noise_sigma(cat.runs, cat.readout.sensors, o);
+  const auto [ws, ys] = whitened_runs(cat.runs, sel.sigma);
+  for (const auto& y : ys) sel.residual_ss += y.squaredNorm();
+  sel.null_score = null_score(cat, ws, ys, sel.sigma, o);
+  const Scoring sc{
+      cat, ws, sel, o, linearised, channel_allowance(cat, sel.sigma, o), sel.residual_ss};
+  const Ranked first = claimed_greedily(sc, ys, sel);
+  backfit(sc, ys, sel);
+  if (o.max_effects >= 2 && !first.fits.empty())
+    choose_pair(cat, ws, ys, first.fits, first.order, sel, o);
   return sel;
 }
 
