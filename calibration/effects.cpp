@@ -1117,6 +1117,94 @@ double gain_spread(const std::vector<double>& a, const std::vector<double>& b) {
   return std::sqrt(static_cast<double>(n) * ss / static_cast<double>(n - 1));
 }
 
+/// A pair's joint design on every run: the shared members' whitened columns side by side, the
+/// run's air (if any) eliminated beside them, their normal equations, and the number of
+/// parameters the pair pays for.
+struct PairDesign {
+  std::vector<Normal> normals;
+  std::vector<Eigen::MatrixXd> cols;
+  std::vector<AirEliminated> design;
+  double penalty = 0;
+};
+
+PairDesign pair_design(const Catalogue& cat, const std::vector<Whitened>& ws,
+                       const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
+                       const std::vector<const Candidate*>& shared, const Candidate* air,
+                       const CalibrationOptions& o) {
+  const size_t nr = cat.runs.size();
+  PairDesign d;
+  d.cols.resize(nr);
+  for (const Candidate* c : shared) d.penalty += static_cast<double>(c->columns.front().cols());
+  for (size_t ri = 0; ri < nr; ++ri) {
+    Eigen::Index p = 0;
+    for (const Candidate* c : shared) p += c->columns.front().cols();
+    d.cols[ri].resize(static_cast<Eigen::Index>(ws[ri].rows.size()), p);
+    Eigen::Index at = 0;
+    for (const Candidate* c : shared) {
+      const Eigen::Index k = c->columns.front().cols();
+      d.cols[ri].middleCols(at, k) = whitened_rows(c->columns[ri], ws[ri], sigma);
+      at += k;
+    }
+    d.design.push_back(
+        air_eliminated(air, cat.runs[ri], cat.readout, ws[ri], ys[ri], d.cols[ri], ri, sigma, o));
+    const AirEliminated& e = d.design.back();
+    d.normals.push_back({e.m.transpose() * e.m, e.m.transpose() * e.y, e.y.squaredNorm()});
+    if (air && cat.runs[ri].air.size() == 0)
+      d.penalty += static_cast<double>(air->columns.front().cols());
+  }
+  return d;
+}
+
+/// Gains against the residual itself into `fold_gains`, with each run's air fitted within its
+/// bounds beside the shared parameters of its fold (those of the other runs); returns each run's
+/// air fitted beside the in-sample shared parameters `sf.full`.
+std::vector<std::vector<double>> air_fold_gains(const Catalogue& cat,
+                                                const std::vector<Eigen::VectorXd>& ys,
+                                                const Candidate& air, const PairDesign& d,
+                                                const SharedFit& sf, const CalibrationOptions& o,
+                                                std::vector<double>& fold_gains) {
+  const auto& normals = d.normals;
+  const auto& cols = d.cols;
+  const auto& design = d.design;
+  std::vector<std::vector<double>> airs;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(sf.full.size(), sf.full.size());
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(sf.full.size());
+  for (const auto& nm : normals) {
+    g += nm.g;
+    rhs += nm.b;
+  }
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    const Eigen::VectorXd x = solve_ridge(g - normals[ri].g, rhs - normals[ri].b, o.ridge);
+    const Eigen::VectorXd th = air_at(air, cat.runs[ri], design[ri], ys[ri], cols[ri], x, o);
+    fold_gains[ri] =
+        ys[ri].squaredNorm() - (ys[ri] - cols[ri] * x - design[ri].a * th).squaredNorm();
+    const Eigen::VectorXd full =
+        air_at(air, cat.runs[ri], design[ri], ys[ri], cols[ri], sf.full, o);
+    airs.emplace_back(full.data(), full.data() + full.size());
+  }
+  return airs;
+}
+
+/// Each member of `pf` given its joint parameters (the shared ones from `full` in member order,
+/// an air its per-run `airs`) and judged physical with them.
+void size_members(const Catalogue& cat, PairFit& pf, const Eigen::VectorXd& full,
+                  const std::vector<std::vector<double>>& airs, const CalibrationOptions& o) {
+  Eigen::Index at = 0;
+  for (EffectFit* f : {&pf.first, &pf.second}) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f->candidate)];
+    if (c.per_run) {
+      f->parameters.clear();
+      f->run_parameters = airs;
+    } else {
+      const Eigen::Index k = c.columns.front().cols();
+      f->parameters.assign(full.data() + at, full.data() + at + k);
+      at += k;
+    }
+    f->unphysical =
+        unphysical_reason(c, f->parameters, f->run_parameters, cat.runs, o, &f->duty_correlation);
+  }
+}
+
 /// Candidates `a` and `b` (their single fits of the first round) fitted together: the joint
 /// leave-one-run-out gains, the joint in-sample parameters, each member judged physical with them.
 /// One member may be a per-run air: it is fitted on each run beside the other's shared parameters
@@ -1140,67 +1228,14 @@ PairFit pair_fit(const Catalogue& cat, const std::vector<Whitened>& ws,
   std::vector<const Candidate*> shared;
   for (const Candidate* c : {&ca, &cb})
     if (!c->per_run) shared.push_back(c);
-  const size_t nr = cat.runs.size();
-  std::vector<Normal> normals;
-  std::vector<Eigen::MatrixXd> cols(nr);
-  std::vector<AirEliminated> design;
-  double penalty = 0;
-  for (const Candidate* c : shared) penalty += static_cast<double>(c->columns.front().cols());
-  for (size_t ri = 0; ri < nr; ++ri) {
-    Eigen::Index p = 0;
-    for (const Candidate* c : shared) p += c->columns.front().cols();
-    cols[ri].resize(static_cast<Eigen::Index>(ws[ri].rows.size()), p);
-    Eigen::Index at = 0;
-    for (const Candidate* c : shared) {
-      const Eigen::Index k = c->columns.front().cols();
-      cols[ri].middleCols(at, k) = whitened_rows(c->columns[ri], ws[ri], sigma);
-      at += k;
-    }
-    design.push_back(
-        air_eliminated(air, cat.runs[ri], cat.readout, ws[ri], ys[ri], cols[ri], ri, sigma, o));
-    const AirEliminated& e = design.back();
-    normals.push_back({e.m.transpose() * e.m, e.m.transpose() * e.y, e.y.squaredNorm()});
-    if (air && cat.runs[ri].air.size() == 0)
-      penalty += static_cast<double>(air->columns.front().cols());
-  }
-  const SharedFit sf = shared_fit(normals, o);
+  const PairDesign d = pair_design(cat, ws, ys, sigma, shared, air, o);
+  const SharedFit sf = shared_fit(d.normals, o);
   pf.fold_gains = sf.fold_gains;
   std::vector<std::vector<double>> airs;
-  if (air) {
-    // Gains against the residual itself, with each run's air fitted within its bounds beside the
-    // shared parameters of its fold (those of the other runs).
-    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(sf.full.size(), sf.full.size());
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(sf.full.size());
-    for (const auto& nm : normals) {
-      g += nm.g;
-      rhs += nm.b;
-    }
-    for (size_t ri = 0; ri < nr; ++ri) {
-      const Eigen::VectorXd x = solve_ridge(g - normals[ri].g, rhs - normals[ri].b, o.ridge);
-      const Eigen::VectorXd th = air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], x, o);
-      pf.fold_gains[ri] =
-          ys[ri].squaredNorm() - (ys[ri] - cols[ri] * x - design[ri].a * th).squaredNorm();
-      const Eigen::VectorXd full =
-          air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], sf.full, o);
-      airs.emplace_back(full.data(), full.data() + full.size());
-    }
-  }
+  if (air) airs = air_fold_gains(cat, ys, *air, d, sf, o, pf.fold_gains);
   for (double gain : pf.fold_gains) pf.heldout_gain += gain;
-  pf.score = pf.heldout_gain - o.penalty_per_parameter * penalty;
-  Eigen::Index at = 0;
-  for (EffectFit* f : {&pf.first, &pf.second}) {
-    const Candidate& c = cat.candidates[static_cast<size_t>(f->candidate)];
-    if (c.per_run) {
-      f->parameters.clear();
-      f->run_parameters = airs;
-    } else {
-      const Eigen::Index k = c.columns.front().cols();
-      f->parameters.assign(sf.full.data() + at, sf.full.data() + at + k);
-      at += k;
-    }
-    f->unphysical =
-        unphysical_reason(c, f->parameters, f->run_parameters, cat.runs, o, &f->duty_correlation);
-  }
+  pf.score = pf.heldout_gain - o.penalty_per_parameter * d.penalty;
+  size_members(cat, pf, sf.full, airs, o);
   pf.adds_first = pf.score - b.score;
   pf.adds_second = pf.score - a.score;
   pf.admissible = pf.first.unphysical.empty() && pf.second.unphysical.empty() &&
