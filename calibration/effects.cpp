@@ -1276,11 +1276,10 @@ std::optional<Catalogue> resized_catalogue(const Catalogue& cat, const Calibrati
   return out;
 }
 
-/// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
-/// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
-void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
-                 const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
-                 const std::vector<int>& order, Selection& sel, const CalibrationOptions& o) {
+/// The first round's best candidates (`fits` in `order`) that may be paired: physical, not fixed,
+/// scoring above zero; at most o.pair_pool_per_kind of a kind and o.pair_pool in all.
+std::vector<int> pair_pool(const Catalogue& cat, const std::vector<EffectFit>& fits,
+                           const std::vector<int>& order, const CalibrationOptions& o) {
   std::vector<int> pool;
   std::map<EffectKind, int> per_kind;
   for (int i : order) {
@@ -1292,6 +1291,66 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
     pool.push_back(i);
     if (static_cast<int>(pool.size()) >= o.pair_pool) break;
   }
+  return pool;
+}
+
+/// The best partner of each kind over the whole catalogue for `member`, each candidate fitted
+/// jointly with it (pair_fit), as kind -> (score, candidate); only physical pairs, one air at most.
+std::map<EffectKind, std::pair<double, int>> best_partners(
+    const Catalogue& cat, const std::vector<Whitened>& ws, const std::vector<Eigen::VectorXd>& ys,
+    const std::vector<EffectFit>& fits, const EffectFit& member, const Selection& sel,
+    const CalibrationOptions& o) {
+  const bool member_per_run = cat.candidates[static_cast<size_t>(member.candidate)].per_run;
+  std::map<EffectKind, std::pair<double, int>> best_of_kind;
+  for (const EffectFit& f : fits) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (f.candidate == member.candidate || c.fixed || (c.per_run && member_per_run)) continue;
+    const PairFit pf = pair_fit(cat, ws, ys, sel.sigma, member, f, sel.null_score, o);
+    if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
+    const auto it = best_of_kind.find(f.kind);
+    if (it == best_of_kind.end() || pf.score > it->second.first)
+      best_of_kind[f.kind] = {pf.score, f.candidate};
+  }
+  return best_of_kind;
+}
+
+/// Whether the best admissible pair `best` replaces the greedy claims of `sel`: not when nothing
+/// is claimed or a claim is fixed; with two claims, when it beats their own pair by more than the
+/// spread of the per-run gains; with one, when it adds more than noise and both floors.
+bool pair_overrules(const Catalogue& cat, const std::vector<Whitened>& ws,
+                    const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
+                    const PairFit& best, const Selection& sel, const CalibrationOptions& o) {
+  // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
+  if (sel.claimed.empty()) return false;
+  for (const auto& f : sel.claimed) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (c.fixed) return false;  // the greedy choice holds what pairs cannot
+  }
+  auto same = [](const PairFit& p, int a, int b) {
+    return (p.first.candidate == a && p.second.candidate == b) ||
+           (p.first.candidate == b && p.second.candidate == a);
+  };
+  if (sel.claimed.size() >= 2) {
+    const EffectFit &g0 = sel.claimed[0], &g1 = sel.claimed[1];
+    if (same(best, g0.candidate, g1.candidate)) return false;
+    // The greedy pair scored the same way (its members from the first round's fits).
+    const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
+                                    fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
+    if (!std::isfinite(greedy.score)) return false;  // two airs: no joint fit to compare with
+    if (best.score - greedy.score <= gain_spread(best.fold_gains, greedy.fold_gains)) return false;
+  } else if (best.score - sel.claimed[0].score <=
+             std::max(sel.null_score, std::max(best.first.floor, best.second.floor))) {
+    return false;
+  }
+  return true;
+}
+
+/// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
+/// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
+void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
+                 const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
+                 const std::vector<int>& order, Selection& sel, const CalibrationOptions& o) {
+  const std::vector<int> pool = pair_pool(cat, fits, order, o);
   std::vector<PairFit> pairs;
   std::set<std::pair<int, int>> scored;
   auto per_run = [&](int i) {
@@ -1315,20 +1374,9 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
   // favoured the bearing's conductivity over the film. A candidate's score alone does not matter.
   for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
     const int a = pool[x];
-    std::map<EffectKind, std::pair<double, int>> best_of_kind;
-    for (const EffectFit& f : fits) {
-      const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-      if (f.candidate == fits[static_cast<size_t>(a)].candidate || c.fixed ||
-          (c.per_run && per_run(a)))
-        continue;
-      const PairFit pf =
-          pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)], f, sel.null_score, o);
-      if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
-      const auto it = best_of_kind.find(f.kind);
-      if (it == best_of_kind.end() || pf.score > it->second.first)
-        best_of_kind[f.kind] = {pf.score, f.candidate};
-    }
-    for (const auto& [kind, best] : best_of_kind) add_pair(a, best.second);
+    for (const auto& [kind, best] :
+         best_partners(cat, ws, ys, fits, fits[static_cast<size_t>(a)], sel, o))
+      add_pair(a, best.second);
   }
   std::sort(pairs.begin(), pairs.end(),
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
@@ -1336,28 +1384,7 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
       std::find_if(pairs.begin(), pairs.end(), [](const PairFit& p) { return p.admissible; });
   sel.pairs.assign(pairs.begin(),
                    pairs.begin() + std::min<std::ptrdiff_t>(5, pairs.end() - pairs.begin()));
-  // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
-  if (best == pairs.end() || sel.claimed.empty()) return;
-  for (const auto& f : sel.claimed) {
-    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-    if (c.fixed) return;  // the greedy choice holds what pairs cannot
-  }
-  auto same = [](const PairFit& p, int a, int b) {
-    return (p.first.candidate == a && p.second.candidate == b) ||
-           (p.first.candidate == b && p.second.candidate == a);
-  };
-  if (sel.claimed.size() >= 2) {
-    const EffectFit &g0 = sel.claimed[0], &g1 = sel.claimed[1];
-    if (same(*best, g0.candidate, g1.candidate)) return;
-    // The greedy pair scored the same way (its members from the first round's fits).
-    const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
-                                    fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
-    if (!std::isfinite(greedy.score)) return;  // two airs: no joint fit to compare with
-    if (best->score - greedy.score <= gain_spread(best->fold_gains, greedy.fold_gains)) return;
-  } else if (best->score - sel.claimed[0].score <=
-             std::max(sel.null_score, std::max(best->first.floor, best->second.floor))) {
-    return;
-  }
+  if (best == pairs.end() || !pair_overrules(cat, ws, ys, fits, *best, sel, o)) return;
   const bool swap = best->second.score > best->first.score;
   sel.claimed = {swap ? best->second : best->first, swap ? best->first : best->second};
   sel.by_pair = true;
