@@ -82,6 +82,56 @@ core::DutyCycle random_duty_cycle(double hours, std::mt19937_64& rng) {
   return d;
 }
 
+namespace {
+
+/// A heat input's place drawn into `e`: a box around a random point of the housing's unfixed
+/// exterior, sized at random, with its magnitude [W], groups, area and centre.
+void draw_heat_box(InjectedEffect& e, const core::CaseSpec& declared, const mesh::TetMesh& m,
+                   std::mt19937_64& rng) {
+  std::vector<int> faces;
+  std::vector<double> cum;
+  double total = 0;
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
+    const int g = core::index_of(m.face_group[f]);
+    if (m.face_other_tet[f] >= 0 || g < 0) continue;
+    const auto& fixed = declared.mechanical.fixed_groups;
+    if (std::find(fixed.begin(), fixed.end(), g) != fixed.end()) continue;
+    if (m.region_names[core::index_of(m.tet_region[m.face_tet[f]])] != declared.bodies.front().name)
+      continue;
+    const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), b = m.nodes.row(m.faces(f, 1)),
+                          c = m.nodes.row(m.faces(f, 2));
+    total += 0.5 * (b - a).cross(c - a).norm();
+    faces.push_back(static_cast<int>(f));
+    cum.push_back(total);
+  }
+  const double u = uniform(rng, 0, total);
+  const int f = faces[std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()];
+  const Eigen::Vector3d p =
+      (m.nodes.row(m.faces(f, 0)) + m.nodes.row(m.faces(f, 1)) + m.nodes.row(m.faces(f, 2))) / 3;
+  Eigen::Vector3d half(uniform(rng, 0.03, 0.06), uniform(rng, 0.03, 0.06),
+                       uniform(rng, 0.03, 0.06));
+  e.box_min = p - half;
+  e.box_max = p + half;
+  e.magnitude = log_uniform(rng, 4, 25);  // W
+  // The faces whose centroid is in the box (the case format's rule) give area and centre.
+  Eigen::Vector3d wc = Eigen::Vector3d::Zero();
+  for (int k : faces) {
+    const Eigen::Vector3d a = m.nodes.row(m.faces(k, 0)), b = m.nodes.row(m.faces(k, 1)),
+                          c = m.nodes.row(m.faces(k, 2));
+    const Eigen::Vector3d g = (a + b + c) / 3;
+    if ((g.array() < e.box_min.array()).any() || (g.array() > e.box_max.array()).any()) continue;
+    const double ar = 0.5 * (b - a).cross(c - a).norm();
+    const std::string gname = m.group_names[core::index_of(m.face_group[k])];
+    if (std::find(e.groups.begin(), e.groups.end(), gname) == e.groups.end())
+      e.groups.push_back(gname);
+    e.area += ar;
+    wc += ar * g;
+  }
+  e.centre = wc / e.area;
+}
+
+}  // namespace
+
 InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
                              const mesh::TetMesh& m, const std::vector<std::string>& sensors,
                              std::mt19937_64& rng) {
@@ -100,54 +150,10 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
     case EffectKind::ambient_temperature:
       e.magnitude = log_uniform(rng, 0.3, 2.5);
       break;
-    case EffectKind::heat_input: {
-      // A box around a random point of the housing's unfixed exterior, sized at random.
-      std::vector<int> faces;
-      std::vector<double> cum;
-      double total = 0;
-      for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
-        const int g = core::index_of(m.face_group[f]);
-        if (m.face_other_tet[f] >= 0 || g < 0) continue;
-        const auto& fixed = declared.mechanical.fixed_groups;
-        if (std::find(fixed.begin(), fixed.end(), g) != fixed.end()) continue;
-        if (m.region_names[core::index_of(m.tet_region[m.face_tet[f]])] !=
-            declared.bodies.front().name)
-          continue;
-        const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), b = m.nodes.row(m.faces(f, 1)),
-                              c = m.nodes.row(m.faces(f, 2));
-        total += 0.5 * (b - a).cross(c - a).norm();
-        faces.push_back(static_cast<int>(f));
-        cum.push_back(total);
-      }
-      const double u = uniform(rng, 0, total);
-      const int f = faces[std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()];
-      const Eigen::Vector3d p =
-          (m.nodes.row(m.faces(f, 0)) + m.nodes.row(m.faces(f, 1)) + m.nodes.row(m.faces(f, 2))) /
-          3;
-      Eigen::Vector3d half(uniform(rng, 0.03, 0.06), uniform(rng, 0.03, 0.06),
-                           uniform(rng, 0.03, 0.06));
-      e.box_min = p - half;
-      e.box_max = p + half;
-      e.magnitude = log_uniform(rng, 4, 25);  // W
-      // The faces whose centroid is in the box (the case format's rule) give area and centre.
-      Eigen::Vector3d wc = Eigen::Vector3d::Zero();
-      for (int k : faces) {
-        const Eigen::Vector3d a = m.nodes.row(m.faces(k, 0)), b = m.nodes.row(m.faces(k, 1)),
-                              c = m.nodes.row(m.faces(k, 2));
-        const Eigen::Vector3d g = (a + b + c) / 3;
-        if ((g.array() < e.box_min.array()).any() || (g.array() > e.box_max.array()).any())
-          continue;
-        const double ar = 0.5 * (b - a).cross(c - a).norm();
-        const std::string gname = m.group_names[core::index_of(m.face_group[k])];
-        if (std::find(e.groups.begin(), e.groups.end(), gname) == e.groups.end())
-          e.groups.push_back(gname);
-        e.area += ar;
-        wc += ar * g;
-      }
-      e.centre = wc / e.area;
+    case EffectKind::heat_input:
+      draw_heat_box(e, declared, m, rng);
       e.follows_speed = pick(rng, 2) == 1;
       break;
-    }
     case EffectKind::speed_dependent_convection: {
       const int c = unfixed[static_cast<size_t>(pick(rng, static_cast<int>(unfixed.size())))];
       e.target = declared.groups[conv[c].group].name;
