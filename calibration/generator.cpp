@@ -196,6 +196,52 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
   return e;
 }
 
+namespace {
+
+/// The injected air `e` of run `run_index` added to the sinks of `s` it acts on (its target's, or
+/// every unfixed group's).
+void add_injected_air(core::CaseSpec& s, const InjectedEffect& e, const core::DutyCycle& duty,
+                      int run_index) {
+  auto& conv = s.thermal.convection;
+  auto on = [&](const core::Convection& c) {
+    if (!e.target.empty()) return s.groups[c.group].name == e.target;
+    const auto& f = s.mechanical.fixed_groups;
+    return std::find(f.begin(), f.end(), c.group) == f.end();
+  };
+  const core::TimeTable t = e.air == InjectedEffect::Air::shop_day
+                                ? shop_day_air(e.magnitude, e.seed, run_index, duty.end)
+                                : waves_air(e.magnitude, e.seed, run_index, duty.end);
+  for (auto& c : conv) {
+    if (!on(c)) continue;
+    core::TimeTable own = t;
+    for (size_t k = 0; k < own.time.size(); ++k)
+      own.value[k] += solvers::table_value(c.sink, own.time[k]);
+    c.sink = own;
+  }
+}
+
+/// The injected heat input `e` declared in `s`: every group the box covers gets its part (the
+/// case format's way to put heat on faces).
+void add_injected_heat(core::CaseSpec& s, const InjectedEffect& e) {
+  HeatInput h;
+  h.box_min = e.box_min;
+  h.box_max = e.box_max;
+  h.law = e.follows_speed ? HeatLaw::speed : HeatLaw::constant;
+  h.ref_speed_rpm = 3000;
+  h.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
+  // The drawn effect names its groups (InjectedEffect is written as truth.json).
+  for (const auto& name : e.groups)
+    for (size_t g = 0; g < s.groups.size(); ++g)
+      if (s.groups[g].name == name) h.groups.push_back(static_cast<int>(g));
+  Candidate c;
+  c.effect = h;
+  AugmentedCase a{s, {}, {}};
+  a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
+  s = a.spec;
+}
+
+}  // namespace
+
 core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
                           const core::DutyCycle& duty, int run_index) {
   core::CaseSpec s = gen;
@@ -208,43 +254,12 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
     throw core::DataError("generator: no convection on group '" + group + "'");
   };
   switch (e.kind) {
-    case EffectKind::ambient_temperature: {
-      auto on = [&](const core::Convection& c) {
-        if (!e.target.empty()) return s.groups[c.group].name == e.target;
-        const auto& f = s.mechanical.fixed_groups;
-        return std::find(f.begin(), f.end(), c.group) == f.end();
-      };
-      const core::TimeTable t = e.air == InjectedEffect::Air::shop_day
-                                    ? shop_day_air(e.magnitude, e.seed, run_index, duty.end)
-                                    : waves_air(e.magnitude, e.seed, run_index, duty.end);
-      for (auto& c : conv) {
-        if (!on(c)) continue;
-        core::TimeTable own = t;
-        for (size_t k = 0; k < own.time.size(); ++k)
-          own.value[k] += solvers::table_value(c.sink, own.time[k]);
-        c.sink = own;
-      }
+    case EffectKind::ambient_temperature:
+      add_injected_air(s, e, duty, run_index);
       break;
-    }
-    case EffectKind::heat_input: {
-      // Every group the box covers gets its part (the case format's way to put heat on faces).
-      HeatInput h;
-      h.box_min = e.box_min;
-      h.box_max = e.box_max;
-      h.law = e.follows_speed ? HeatLaw::speed : HeatLaw::constant;
-      h.ref_speed_rpm = 3000;
-      h.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
-      // The drawn effect names its groups (InjectedEffect is written as truth.json).
-      for (const auto& name : e.groups)
-        for (size_t g = 0; g < s.groups.size(); ++g)
-          if (s.groups[g].name == name) h.groups.push_back(static_cast<int>(g));
-      Candidate c;
-      c.effect = h;
-      AugmentedCase a{s, {}, {}};
-      a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
-      s = a.spec;
+    case EffectKind::heat_input:
+      add_injected_heat(s, e);
       break;
-    }
     case EffectKind::speed_dependent_convection: {
       auto& c = entry_of(e.target);
       c.h_speed_gain = e.magnitude;
