@@ -394,6 +394,76 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
   return clean_run(mesh_in, truth, InjectedEffects{e}, inst, o, name);
 }
 
+namespace {
+
+/// `x` (a sensor's true temperature on the truth's fine times `fine_t` [s]) as sensor `id` reads
+/// it: with its injected lag and offset in `effects`.
+Eigen::VectorXd sensed(Eigen::VectorXd x, const Eigen::VectorXd& fine_t,
+                       const InjectedEffects& effects, const std::string& id) {
+  const Eigen::Index nt = fine_t.size();
+  for (const InjectedEffect& e : effects) {
+    if (!e.present || e.target != id) continue;
+    if (e.kind == EffectKind::sensor_lag) {
+      // The sensor's own first-order lag, integrated on the truth's fine time grid.
+      Eigen::VectorXd y(nt);
+      y(0) = x(0);
+      for (Eigen::Index k = 1; k < nt; ++k) {
+        const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
+        y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
+      }
+      x = y;
+    }
+    if (e.kind == EffectKind::sensor_offset) x.array() += e.magnitude;
+  }
+  return x;
+}
+
+/// `run` with an ambient sensor "AIR" reading the sink of the truth's first unfixed convection
+/// entry at its sample times.
+void add_ambient_sensor(io::MeasuredRun& run, const core::CaseSpec& truth) {
+  const Eigen::Index ns = run.time.size();
+  const auto& fixed = truth.mechanical.fixed_groups;
+  const auto air = std::find_if(
+      truth.thermal.convection.begin(), truth.thermal.convection.end(),
+      [&](const auto& c) { return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end(); });
+  if (air == truth.thermal.convection.end())
+    throw core::DataError(
+        "generator: an ambient sensor needs a convection entry on a group "
+        "that is not fixed (the air); the case has none");
+  const Eigen::Index k = run.temperature.cols();
+  run.temperature.conservativeResize(ns, k + 1);
+  for (Eigen::Index i = 0; i < ns; ++i)
+    run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + core::kCelsiusOffset;
+  run.sensors.push_back({"AIR", std::nullopt});
+  run.ambient_sensor = "AIR";
+}
+
+/// `run` with the TCP's displacement probes (dx, dy, dz from the history's first column at the
+/// samples `at`) when the instrumentation asks for them and the truth has a TCP; else none.
+void add_tcp_probes(io::MeasuredRun& run, const mesh::TetMesh& m, const core::CaseSpec& truth,
+                    const Instrumentation& inst, const solvers::ThermalHistory& th,
+                    const std::vector<Eigen::Index>& at) {
+  const Eigen::Index ns = run.time.size();
+  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
+    const int tcp = point_node(m, truth.mechanical.tcp_point);
+    const solvers::ElasticModel model(m, truth);
+    const char* ids[] = {"dx", "dy", "dz"};
+    run.displacement.resize(ns, 3);
+    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd a = model.influence(tcp, d);
+      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
+      const double u0 = a.dot(th.temperature.col(0));
+      for (Eigen::Index i = 0; i < ns; ++i)
+        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
+    }
+  } else {
+    run.displacement.resize(ns, 0);
+  }
+}
+
+}  // namespace
+
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {
@@ -440,57 +510,13 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
     run.sensors.push_back({inst.sensor_points[s], m.points[0].position});
     for (const auto& p : m.points)
       if (p.id == inst.sensor_points[s]) run.sensors.back().position = p.position;
-    Eigen::VectorXd x = th.temperature.row(node).transpose();
-    for (const InjectedEffect& e : effects) {
-      if (!e.present || e.target != inst.sensor_points[s]) continue;
-      if (e.kind == EffectKind::sensor_lag) {
-        // The sensor's own first-order lag, integrated on the truth's fine time grid.
-        Eigen::VectorXd y(nt);
-        y(0) = x(0);
-        for (Eigen::Index k = 1; k < nt; ++k) {
-          const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
-          y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
-        }
-        x = y;
-      }
-      if (e.kind == EffectKind::sensor_offset) x.array() += e.magnitude;
-    }
+    const Eigen::VectorXd x =
+        sensed(th.temperature.row(node).transpose(), fine_t, effects, inst.sensor_points[s]);
     for (Eigen::Index i = 0; i < ns; ++i)
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
   }
-  if (inst.ambient_sensor) {
-    const auto& fixed = truth.mechanical.fixed_groups;
-    const auto air = std::find_if(
-        truth.thermal.convection.begin(), truth.thermal.convection.end(), [&](const auto& c) {
-          return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end();
-        });
-    if (air == truth.thermal.convection.end())
-      throw core::DataError(
-          "generator: an ambient sensor needs a convection entry on a group "
-          "that is not fixed (the air); the case has none");
-    const Eigen::Index k = run.temperature.cols();
-    run.temperature.conservativeResize(ns, k + 1);
-    for (Eigen::Index i = 0; i < ns; ++i)
-      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + core::kCelsiusOffset;
-    run.sensors.push_back({"AIR", std::nullopt});
-    run.ambient_sensor = "AIR";
-  }
-  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
-    const int tcp = point_node(m, truth.mechanical.tcp_point);
-    const solvers::ElasticModel model(m, truth);
-    const char* ids[] = {"dx", "dy", "dz"};
-    run.displacement.resize(ns, 3);
-    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
-    for (int d = 0; d < 3; ++d) {
-      const Eigen::VectorXd a = model.influence(tcp, d);
-      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
-      const double u0 = a.dot(th.temperature.col(0));
-      for (Eigen::Index i = 0; i < ns; ++i)
-        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
-    }
-  } else {
-    run.displacement.resize(ns, 0);
-  }
+  if (inst.ambient_sensor) add_ambient_sensor(run, truth);
+  add_tcp_probes(run, m, truth, inst, th, at);
   return run;
 }
 
