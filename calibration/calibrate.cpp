@@ -241,13 +241,140 @@ void describe(CalibrationResult& res, const Catalogue& cat) {
   for (const auto& f : sel.refit_rejected) res.refit_rejected.push_back(reported(cat, f, false));
 }
 
+/// A heat input or a sensor lag found on its grid: `train` with the place (the time constant)
+/// refined on finer grids around the best ones, so that the choice can be made again with those
+/// candidates and the noise rule and the ranking see them too; nothing when the claims have nothing
+/// to refine. A heat input that is not the first claim is refined too (when the first has nothing
+/// to refine); its places are scored with the other claims' fits removed, so that an offset sensor
+/// or an air does not pull them.
+std::optional<Catalogue> refined_catalogue(const MarchModel& model, const Catalogue& train,
+                                           const Selection& selection,
+                                           const CalibrationOptions& o) {
+  std::optional<Catalogue> refined;
+  const std::vector<EffectFit>& claimed = selection.claimed;
+  const Candidate& first = train.candidates[claimed.front().candidate];
+  const auto heat = std::find_if(claimed.begin(), claimed.end(), [&](const EffectFit& f) {
+    return f.kind == EffectKind::heat_input;
+  });
+  const bool heat_first = kind(first) == EffectKind::heat_input;
+  if (const auto* lag = std::get_if<SensorLag>(&first.effect); lag && o.lag_refine_steps > 1)
+    refined = with_refined_lag(train, lag->sensor, lag->time_constant_s, o);
+  else if (kind(first) == EffectKind::speed_dependent_convection && !o.speed_exponent_grid.empty())
+    refined = with_speed_exponents(model, train, claimed.front().candidate, o);
+  else if ((heat_first || heat != claimed.end()) && o.heat_refine_levels > 0) {
+    std::vector<EffectFit> others;
+    for (auto it = claimed.begin(); it != claimed.end(); ++it)
+      if (it != heat) others.push_back(*it);
+    refined = with_refined_heat_inputs(model, train, o, others);
+  }
+  return refined;
+}
+
+/// The test run `run` simulated with `aug` as its written file reads back (meshed again: heat
+/// inputs add boundary groups), sensor corrections applied; `rt` is the run's readout on `model`.
+Eigen::MatrixXd simulated_test_run(const MarchModel& model, const core::CaseSpec& declared,
+                                   const Readout& rt, const io::MeasuredRun& run,
+                                   const AugmentedCase& aug) {
+  const mesh::TetMesh& mesh = model.mesh();
+  const core::CaseSpec again =
+      io::case_from_toml(io::resolved_case_toml(aug.spec), "augmented.toml");
+  // The augmented case's own mesh: its new boundary groups take faces of the same tets.
+  const mesh::TetMesh m2 = mesh::mesh_case(again);
+  if (model.is_reduced() && same_tets(m2, mesh)) {
+    // The same basis: the augmented operators projected; the channels' rows kept (the sensor
+    // weights depend on the tets only), the probes' with any change of expansion (exact:
+    // the stiffness and the supports are the declared case's).
+    Readout r2 = rt;
+    r2.displacement = displacement_with_expansions(rt, declared, again);
+    const MarchModel augmented = model.with_case(m2, again);
+    return corrected(march(augmented, again, r2, run.time, {}, {}).base, run.time, r2, aug.sensors);
+  }
+  const Readout r2 = readout(m2, again, run);
+  return corrected(march(MarchModel(m2, again), again, r2, run.time, {}, {}).base, run.time, r2,
+                   aug.sensors);
+}
+
+/// What the calibration needs to simulate one test run with its claims.
+struct TestContext {
+  const MarchModel& model;
+  const core::CaseSpec& declared;
+  const Catalogue& cat;       ///< the training catalogue the claims index
+  const Catalogue& test_cat;  ///< the test runs' ambient columns (when a claim is per run)
+  const Selection& selection;
+  const CalibrationOptions& o;
+};
+
+/// Test run `ti`'s case (`spec`, readout `rt`) with the claims declared: the shared claims first;
+/// a per-run air is then fitted to what the model with them leaves of the test run (fitted against
+/// the declared model alone, it would take the other claims' signal a second time), and declared
+/// before them (a heat input's new group copies the covered group's sink).
+AugmentedCase claimed_case(const TestContext& tc, const io::MeasuredRun& run, size_t ti,
+                           const Readout& rt, const core::CaseSpec& spec) {
+  const Catalogue& cat = tc.cat;
+  const Readout& r = cat.readout;
+  const Selection& sel = tc.selection;
+  AugmentedCase aug{spec, {}, {}};
+  std::vector<const EffectFit*> airs;
+  for (const auto& f : sel.claimed) {
+    const Candidate& c = cat.candidates[f.candidate];
+    if (c.per_run)
+      airs.push_back(&f);
+    else
+      aug = augmented_case(aug, c, f.parameters, r);
+  }
+  if (airs.empty()) return aug;
+  RunModel left = tc.test_cat.runs[ti];
+  if (airs.size() < sel.claimed.size())
+    left.base = simulated_test_run(tc.model, tc.declared, rt, run, aug);
+  AugmentedCase with_air{spec, {}, {}};
+  for (const EffectFit* f : airs) {
+    const Candidate& c = cat.candidates[f->candidate];
+    const auto it = std::find_if(tc.test_cat.candidates.begin(), tc.test_cat.candidates.end(),
+                                 [&](const Candidate& x) { return same_place(x, c); });
+    const std::vector<double> p =
+        fit_run_parameters(*it, static_cast<int>(ti), left, r, sel.sigma, tc.o);
+    with_air = augmented_case(with_air, *it, p, r);
+    // A second air is fitted to what the first leaves (its columns are the declared model's).
+    const Eigen::VectorXd moved =
+        it->columns[ti] *
+        Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
+    left.base +=
+        Eigen::Map<const Eigen::MatrixXd>(moved.data(), left.base.rows(), left.base.cols());
+  }
+  for (const auto& f : sel.claimed) {
+    const Candidate& c = cat.candidates[f.candidate];
+    if (!c.per_run) with_air = augmented_case(with_air, c, f.parameters, r);
+  }
+  return with_air;
+}
+
+/// Test run `ti` simulated before (the declared case) and after (with the claims).
+TestRun test_run(const TestContext& tc, const io::MeasuredRun& run, size_t ti) {
+  const Readout& r = tc.cat.readout;
+  TestRun tr;
+  tr.name = run.run;
+  tr.times = run.time;
+  const Readout rt = readout_like(tc.model.mesh(), tc.declared, run, r);
+  if (rt.ids != r.ids)
+    throw core::DataError("test run '" + run.run +
+                          "' has other located channels than the training runs; " +
+                          "every run must list the same sensors and probes");
+  tr.measured = measured_channels(run, rt);
+  const core::CaseSpec spec = case_for_run(tc.declared, run);
+  tr.before = march(tc.model, spec, rt, run.time, {}, {}).base;
+  const AugmentedCase aug = claimed_case(tc, run, ti, rt, spec);
+  tr.after = tc.selection.claimed.empty() ? tr.before
+                                          : simulated_test_run(tc.model, tc.declared, rt, run, aug);
+  tr.augmented = aug;
+  return tr;
+}
+
 }  // namespace
 
 CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& declared,
                             const Catalogue& train, const std::vector<io::MeasuredRun>& test,
                             const CalibrationOptions& o) {
   CalibrationResult res;
-  const mesh::TetMesh& mesh = model.mesh();
   // Nonlinear candidates judged on their size, not on their linearisation's (refit_alone).
   auto resizer = [&](const Catalogue& c) -> Resizer {
     const Eigen::VectorXd sigma = noise_sigma(c.runs, c.readout.sensors, o);
@@ -256,31 +383,11 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
     };
   };
   res.selection = select_effects(train, o, resizer(train));
-  // A heat input or a sensor lag found on its grid: the place (the time constant) refined on finer
-  // grids around the best ones, and the choice made again with those candidates, so that the
-  // noise rule and the ranking see them too.
-  // A heat input that is not the first claim is refined too (when the first has nothing to
-  // refine); its places are scored with the other claims' fits removed, so that an offset sensor
-  // or an air does not pull them.
+  // A heat input or a sensor lag found on its grid: the choice made again with the refined
+  // candidates (refined_catalogue).
   std::optional<Catalogue> refined;
   if (!res.selection.claimed.empty()) {
-    const std::vector<EffectFit>& claimed = res.selection.claimed;
-    const Candidate& first = train.candidates[claimed.front().candidate];
-    const auto heat = std::find_if(claimed.begin(), claimed.end(), [&](const EffectFit& f) {
-      return f.kind == EffectKind::heat_input;
-    });
-    const bool heat_first = kind(first) == EffectKind::heat_input;
-    if (const auto* lag = std::get_if<SensorLag>(&first.effect); lag && o.lag_refine_steps > 1)
-      refined = with_refined_lag(train, lag->sensor, lag->time_constant_s, o);
-    else if (kind(first) == EffectKind::speed_dependent_convection &&
-             !o.speed_exponent_grid.empty())
-      refined = with_speed_exponents(model, train, claimed.front().candidate, o);
-    else if ((heat_first || heat != claimed.end()) && o.heat_refine_levels > 0) {
-      std::vector<EffectFit> others;
-      for (auto it = claimed.begin(); it != claimed.end(); ++it)
-        if (it != heat) others.push_back(*it);
-      refined = with_refined_heat_inputs(model, train, o, others);
-    }
+    refined = refined_catalogue(model, train, res.selection, o);
     if (refined) res.selection = select_effects(*refined, o, resizer(*refined));
   }
   const Catalogue& cat = refined ? *refined : train;
@@ -294,80 +401,10 @@ CalibrationResult calibrate(const MarchModel& model, const core::CaseSpec& decla
   Catalogue test_cat;
   if (per_run && !test.empty()) test_cat = catalogue(model, declared, r, test, o, true);
 
+  const TestContext tc{model, declared, cat, test_cat, res.selection, o};
   std::vector<Eigen::MatrixXd> meas, before, after;
   for (size_t ti = 0; ti < test.size(); ++ti) {
-    const io::MeasuredRun& run = test[ti];
-    TestRun tr;
-    tr.name = run.run;
-    tr.times = run.time;
-    const Readout rt = readout_like(mesh, declared, run, r);
-    if (rt.ids != r.ids)
-      throw core::DataError("test run '" + run.run +
-                            "' has other located channels than the training runs; " +
-                            "every run must list the same sensors and probes");
-    tr.measured = measured_channels(run, rt);
-    const core::CaseSpec spec = case_for_run(declared, run);
-    tr.before = march(model, spec, rt, run.time, {}, {}).base;
-    // The test run simulated with `aug` as its written file reads back (meshed again: heat inputs
-    // add boundary groups), sensor corrections applied.
-    auto simulated = [&](const AugmentedCase& aug) -> Eigen::MatrixXd {
-      const core::CaseSpec again =
-          io::case_from_toml(io::resolved_case_toml(aug.spec), "augmented.toml");
-      // The augmented case's own mesh: its new boundary groups take faces of the same tets.
-      const mesh::TetMesh m2 = mesh::mesh_case(again);
-      if (model.is_reduced() && same_tets(m2, mesh)) {
-        // The same basis: the augmented operators projected; the channels' rows kept (the sensor
-        // weights depend on the tets only), the probes' with any change of expansion (exact:
-        // the stiffness and the supports are the declared case's).
-        Readout r2 = rt;
-        r2.displacement = displacement_with_expansions(rt, declared, again);
-        const MarchModel augmented = model.with_case(m2, again);
-        return corrected(march(augmented, again, r2, run.time, {}, {}).base, run.time, r2,
-                         aug.sensors);
-      }
-      const Readout r2 = readout(m2, again, run);
-      return corrected(march(MarchModel(m2, again), again, r2, run.time, {}, {}).base, run.time, r2,
-                       aug.sensors);
-    };
-    // The shared claims first; a per-run air is then fitted to what the model with them leaves of
-    // the test run (fitted against the declared model alone, it would take the other claims'
-    // signal a second time), and declared before them (a heat input's new group copies the
-    // covered group's sink).
-    AugmentedCase aug{spec, {}, {}};
-    std::vector<const EffectFit*> airs;
-    for (const auto& f : res.selection.claimed) {
-      const Candidate& c = cat.candidates[f.candidate];
-      if (c.per_run)
-        airs.push_back(&f);
-      else
-        aug = augmented_case(aug, c, f.parameters, r);
-    }
-    if (!airs.empty()) {
-      RunModel left = test_cat.runs[ti];
-      if (airs.size() < res.selection.claimed.size()) left.base = simulated(aug);
-      AugmentedCase with_air{spec, {}, {}};
-      for (const EffectFit* f : airs) {
-        const Candidate& c = cat.candidates[f->candidate];
-        const auto it = std::find_if(test_cat.candidates.begin(), test_cat.candidates.end(),
-                                     [&](const Candidate& x) { return same_place(x, c); });
-        const std::vector<double> p =
-            fit_run_parameters(*it, static_cast<int>(ti), left, r, res.selection.sigma, o);
-        with_air = augmented_case(with_air, *it, p, r);
-        // A second air is fitted to what the first leaves (its columns are the declared model's).
-        const Eigen::VectorXd moved =
-            it->columns[ti] *
-            Eigen::Map<const Eigen::VectorXd>(p.data(), static_cast<Eigen::Index>(p.size()));
-        left.base +=
-            Eigen::Map<const Eigen::MatrixXd>(moved.data(), left.base.rows(), left.base.cols());
-      }
-      for (const auto& f : res.selection.claimed) {
-        const Candidate& c = cat.candidates[f.candidate];
-        if (!c.per_run) with_air = augmented_case(with_air, c, f.parameters, r);
-      }
-      aug = with_air;
-    }
-    tr.after = res.selection.claimed.empty() ? tr.before : simulated(aug);
-    tr.augmented = aug;
+    TestRun tr = test_run(tc, test[ti], ti);
     meas.push_back(tr.measured);
     before.push_back(tr.before);
     after.push_back(tr.after);

@@ -644,14 +644,27 @@ Eigen::VectorXd noise_sigma(const std::vector<RunModel>& runs, int sensors,
   return sigma;
 }
 
-Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
-                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
-                    bool ambient_only, const solvers::Progress& progress) {
-  Catalogue cat;
-  cat.readout = r;
-  const mesh::TetMesh& m = model.mesh();
-  const auto& conv = declared.thermal.convection;
-  const solvers::FullThermalSystem& ops = model.full();
+namespace {
+
+/// Which of the march's responses make a candidate's columns: a separable column, a load column,
+/// an extra readout (indices into each list).
+struct ColumnSource {
+  enum { separable, load, extra_readout, ambient, none } type;
+  std::vector<int> index;
+};
+
+/// The candidates that need a march, with what the march must respond to for their columns:
+/// `sources[i]` names the responses of `cands[i]`.
+struct MarchedCandidates {
+  std::vector<Candidate> cands;
+  std::vector<SeparableColumn> sep;
+  std::vector<LoadColumn> loads;
+  std::vector<Eigen::MatrixXd> extra;
+  std::vector<ColumnSource> sources;
+};
+
+/// The speed a speed law is referred to [rpm]: the sources' own, else the runs' fastest, else 1.
+double reference_speed(const core::CaseSpec& declared, const std::vector<io::MeasuredRun>& runs) {
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
   if (ref_speed <= 0) {
@@ -661,23 +674,16 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     }
   }
   if (ref_speed <= 0) ref_speed = 1;
+  return ref_speed;
+}
 
-  // 1. The candidates' identities and their unit loads.
-  std::vector<Candidate> cands;
-  std::vector<SeparableColumn> sep;
-  std::vector<LoadColumn> loads;
-  std::vector<Eigen::MatrixXd> extra;
-  // Column bookkeeping: candidate -> (kind of column source, indices).
-  struct Source {
-    enum { separable, load, extra_readout, ambient, none } type;
-    std::vector<int> index;
-  };
-  std::vector<Source> sources;
-
+/// Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
+/// whose group is not mechanically fixed (a bed that keeps its own temperature).
+void add_air_candidates(MarchedCandidates& mc, const core::CaseSpec& declared,
+                        const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o) {
+  const auto& conv = declared.thermal.convection;
   double end_max = 0;
   for (const auto& run : runs) end_max = std::max(end_max, run.time(run.time.size() - 1));
-  // Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
-  // whose group is not mechanically fixed (a bed that keeps its own temperature).
   std::vector<double> knots;
   const int intervals = std::max(1, static_cast<int>(std::ceil(end_max / o.ambient_knot_interval)));
   for (int k = 0; k <= intervals; ++k) knots.push_back(end_max * k / intervals);
@@ -697,120 +703,139 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     c.per_run = true;
     c.name = v == 0 ? "air temperature on every convective sink"
                     : "air temperature on the sinks of unfixed groups";
-    Source src{Source::load, {}};
+    ColumnSource src{ColumnSource::load, {}};
     for (size_t k = 0; k < knots.size(); ++k) {
       c.parameters.push_back("delta_air_K at t = " + std::to_string(knots[k]) + " s");
       const std::vector<int> entries = variants[v];
       const double tk = knots[k], dk = end_max / intervals;
-      src.index.push_back(static_cast<int>(loads.size()));
+      src.index.push_back(static_cast<int>(mc.loads.size()));
       // The hat at knot k on every entry's sink: h(n) int N dA per kelvin.
       LoadColumn lc;
       lc.name = c.name + " knot " + std::to_string(k);
       lc.form = SinkHat{entries, tk, dk};
-      loads.push_back(std::move(lc));
+      mc.loads.push_back(std::move(lc));
     }
-    cands.push_back(std::move(c));
-    sources.push_back(src);
+    mc.cands.push_back(std::move(c));
+    mc.sources.push_back(src);
   }
+}
 
-  if (!ambient_only) {
-    // Heat entering through an undeclared surface patch, under each law.
-    for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
-      for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
-        Candidate c = heat_candidate(p, law, ref_speed);
-        sources.push_back({Source::separable, {static_cast<int>(sep.size())}});
-        sep.push_back(heat_column(m, p, c));
-        c.unit_separable = {sep.back()};
-        c.unit_weights = {1};
-        cands.push_back(std::move(c));
-      }
+/// Heat entering through an undeclared surface patch, under each law.
+void add_heat_candidates(MarchedCandidates& mc, const mesh::TetMesh& m, const CalibrationOptions& o,
+                         double ref_speed) {
+  for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
+    for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
+      Candidate c = heat_candidate(p, law, ref_speed);
+      mc.sources.push_back({ColumnSource::separable, {static_cast<int>(mc.sep.size())}});
+      mc.sep.push_back(heat_column(m, p, c));
+      c.unit_separable = {mc.sep.back()};
+      c.unit_weights = {1};
+      mc.cands.push_back(std::move(c));
     }
-    // Per convection entry: a wrong conductance, and a conductance growing with speed.
-    for (size_t e = 0; e < conv.size(); ++e) {
-      const std::string gname = declared.groups[conv[e].group].name;
-      for (int speed_law = 0; speed_law < 2; ++speed_law) {
-        Candidate c;
-        const std::vector<int> entry{static_cast<int>(e)};
-        if (speed_law)
-          c.effect = SpeedDependentConvection{entry, {1}, ref_speed, 1};
-        else
-          c.effect = BoundaryConductance{entry, {1}};
-        c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
-        c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
-                                  : "delta_h_W_m2K"};
-        LoadColumn lc;
-        lc.name = c.name;
-        lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
-        sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-        c.unit_loads = {lc};
-        c.unit_weights = {1};
-        loads.push_back(std::move(lc));
-        cands.push_back(std::move(c));
-      }
-    }
-    // Heat that grows with the source's temperature.
-    const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
-    for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
-      const auto& srcspec = declared.thermal.sources[i];
+  }
+}
+
+/// `c` responding to the one load column `lc`, appended with it.
+void add_load_candidate(MarchedCandidates& mc, Candidate c, LoadColumn lc) {
+  mc.sources.push_back({ColumnSource::load, {static_cast<int>(mc.loads.size())}});
+  c.unit_loads = {lc};
+  c.unit_weights = {1};
+  mc.loads.push_back(std::move(lc));
+  mc.cands.push_back(std::move(c));
+}
+
+/// Per convection entry: a wrong conductance, and a conductance growing with speed.
+void add_film_candidates(MarchedCandidates& mc, const core::CaseSpec& declared, double ref_speed) {
+  const auto& conv = declared.thermal.convection;
+  for (size_t e = 0; e < conv.size(); ++e) {
+    const std::string gname = declared.groups[conv[e].group].name;
+    for (int speed_law = 0; speed_law < 2; ++speed_law) {
       Candidate c;
-      c.effect = TemperatureDependentHeat{{static_cast<int>(i)}, {1}};
-      c.name = "heat of " + srcspec.name + " growing with its temperature";
-      c.parameters = {"temperature_coefficient_per_K"};
+      const std::vector<int> entry{static_cast<int>(e)};
+      if (speed_law)
+        c.effect = SpeedDependentConvection{entry, {1}, ref_speed, 1};
+      else
+        c.effect = BoundaryConductance{entry, {1}};
+      c.name = (speed_law ? "convection growing with speed on " : "conductance of ") + gname;
+      c.parameters = {speed_law ? "h_speed_gain_W_m2K at " + std::to_string(ref_speed) + " rpm"
+                                : "delta_h_W_m2K"};
       LoadColumn lc;
       lc.name = c.name;
-      lc.form = SourceGrowth{static_cast<int>(i), t0_k};
-      sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-      c.unit_loads = {lc};
-      c.unit_weights = {1};
-      loads.push_back(std::move(lc));
-      cands.push_back(std::move(c));
-    }
-    // Material parameters, each as a relative change: conductivity, heat capacity, expansion.
-    for (size_t mi = 0; mi < declared.materials.size(); ++mi) {
-      core::CaseSpec doubled = declared;
-      doubled.materials[mi].conductivity *= 2;
-      doubled.materials[mi].density *= 2;
-      const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
-      const auto km =
-          std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
-      const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
-      if (km->norm() == 0) continue;  // a material no body uses
-      const std::string mname = declared.materials[mi].name;
-      for (const auto& [field, fname] : kMaterialFieldNames) {
-        if (field == MaterialField::expansion &&
-            (r.displacement.rows() == 0 || !declared.mechanical.enabled))
-          continue;
-        Candidate c;
-        c.effect = MaterialParameter{static_cast<int>(mi), field};
-        c.name = std::string(fname) + " of " + mname;
-        c.parameters = {"relative_change"};
-        if (field == MaterialField::expansion) {
-          // The probes' rows gain the material's part per unit relative change.
-          extra.push_back(r.expansion.at(mi));
-          sources.push_back({Source::extra_readout, {static_cast<int>(extra.size()) - 1}});
-        } else {
-          // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
-          OperatorChange change;
-          const bool conductivity = field == MaterialField::conductivity;
-          change.which = conductivity ? OperatorChange::Operator::conduction
-                                      : OperatorChange::Operator::capacity;
-          change.full = conductivity ? km : cm;
-          if (model.is_reduced())
-            change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
-          LoadColumn lc;
-          lc.name = c.name;
-          lc.form = std::move(change);
-          sources.push_back({Source::load, {static_cast<int>(loads.size())}});
-          c.unit_loads = {lc};
-          c.unit_weights = {1};
-          loads.push_back(std::move(lc));
-        }
-        cands.push_back(std::move(c));
-      }
+      lc.form = FilmChange{static_cast<int>(e), speed_law == 1, ref_speed};
+      add_load_candidate(mc, std::move(c), std::move(lc));
     }
   }
+}
 
-  // 2. One march per run with every column; sensors' own effects from the base histories.
+/// Heat that grows with the source's temperature.
+void add_source_growth_candidates(MarchedCandidates& mc, const core::CaseSpec& declared) {
+  const double t0_k = declared.thermal.initial_temperature_c + core::kCelsiusOffset;
+  for (size_t i = 0; i < declared.thermal.sources.size(); ++i) {
+    const auto& srcspec = declared.thermal.sources[i];
+    Candidate c;
+    c.effect = TemperatureDependentHeat{{static_cast<int>(i)}, {1}};
+    c.name = "heat of " + srcspec.name + " growing with its temperature";
+    c.parameters = {"temperature_coefficient_per_K"};
+    LoadColumn lc;
+    lc.name = c.name;
+    lc.form = SourceGrowth{static_cast<int>(i), t0_k};
+    add_load_candidate(mc, std::move(c), std::move(lc));
+  }
+}
+
+/// Material parameters, each as a relative change: conductivity, heat capacity, expansion.
+void add_material_candidates(MarchedCandidates& mc, const MarchModel& model,
+                             const core::CaseSpec& declared, const Readout& r) {
+  const mesh::TetMesh& m = model.mesh();
+  const solvers::FullThermalSystem& ops = model.full();
+  for (size_t mi = 0; mi < declared.materials.size(); ++mi) {
+    core::CaseSpec doubled = declared;
+    doubled.materials[mi].conductivity *= 2;
+    doubled.materials[mi].density *= 2;
+    const solvers::FullThermalSystem dops = solvers::thermal_system(m, doubled);
+    const auto km = std::make_shared<Eigen::SparseMatrix<double>>(dops.conduction - ops.conduction);
+    const auto cm = std::make_shared<Eigen::SparseMatrix<double>>(dops.capacity - ops.capacity);
+    if (km->norm() == 0) continue;  // a material no body uses
+    const std::string mname = declared.materials[mi].name;
+    for (const auto& [field, fname] : kMaterialFieldNames) {
+      if (field == MaterialField::expansion &&
+          (r.displacement.rows() == 0 || !declared.mechanical.enabled))
+        continue;
+      Candidate c;
+      c.effect = MaterialParameter{static_cast<int>(mi), field};
+      c.name = std::string(fname) + " of " + mname;
+      c.parameters = {"relative_change"};
+      if (field == MaterialField::expansion) {
+        // The probes' rows gain the material's part per unit relative change.
+        mc.extra.push_back(r.expansion.at(mi));
+        mc.sources.push_back(
+            {ColumnSource::extra_readout, {static_cast<int>(mc.extra.size()) - 1}});
+        mc.cands.push_back(std::move(c));
+        continue;
+      }
+      // A relative change of conductivity (capacity) adds -dK T (-dC dT/dt).
+      OperatorChange change;
+      const bool conductivity = field == MaterialField::conductivity;
+      change.which =
+          conductivity ? OperatorChange::Operator::conduction : OperatorChange::Operator::capacity;
+      change.full = conductivity ? km : cm;
+      if (model.is_reduced())
+        change.reduced = std::make_shared<const Eigen::MatrixXd>(model.projected(*change.full));
+      LoadColumn lc;
+      lc.name = c.name;
+      lc.form = std::move(change);
+      add_load_candidate(mc, std::move(c), std::move(lc));
+    }
+  }
+}
+
+/// One march per run with every column of `mc`: the runs (base histories, measured channels) into
+/// `cat.runs`, their responses returned in run order.
+std::vector<Responses> marched_runs(Catalogue& cat, const MarchModel& model,
+                                    const core::CaseSpec& declared, const Readout& r,
+                                    const std::vector<io::MeasuredRun>& runs,
+                                    const MarchedCandidates& mc,
+                                    const solvers::Progress& progress) {
   std::vector<Responses> resp;
   double simulated = 0, total = 0;
   for (const auto& run : runs) total += run.time(run.time.size() - 1);
@@ -820,49 +845,81 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
     rm.spec = case_for_run(declared, run);
     rm.times = run.time;
     rm.measured = measured_channels(run, r);
-    Responses rs = march(model, rm.spec, r, run.time, sep, loads, extra);
+    Responses rs = march(model, rm.spec, r, run.time, mc.sep, mc.loads, mc.extra);
     simulated += run.time(run.time.size() - 1);
     if (progress) progress(simulated, total);
     rm.base = rs.base;
     cat.runs.push_back(std::move(rm));
     resp.push_back(std::move(rs));
   }
+  return resp;
+}
+
+/// Each candidate's columns per run, gathered from the runs' responses `resp` by its source.
+void fill_columns(MarchedCandidates& mc, const std::vector<Responses>& resp) {
   auto vec = [](const Eigen::MatrixXd& a) {
     return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size()).eval();
   };
-  for (size_t ci = 0; ci < cands.size(); ++ci) {
-    Candidate& c = cands[ci];
-    for (size_t ri = 0; ri < runs.size(); ++ri) {
+  const auto& sources = mc.sources;
+  for (size_t ci = 0; ci < mc.cands.size(); ++ci) {
+    Candidate& c = mc.cands[ci];
+    for (size_t ri = 0; ri < resp.size(); ++ri) {
       const Responses& rs = resp[ri];
       const Eigen::Index rows = rs.base.size();
       Eigen::MatrixXd a(rows, static_cast<Eigen::Index>(sources[ci].index.size()));
       for (size_t k = 0; k < sources[ci].index.size(); ++k) {
         const int idx = sources[ci].index[k];
-        const Eigen::MatrixXd& m_k = sources[ci].type == Source::separable ? rs.columns[idx]
-                                     : sources[ci].type == Source::load
-                                         ? rs.columns[sep.size() + static_cast<size_t>(idx)]
+        const Eigen::MatrixXd& m_k = sources[ci].type == ColumnSource::separable ? rs.columns[idx]
+                                     : sources[ci].type == ColumnSource::load
+                                         ? rs.columns[mc.sep.size() + static_cast<size_t>(idx)]
                                          : rs.extra[idx];
         a.col(static_cast<Eigen::Index>(k)) = vec(m_k);
       }
       c.columns.push_back(std::move(a));
     }
   }
-  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
-  if (!ambient_only) {
-    for (int s = 0; s < r.sensors; ++s) {
-      Candidate c;
-      c.effect = SensorOffset{s};
-      c.name = "offset of sensor " + r.ids[s];
-      c.parameters = {"offset_K"};
-      for (const auto& rm : cat.runs) {
-        Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
-        a.block(s * rm.times.size(), 0, rm.times.size(), 1).setOnes();
-        c.columns.push_back(a);
-      }
-      cands.push_back(std::move(c));
-      for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(cat.runs, r, s, tau));
+}
+
+/// Sensors' own effects, from the base histories of `runs`: an offset and a lag per grid value.
+void add_sensor_candidates(std::vector<Candidate>& cands, const std::vector<RunModel>& runs,
+                           const Readout& r, const CalibrationOptions& o) {
+  for (int s = 0; s < r.sensors; ++s) {
+    Candidate c;
+    c.effect = SensorOffset{s};
+    c.name = "offset of sensor " + r.ids[s];
+    c.parameters = {"offset_K"};
+    for (const auto& rm : runs) {
+      Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rm.base.size(), 1);
+      a.block(s * rm.times.size(), 0, rm.times.size(), 1).setOnes();
+      c.columns.push_back(a);
     }
+    cands.push_back(std::move(c));
+    for (double tau : o.lag_grid_s) cands.push_back(lag_candidate(runs, r, s, tau));
   }
+}
+
+}  // namespace
+
+Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
+                    const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o,
+                    bool ambient_only, const solvers::Progress& progress) {
+  Catalogue cat;
+  cat.readout = r;
+  const double ref_speed = reference_speed(declared, runs);
+  // 1. The candidates' identities and their unit loads.
+  MarchedCandidates mc;
+  add_air_candidates(mc, declared, runs, o);
+  if (!ambient_only) {
+    add_heat_candidates(mc, model.mesh(), o, ref_speed);
+    add_film_candidates(mc, declared, ref_speed);
+    add_source_growth_candidates(mc, declared);
+    add_material_candidates(mc, model, declared, r);
+  }
+  // 2. One march per run with every column; sensors' own effects from the base histories.
+  fill_columns(mc, marched_runs(cat, model, declared, r, runs, mc, progress));
+  std::vector<Candidate> cands = std::move(mc.cands);
+  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
+  if (!ambient_only) add_sensor_candidates(cands, cat.runs, r, o);
   // The air the runs' ambient sensors read (the readout leaves them out of the channels).
   for (size_t k = 0; k < runs.size(); ++k) cat.runs[k].air = ambient_reading(runs[k]);
   cat.candidates = std::move(cands);
@@ -1060,6 +1117,94 @@ double gain_spread(const std::vector<double>& a, const std::vector<double>& b) {
   return std::sqrt(static_cast<double>(n) * ss / static_cast<double>(n - 1));
 }
 
+/// A pair's joint design on every run: the shared members' whitened columns side by side, the
+/// run's air (if any) eliminated beside them, their normal equations, and the number of
+/// parameters the pair pays for.
+struct PairDesign {
+  std::vector<Normal> normals;
+  std::vector<Eigen::MatrixXd> cols;
+  std::vector<AirEliminated> design;
+  double penalty = 0;
+};
+
+PairDesign pair_design(const Catalogue& cat, const std::vector<Whitened>& ws,
+                       const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
+                       const std::vector<const Candidate*>& shared, const Candidate* air,
+                       const CalibrationOptions& o) {
+  const size_t nr = cat.runs.size();
+  PairDesign d;
+  d.cols.resize(nr);
+  for (const Candidate* c : shared) d.penalty += static_cast<double>(c->columns.front().cols());
+  for (size_t ri = 0; ri < nr; ++ri) {
+    Eigen::Index p = 0;
+    for (const Candidate* c : shared) p += c->columns.front().cols();
+    d.cols[ri].resize(static_cast<Eigen::Index>(ws[ri].rows.size()), p);
+    Eigen::Index at = 0;
+    for (const Candidate* c : shared) {
+      const Eigen::Index k = c->columns.front().cols();
+      d.cols[ri].middleCols(at, k) = whitened_rows(c->columns[ri], ws[ri], sigma);
+      at += k;
+    }
+    d.design.push_back(
+        air_eliminated(air, cat.runs[ri], cat.readout, ws[ri], ys[ri], d.cols[ri], ri, sigma, o));
+    const AirEliminated& e = d.design.back();
+    d.normals.push_back({e.m.transpose() * e.m, e.m.transpose() * e.y, e.y.squaredNorm()});
+    if (air && cat.runs[ri].air.size() == 0)
+      d.penalty += static_cast<double>(air->columns.front().cols());
+  }
+  return d;
+}
+
+/// Gains against the residual itself into `fold_gains`, with each run's air fitted within its
+/// bounds beside the shared parameters of its fold (those of the other runs); returns each run's
+/// air fitted beside the in-sample shared parameters `sf.full`.
+std::vector<std::vector<double>> air_fold_gains(const Catalogue& cat,
+                                                const std::vector<Eigen::VectorXd>& ys,
+                                                const Candidate& air, const PairDesign& d,
+                                                const SharedFit& sf, const CalibrationOptions& o,
+                                                std::vector<double>& fold_gains) {
+  const auto& normals = d.normals;
+  const auto& cols = d.cols;
+  const auto& design = d.design;
+  std::vector<std::vector<double>> airs;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(sf.full.size(), sf.full.size());
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(sf.full.size());
+  for (const auto& nm : normals) {
+    g += nm.g;
+    rhs += nm.b;
+  }
+  for (size_t ri = 0; ri < cat.runs.size(); ++ri) {
+    const Eigen::VectorXd x = solve_ridge(g - normals[ri].g, rhs - normals[ri].b, o.ridge);
+    const Eigen::VectorXd th = air_at(air, cat.runs[ri], design[ri], ys[ri], cols[ri], x, o);
+    fold_gains[ri] =
+        ys[ri].squaredNorm() - (ys[ri] - cols[ri] * x - design[ri].a * th).squaredNorm();
+    const Eigen::VectorXd full =
+        air_at(air, cat.runs[ri], design[ri], ys[ri], cols[ri], sf.full, o);
+    airs.emplace_back(full.data(), full.data() + full.size());
+  }
+  return airs;
+}
+
+/// Each member of `pf` given its joint parameters (the shared ones from `full` in member order,
+/// an air its per-run `airs`) and judged physical with them.
+void size_members(const Catalogue& cat, PairFit& pf, const Eigen::VectorXd& full,
+                  const std::vector<std::vector<double>>& airs, const CalibrationOptions& o) {
+  Eigen::Index at = 0;
+  for (EffectFit* f : {&pf.first, &pf.second}) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f->candidate)];
+    if (c.per_run) {
+      f->parameters.clear();
+      f->run_parameters = airs;
+    } else {
+      const Eigen::Index k = c.columns.front().cols();
+      f->parameters.assign(full.data() + at, full.data() + at + k);
+      at += k;
+    }
+    f->unphysical =
+        unphysical_reason(c, f->parameters, f->run_parameters, cat.runs, o, &f->duty_correlation);
+  }
+}
+
 /// Candidates `a` and `b` (their single fits of the first round) fitted together: the joint
 /// leave-one-run-out gains, the joint in-sample parameters, each member judged physical with them.
 /// One member may be a per-run air: it is fitted on each run beside the other's shared parameters
@@ -1083,67 +1228,14 @@ PairFit pair_fit(const Catalogue& cat, const std::vector<Whitened>& ws,
   std::vector<const Candidate*> shared;
   for (const Candidate* c : {&ca, &cb})
     if (!c->per_run) shared.push_back(c);
-  const size_t nr = cat.runs.size();
-  std::vector<Normal> normals;
-  std::vector<Eigen::MatrixXd> cols(nr);
-  std::vector<AirEliminated> design;
-  double penalty = 0;
-  for (const Candidate* c : shared) penalty += static_cast<double>(c->columns.front().cols());
-  for (size_t ri = 0; ri < nr; ++ri) {
-    Eigen::Index p = 0;
-    for (const Candidate* c : shared) p += c->columns.front().cols();
-    cols[ri].resize(static_cast<Eigen::Index>(ws[ri].rows.size()), p);
-    Eigen::Index at = 0;
-    for (const Candidate* c : shared) {
-      const Eigen::Index k = c->columns.front().cols();
-      cols[ri].middleCols(at, k) = whitened_rows(c->columns[ri], ws[ri], sigma);
-      at += k;
-    }
-    design.push_back(
-        air_eliminated(air, cat.runs[ri], cat.readout, ws[ri], ys[ri], cols[ri], ri, sigma, o));
-    const AirEliminated& e = design.back();
-    normals.push_back({e.m.transpose() * e.m, e.m.transpose() * e.y, e.y.squaredNorm()});
-    if (air && cat.runs[ri].air.size() == 0)
-      penalty += static_cast<double>(air->columns.front().cols());
-  }
-  const SharedFit sf = shared_fit(normals, o);
+  const PairDesign d = pair_design(cat, ws, ys, sigma, shared, air, o);
+  const SharedFit sf = shared_fit(d.normals, o);
   pf.fold_gains = sf.fold_gains;
   std::vector<std::vector<double>> airs;
-  if (air) {
-    // Gains against the residual itself, with each run's air fitted within its bounds beside the
-    // shared parameters of its fold (those of the other runs).
-    Eigen::MatrixXd g = Eigen::MatrixXd::Zero(sf.full.size(), sf.full.size());
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(sf.full.size());
-    for (const auto& nm : normals) {
-      g += nm.g;
-      rhs += nm.b;
-    }
-    for (size_t ri = 0; ri < nr; ++ri) {
-      const Eigen::VectorXd x = solve_ridge(g - normals[ri].g, rhs - normals[ri].b, o.ridge);
-      const Eigen::VectorXd th = air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], x, o);
-      pf.fold_gains[ri] =
-          ys[ri].squaredNorm() - (ys[ri] - cols[ri] * x - design[ri].a * th).squaredNorm();
-      const Eigen::VectorXd full =
-          air_at(*air, cat.runs[ri], design[ri], ys[ri], cols[ri], sf.full, o);
-      airs.emplace_back(full.data(), full.data() + full.size());
-    }
-  }
+  if (air) airs = air_fold_gains(cat, ys, *air, d, sf, o, pf.fold_gains);
   for (double gain : pf.fold_gains) pf.heldout_gain += gain;
-  pf.score = pf.heldout_gain - o.penalty_per_parameter * penalty;
-  Eigen::Index at = 0;
-  for (EffectFit* f : {&pf.first, &pf.second}) {
-    const Candidate& c = cat.candidates[static_cast<size_t>(f->candidate)];
-    if (c.per_run) {
-      f->parameters.clear();
-      f->run_parameters = airs;
-    } else {
-      const Eigen::Index k = c.columns.front().cols();
-      f->parameters.assign(sf.full.data() + at, sf.full.data() + at + k);
-      at += k;
-    }
-    f->unphysical =
-        unphysical_reason(c, f->parameters, f->run_parameters, cat.runs, o, &f->duty_correlation);
-  }
+  pf.score = pf.heldout_gain - o.penalty_per_parameter * d.penalty;
+  size_members(cat, pf, sf.full, airs, o);
   pf.adds_first = pf.score - b.score;
   pf.adds_second = pf.score - a.score;
   pf.admissible = pf.first.unphysical.empty() && pf.second.unphysical.empty() &&
@@ -1184,11 +1276,10 @@ std::optional<Catalogue> resized_catalogue(const Catalogue& cat, const Calibrati
   return out;
 }
 
-/// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
-/// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
-void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
-                 const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
-                 const std::vector<int>& order, Selection& sel, const CalibrationOptions& o) {
+/// The first round's best candidates (`fits` in `order`) that may be paired: physical, not fixed,
+/// scoring above zero; at most o.pair_pool_per_kind of a kind and o.pair_pool in all.
+std::vector<int> pair_pool(const Catalogue& cat, const std::vector<EffectFit>& fits,
+                           const std::vector<int>& order, const CalibrationOptions& o) {
   std::vector<int> pool;
   std::map<EffectKind, int> per_kind;
   for (int i : order) {
@@ -1200,6 +1291,66 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
     pool.push_back(i);
     if (static_cast<int>(pool.size()) >= o.pair_pool) break;
   }
+  return pool;
+}
+
+/// The best partner of each kind over the whole catalogue for `member`, each candidate fitted
+/// jointly with it (pair_fit), as kind -> (score, candidate); only physical pairs, one air at most.
+std::map<EffectKind, std::pair<double, int>> best_partners(
+    const Catalogue& cat, const std::vector<Whitened>& ws, const std::vector<Eigen::VectorXd>& ys,
+    const std::vector<EffectFit>& fits, const EffectFit& member, const Selection& sel,
+    const CalibrationOptions& o) {
+  const bool member_per_run = cat.candidates[static_cast<size_t>(member.candidate)].per_run;
+  std::map<EffectKind, std::pair<double, int>> best_of_kind;
+  for (const EffectFit& f : fits) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (f.candidate == member.candidate || c.fixed || (c.per_run && member_per_run)) continue;
+    const PairFit pf = pair_fit(cat, ws, ys, sel.sigma, member, f, sel.null_score, o);
+    if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
+    const auto it = best_of_kind.find(f.kind);
+    if (it == best_of_kind.end() || pf.score > it->second.first)
+      best_of_kind[f.kind] = {pf.score, f.candidate};
+  }
+  return best_of_kind;
+}
+
+/// Whether the best admissible pair `best` replaces the greedy claims of `sel`: not when nothing
+/// is claimed or a claim is fixed; with two claims, when it beats their own pair by more than the
+/// spread of the per-run gains; with one, when it adds more than noise and both floors.
+bool pair_overrules(const Catalogue& cat, const std::vector<Whitened>& ws,
+                    const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
+                    const PairFit& best, const Selection& sel, const CalibrationOptions& o) {
+  // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
+  if (sel.claimed.empty()) return false;
+  for (const auto& f : sel.claimed) {
+    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
+    if (c.fixed) return false;  // the greedy choice holds what pairs cannot
+  }
+  auto same = [](const PairFit& p, int a, int b) {
+    return (p.first.candidate == a && p.second.candidate == b) ||
+           (p.first.candidate == b && p.second.candidate == a);
+  };
+  if (sel.claimed.size() >= 2) {
+    const EffectFit &g0 = sel.claimed[0], &g1 = sel.claimed[1];
+    if (same(best, g0.candidate, g1.candidate)) return false;
+    // The greedy pair scored the same way (its members from the first round's fits).
+    const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
+                                    fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
+    if (!std::isfinite(greedy.score)) return false;  // two airs: no joint fit to compare with
+    if (best.score - greedy.score <= gain_spread(best.fold_gains, greedy.fold_gains)) return false;
+  } else if (best.score - sel.claimed[0].score <=
+             std::max(sel.null_score, std::max(best.first.floor, best.second.floor))) {
+    return false;
+  }
+  return true;
+}
+
+/// The pairs among the first round's best candidates (`fits` in `order`), scored jointly into
+/// sel.pairs; the claims replaced by the best admissible pair when it beats the greedy choice.
+void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
+                 const std::vector<Eigen::VectorXd>& ys, const std::vector<EffectFit>& fits,
+                 const std::vector<int>& order, Selection& sel, const CalibrationOptions& o) {
+  const std::vector<int> pool = pair_pool(cat, fits, order, o);
   std::vector<PairFit> pairs;
   std::set<std::pair<int, int>> scored;
   auto per_run = [&](int i) {
@@ -1223,20 +1374,9 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
   // favoured the bearing's conductivity over the film. A candidate's score alone does not matter.
   for (size_t x = 0; x < pool.size() && static_cast<int>(x) < o.pair_partner_searches; ++x) {
     const int a = pool[x];
-    std::map<EffectKind, std::pair<double, int>> best_of_kind;
-    for (const EffectFit& f : fits) {
-      const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-      if (f.candidate == fits[static_cast<size_t>(a)].candidate || c.fixed ||
-          (c.per_run && per_run(a)))
-        continue;
-      const PairFit pf =
-          pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(a)], f, sel.null_score, o);
-      if (!pf.first.unphysical.empty() || !pf.second.unphysical.empty()) continue;
-      const auto it = best_of_kind.find(f.kind);
-      if (it == best_of_kind.end() || pf.score > it->second.first)
-        best_of_kind[f.kind] = {pf.score, f.candidate};
-    }
-    for (const auto& [kind, best] : best_of_kind) add_pair(a, best.second);
+    for (const auto& [kind, best] :
+         best_partners(cat, ws, ys, fits, fits[static_cast<size_t>(a)], sel, o))
+      add_pair(a, best.second);
   }
   std::sort(pairs.begin(), pairs.end(),
             [](const PairFit& a, const PairFit& b) { return a.score > b.score; });
@@ -1244,28 +1384,7 @@ void choose_pair(const Catalogue& cat, const std::vector<Whitened>& ws,
       std::find_if(pairs.begin(), pairs.end(), [](const PairFit& p) { return p.admissible; });
   sel.pairs.assign(pairs.begin(),
                    pairs.begin() + std::min<std::ptrdiff_t>(5, pairs.end() - pairs.begin()));
-  // Nothing claimed (below noise, or undecided in the first round): a pair does not overrule it.
-  if (best == pairs.end() || sel.claimed.empty()) return;
-  for (const auto& f : sel.claimed) {
-    const Candidate& c = cat.candidates[static_cast<size_t>(f.candidate)];
-    if (c.fixed) return;  // the greedy choice holds what pairs cannot
-  }
-  auto same = [](const PairFit& p, int a, int b) {
-    return (p.first.candidate == a && p.second.candidate == b) ||
-           (p.first.candidate == b && p.second.candidate == a);
-  };
-  if (sel.claimed.size() >= 2) {
-    const EffectFit &g0 = sel.claimed[0], &g1 = sel.claimed[1];
-    if (same(*best, g0.candidate, g1.candidate)) return;
-    // The greedy pair scored the same way (its members from the first round's fits).
-    const PairFit greedy = pair_fit(cat, ws, ys, sel.sigma, fits[static_cast<size_t>(g0.candidate)],
-                                    fits[static_cast<size_t>(g1.candidate)], sel.null_score, o);
-    if (!std::isfinite(greedy.score)) return;  // two airs: no joint fit to compare with
-    if (best->score - greedy.score <= gain_spread(best->fold_gains, greedy.fold_gains)) return;
-  } else if (best->score - sel.claimed[0].score <=
-             std::max(sel.null_score, std::max(best->first.floor, best->second.floor))) {
-    return;
-  }
+  if (best == pairs.end() || !pair_overrules(cat, ws, ys, fits, *best, sel, o)) return;
   const bool swap = best->second.score > best->first.score;
   sel.claimed = {swap ? best->second : best->first, swap ? best->first : best->second};
   sel.by_pair = true;
@@ -1414,31 +1533,15 @@ Catalogue with_refined_lag(const Catalogue& cat, int sensor, double tau,
   return out;
 }
 
-Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
-                         const Resizer& resize) {
-  if (given.runs.size() < 2)
-    throw core::DataError(
-        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
-        "): effects are chosen by how much they explain on a run held out from the fit");
-  std::map<int, std::vector<double>> linearised;
-  const std::optional<Catalogue> resized =
-      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
-  const Catalogue& cat = resized ? *resized : given;
-  // A resized candidate's fits report the linearised parameters it was found unphysical at.
-  auto mark = [&](std::vector<EffectFit>& fits) {
-    for (auto& f : fits)
-      if (const auto it = linearised.find(f.candidate); it != linearised.end())
-        f.linearised = it->second;
-  };
-  Selection sel;
-  const auto& r = cat.readout;
-  sel.sigma = noise_sigma(cat.runs, r.sensors, o);
-  const auto [ws, ys] = whitened_runs(cat.runs, sel.sigma);
-  for (const auto& y : ys) sel.residual_ss += y.squaredNorm();
-  // Noise alone: the best score over every candidate on white noise at the estimated level.
+namespace {
+
+/// Noise alone: the best score over every candidate on white noise at the estimated level.
+double null_score(const Catalogue& cat, const std::vector<Whitened>& ws,
+                  const std::vector<Eigen::VectorXd>& ys, const Eigen::VectorXd& sigma,
+                  const CalibrationOptions& o) {
   std::mt19937_64 rng = core::generator(o.seed, 7);
   std::normal_distribution<double> normal(0.0, 1.0);
-  sel.null_score = -1e300;
+  double best = -1e300;
   for (int trial = 0; trial < o.null_trials; ++trial) {
     std::vector<Eigen::VectorXd> noise;
     for (const auto& y : ys) {
@@ -1446,10 +1549,15 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       for (Eigen::Index i = 0; i < e.size(); ++i) e(i) = normal(rng);
       noise.push_back(e);
     }
-    for (const auto& f : score_all(cat, ws, noise, sel.sigma, o, false))
-      sel.null_score = std::max(sel.null_score, f.score);
+    for (const auto& f : score_all(cat, ws, noise, sigma, o, false)) best = std::max(best, f.score);
   }
-  // Model-form allowance per channel [whitened SS per sample].
+  return best;
+}
+
+/// Model-form allowance per channel [whitened SS per sample].
+Eigen::VectorXd channel_allowance(const Catalogue& cat, const Eigen::VectorXd& sigma,
+                                  const CalibrationOptions& o) {
+  const auto& r = cat.readout;
   Eigen::VectorXd allowance(r.channels());
   for (int ch = 0; ch < r.channels(); ++ch) {
     double tol = o.temperature_tolerance_K;
@@ -1461,64 +1569,106 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       }
       tol = o.displacement_tolerance_rel * std::sqrt(ss / cnt) + o.displacement_tolerance_m;
     }
-    allowance(ch) = (tol / sel.sigma(ch)) * (tol / sel.sigma(ch));
+    allowance(ch) = (tol / sigma(ch)) * (tol / sigma(ch));
   }
-  std::vector<Eigen::VectorXd> current = ys;
-  const double total = sel.residual_ss;
-  // Every candidate scored on the residual `left_of` (what the claims so far leave), with its
-  // floor and physical check; `order` ranks them by score.
+  return allowance;
+}
+
+/// What every round of the choice scores against: the catalogue, its whitened runs, the floors.
+struct Scoring {
+  const Catalogue& cat;
+  const std::vector<Whitened>& ws;
+  const Selection& sel;  ///< its sigma and null score
+  const CalibrationOptions& o;
+  /// A resized candidate's fits report the linearised parameters it was found unphysical at.
+  const std::map<int, std::vector<double>>& linearised;
+  Eigen::VectorXd allowance;
+  double total = 0;  ///< the whole training residual [whitened SS]
+};
+
+/// Every candidate's fit, and their indices by descending score.
+struct Ranked {
+  std::vector<EffectFit> fits;
   std::vector<int> order;
-  auto evaluate = [&](const std::vector<Eigen::VectorXd>& left_of) {
-    std::vector<EffectFit> fits = score_all(cat, ws, left_of, sel.sigma, o, true);
-    mark(fits);
-    double left = 0;
-    for (const auto& y : left_of) left += y.squaredNorm();
-    for (auto& f : fits) {
-      const Candidate& c = cat.candidates[f.candidate];
-      const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
-      f.floor = 0;
-      for (const auto& w : ws)
-        for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? allowance(ch) : 0.0;
-      // explained_fraction relative to the whole training residual, not what is left of it.
-      f.explained_fraction *= total > 0 ? left / total : 0;
-      f.unphysical =
-          unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
-    }
-    order.resize(fits.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-    std::sort(order.begin(), order.end(),
-              [&](int a, int b) { return fits[a].score > fits[b].score; });
-    return fits;
-  };
-  // The best physical candidate, claimed when it beats noise and floor and no candidate of
-  // another kind that would be claimed too comes within the spread of their per-run gains.
-  auto claimable = [&](const EffectFit& f) {
-    return f.unphysical.empty() && f.score > sel.null_score && f.score > f.floor && f.score > 0;
-  };
-  std::vector<EffectFit> first_fits;
-  std::vector<int> first_order;
+};
+
+/// Every candidate scored on the residual `left_of` (what the claims so far leave), with its
+/// floor and physical check; `order` ranks them by score.
+Ranked evaluated(const Scoring& sc, const std::vector<Eigen::VectorXd>& left_of) {
+  const Catalogue& cat = sc.cat;
+  const auto& r = cat.readout;
+  const CalibrationOptions& o = sc.o;
+  Ranked out;
+  std::vector<EffectFit>& fits = out.fits;
+  fits = score_all(cat, sc.ws, left_of, sc.sel.sigma, o, true);
+  for (auto& f : fits)
+    if (const auto it = sc.linearised.find(f.candidate); it != sc.linearised.end())
+      f.linearised = it->second;
+  double left = 0;
+  for (const auto& y : left_of) left += y.squaredNorm();
+  for (auto& f : fits) {
+    const Candidate& c = cat.candidates[f.candidate];
+    const std::vector<char> t = touched(c, cat.runs.front().times.size(), r.channels());
+    f.floor = 0;
+    for (const auto& w : sc.ws)
+      for (int ch : w.channel) f.floor += t[static_cast<size_t>(ch)] ? sc.allowance(ch) : 0.0;
+    // explained_fraction relative to the whole training residual, not what is left of it.
+    f.explained_fraction *= sc.total > 0 ? left / sc.total : 0;
+    f.unphysical =
+        unphysical_reason(c, f.parameters, f.run_parameters, cat.runs, o, &f.duty_correlation);
+  }
+  out.order.resize(fits.size());
+  for (size_t i = 0; i < out.order.size(); ++i) out.order[i] = static_cast<int>(i);
+  std::sort(out.order.begin(), out.order.end(),
+            [&](int a, int b) { return fits[a].score > fits[b].score; });
+  return out;
+}
+
+/// Whether `f` may be claimed: physical, above noise, above its floor and above zero.
+bool claimable(const EffectFit& f, double null_score) {
+  return f.unphysical.empty() && f.score > null_score && f.score > f.floor && f.score > 0;
+}
+
+/// The first round's ranking: the best fit at each place, best first, at most o.ranking_size.
+std::vector<EffectFit> ranking(const Catalogue& cat, const Ranked& first,
+                               const CalibrationOptions& o) {
+  std::vector<EffectFit> out;
+  std::vector<const Candidate*> places;
+  for (int i : first.order) {
+    const Candidate& c = cat.candidates[i];
+    if (std::any_of(places.begin(), places.end(),
+                    [&](const Candidate* p) { return same_place(*p, c); }))
+      continue;
+    places.push_back(&c);
+    out.push_back(first.fits[i]);
+    if (static_cast<int>(out.size()) >= o.ranking_size) break;
+  }
+  return out;
+}
+
+/// The claims chosen one after the other into sel.claimed (an undecided round into sel.ambiguous):
+/// the best physical candidate, claimed when it beats noise and floor and no candidate of another
+/// kind that would be claimed too comes within the spread of their per-run gains; its fit removed
+/// before the next round. Returns the first round's fits (and sets sel.ranking from them).
+Ranked claimed_greedily(const Scoring& sc, const std::vector<Eigen::VectorXd>& ys, Selection& sel) {
+  const Catalogue& cat = sc.cat;
+  const CalibrationOptions& o = sc.o;
+  std::vector<Eigen::VectorXd> current = ys;
+  Ranked first;
   for (int round = 0; round < o.max_effects; ++round) {
-    std::vector<EffectFit> fits = evaluate(current);
+    const Ranked ranked = evaluated(sc, current);
+    const std::vector<EffectFit>& fits = ranked.fits;
+    const std::vector<int>& order = ranked.order;
     if (round == 0) {
-      first_fits = fits;
-      first_order = order;
-      std::vector<const Candidate*> places;
-      for (int i : order) {
-        const Candidate& c = cat.candidates[i];
-        if (std::any_of(places.begin(), places.end(),
-                        [&](const Candidate* p) { return same_place(*p, c); }))
-          continue;
-        places.push_back(&c);
-        sel.ranking.push_back(fits[i]);
-        if (static_cast<int>(sel.ranking.size()) >= o.ranking_size) break;
-      }
+      first = ranked;
+      sel.ranking = ranking(cat, first, o);
     }
     const auto best_at =
         std::find_if(order.begin(), order.end(), [&](int i) { return fits[i].unphysical.empty(); });
-    if (best_at == order.end() || !claimable(fits[*best_at])) break;
+    if (best_at == order.end() || !claimable(fits[*best_at], sel.null_score)) break;
     const EffectFit& best = fits[*best_at];
     const auto second_at = std::find_if(best_at + 1, order.end(), [&](int i) {
-      return fits[i].kind != best.kind && claimable(fits[i]);
+      return fits[i].kind != best.kind && claimable(fits[i], sel.null_score);
     });
     if (second_at != order.end()) {
       Ambiguity amb{best, fits[*second_at]};
@@ -1532,17 +1682,23 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     }
     sel.claimed.push_back(best);
     // Remove the claimed effect's in-sample fit before looking for the next one.
-    current = without_fits(cat, ws, std::move(current), sel.sigma, {best}, o);
+    current = without_fits(cat, sc.ws, std::move(current), sel.sigma, {best}, o);
   }
-  // Backfitting: each claim's place and size chosen again among the candidates of its kind on the
-  // training residual with the other claims' fits removed, until no claim changes. A claim that
-  // took part of a later one's signal (a heat input placed where an offset sensor pulls it) is
-  // then placed where the rest of the data puts it, and every claim is sized beside the others,
-  // not before them. A claim is replaced only when its replacement scores above it by more than
-  // the noise threshold and the spread of their per-run gains (the ambiguity rule's margin). The
-  // kinds stay the one-after-the-other choice's: letting them change made claims of kinds that
-  // share a signal (an air, a heat law, a conductivity) swap from sweep to sweep, and put a
-  // conductivity first where an air and a heat law were true (docs/calibration.md, §3).
+  return first;
+}
+
+/// Backfitting: each claim's place and size chosen again among the candidates of its kind on the
+/// training residual with the other claims' fits removed, until no claim changes. A claim that
+/// took part of a later one's signal (a heat input placed where an offset sensor pulls it) is
+/// then placed where the rest of the data puts it, and every claim is sized beside the others,
+/// not before them. A claim is replaced only when its replacement scores above it by more than
+/// the noise threshold and the spread of their per-run gains (the ambiguity rule's margin). The
+/// kinds stay the one-after-the-other choice's: letting them change made claims of kinds that
+/// share a signal (an air, a heat law, a conductivity) swap from sweep to sweep, and put a
+/// conductivity first where an air and a heat law were true (docs/calibration.md, §3).
+void backfit(const Scoring& sc, const std::vector<Eigen::VectorXd>& ys, Selection& sel) {
+  const Catalogue& cat = sc.cat;
+  const CalibrationOptions& o = sc.o;
   std::set<std::vector<int>> visited;
   for (int sweep = 0; sweep < o.backfit_sweeps && sel.claimed.size() >= 2; ++sweep) {
     bool changed = false;
@@ -1553,10 +1709,12 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       std::vector<EffectFit> others;
       for (size_t j = 0; j < sel.claimed.size(); ++j)
         if (j != i) others.push_back(sel.claimed[j]);
-      const std::vector<EffectFit> fits = evaluate(without_fits(cat, ws, ys, sel.sigma, others, o));
+      const Ranked ranked = evaluated(sc, without_fits(cat, sc.ws, ys, sel.sigma, others, o));
+      const std::vector<EffectFit>& fits = ranked.fits;
+      const std::vector<int>& order = ranked.order;
       const auto best_at = std::find_if(order.begin(), order.end(), [&](int k) {
         return fits[static_cast<size_t>(k)].kind == sel.claimed[i].kind &&
-               claimable(fits[static_cast<size_t>(k)]) &&
+               claimable(fits[static_cast<size_t>(k)], sel.null_score) &&
                std::none_of(others.begin(), others.end(), [&](const EffectFit& f) {
                  return f.candidate == fits[static_cast<size_t>(k)].candidate;
                });
@@ -1564,7 +1722,7 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
       if (best_at == order.end()) continue;  // nothing beats noise under the others: kept
       const EffectFit* chosen = &fits[static_cast<size_t>(*best_at)];
       const EffectFit& now = fits[static_cast<size_t>(sel.claimed[i].candidate)];
-      if (chosen->candidate != now.candidate && claimable(now) &&
+      if (chosen->candidate != now.candidate && claimable(now, sel.null_score) &&
           chosen->score - now.score <=
               std::max(sel.null_score, gain_spread(chosen->fold_gains, now.fold_gains)))
         chosen = &now;
@@ -1577,8 +1735,31 @@ Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
     }
     if (!changed) break;
   }
-  if (o.max_effects >= 2 && !first_fits.empty())
-    choose_pair(cat, ws, ys, first_fits, first_order, sel, o);
+}
+
+}  // namespace
+
+Selection select_effects(const Catalogue& given, const CalibrationOptions& o,
+                         const Resizer& resize) {
+  if (given.runs.size() < 2)
+    throw core::DataError(
+        "calibration needs at least two training runs (got " + std::to_string(given.runs.size()) +
+        "): effects are chosen by how much they explain on a run held out from the fit");
+  std::map<int, std::vector<double>> linearised;
+  const std::optional<Catalogue> resized =
+      resize ? resized_catalogue(given, o, resize, linearised) : std::nullopt;
+  const Catalogue& cat = resized ? *resized : given;
+  Selection sel;
+  sel.sigma = noise_sigma(cat.runs, cat.readout.sensors, o);
+  const auto [ws, ys] = whitened_runs(cat.runs, sel.sigma);
+  for (const auto& y : ys) sel.residual_ss += y.squaredNorm();
+  sel.null_score = null_score(cat, ws, ys, sel.sigma, o);
+  const Scoring sc{
+      cat, ws, sel, o, linearised, channel_allowance(cat, sel.sigma, o), sel.residual_ss};
+  const Ranked first = claimed_greedily(sc, ys, sel);
+  backfit(sc, ys, sel);
+  if (o.max_effects >= 2 && !first.fits.empty())
+    choose_pair(cat, ws, ys, first.fits, first.order, sel, o);
   return sel;
 }
 

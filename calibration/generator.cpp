@@ -82,6 +82,56 @@ core::DutyCycle random_duty_cycle(double hours, std::mt19937_64& rng) {
   return d;
 }
 
+namespace {
+
+/// A heat input's place drawn into `e`: a box around a random point of the housing's unfixed
+/// exterior, sized at random, with its magnitude [W], groups, area and centre.
+void draw_heat_box(InjectedEffect& e, const core::CaseSpec& declared, const mesh::TetMesh& m,
+                   std::mt19937_64& rng) {
+  std::vector<int> faces;
+  std::vector<double> cum;
+  double total = 0;
+  for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
+    const int g = core::index_of(m.face_group[f]);
+    if (m.face_other_tet[f] >= 0 || g < 0) continue;
+    const auto& fixed = declared.mechanical.fixed_groups;
+    if (std::find(fixed.begin(), fixed.end(), g) != fixed.end()) continue;
+    if (m.region_names[core::index_of(m.tet_region[m.face_tet[f]])] != declared.bodies.front().name)
+      continue;
+    const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), b = m.nodes.row(m.faces(f, 1)),
+                          c = m.nodes.row(m.faces(f, 2));
+    total += 0.5 * (b - a).cross(c - a).norm();
+    faces.push_back(static_cast<int>(f));
+    cum.push_back(total);
+  }
+  const double u = uniform(rng, 0, total);
+  const int f = faces[std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()];
+  const Eigen::Vector3d p =
+      (m.nodes.row(m.faces(f, 0)) + m.nodes.row(m.faces(f, 1)) + m.nodes.row(m.faces(f, 2))) / 3;
+  Eigen::Vector3d half(uniform(rng, 0.03, 0.06), uniform(rng, 0.03, 0.06),
+                       uniform(rng, 0.03, 0.06));
+  e.box_min = p - half;
+  e.box_max = p + half;
+  e.magnitude = log_uniform(rng, 4, 25);  // W
+  // The faces whose centroid is in the box (the case format's rule) give area and centre.
+  Eigen::Vector3d wc = Eigen::Vector3d::Zero();
+  for (int k : faces) {
+    const Eigen::Vector3d a = m.nodes.row(m.faces(k, 0)), b = m.nodes.row(m.faces(k, 1)),
+                          c = m.nodes.row(m.faces(k, 2));
+    const Eigen::Vector3d g = (a + b + c) / 3;
+    if ((g.array() < e.box_min.array()).any() || (g.array() > e.box_max.array()).any()) continue;
+    const double ar = 0.5 * (b - a).cross(c - a).norm();
+    const std::string gname = m.group_names[core::index_of(m.face_group[k])];
+    if (std::find(e.groups.begin(), e.groups.end(), gname) == e.groups.end())
+      e.groups.push_back(gname);
+    e.area += ar;
+    wc += ar * g;
+  }
+  e.centre = wc / e.area;
+}
+
+}  // namespace
+
 InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
                              const mesh::TetMesh& m, const std::vector<std::string>& sensors,
                              std::mt19937_64& rng) {
@@ -100,54 +150,10 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
     case EffectKind::ambient_temperature:
       e.magnitude = log_uniform(rng, 0.3, 2.5);
       break;
-    case EffectKind::heat_input: {
-      // A box around a random point of the housing's unfixed exterior, sized at random.
-      std::vector<int> faces;
-      std::vector<double> cum;
-      double total = 0;
-      for (Eigen::Index f = 0; f < m.faces.rows(); ++f) {
-        const int g = core::index_of(m.face_group[f]);
-        if (m.face_other_tet[f] >= 0 || g < 0) continue;
-        const auto& fixed = declared.mechanical.fixed_groups;
-        if (std::find(fixed.begin(), fixed.end(), g) != fixed.end()) continue;
-        if (m.region_names[core::index_of(m.tet_region[m.face_tet[f]])] !=
-            declared.bodies.front().name)
-          continue;
-        const Eigen::Vector3d a = m.nodes.row(m.faces(f, 0)), b = m.nodes.row(m.faces(f, 1)),
-                              c = m.nodes.row(m.faces(f, 2));
-        total += 0.5 * (b - a).cross(c - a).norm();
-        faces.push_back(static_cast<int>(f));
-        cum.push_back(total);
-      }
-      const double u = uniform(rng, 0, total);
-      const int f = faces[std::lower_bound(cum.begin(), cum.end(), u) - cum.begin()];
-      const Eigen::Vector3d p =
-          (m.nodes.row(m.faces(f, 0)) + m.nodes.row(m.faces(f, 1)) + m.nodes.row(m.faces(f, 2))) /
-          3;
-      Eigen::Vector3d half(uniform(rng, 0.03, 0.06), uniform(rng, 0.03, 0.06),
-                           uniform(rng, 0.03, 0.06));
-      e.box_min = p - half;
-      e.box_max = p + half;
-      e.magnitude = log_uniform(rng, 4, 25);  // W
-      // The faces whose centroid is in the box (the case format's rule) give area and centre.
-      Eigen::Vector3d wc = Eigen::Vector3d::Zero();
-      for (int k : faces) {
-        const Eigen::Vector3d a = m.nodes.row(m.faces(k, 0)), b = m.nodes.row(m.faces(k, 1)),
-                              c = m.nodes.row(m.faces(k, 2));
-        const Eigen::Vector3d g = (a + b + c) / 3;
-        if ((g.array() < e.box_min.array()).any() || (g.array() > e.box_max.array()).any())
-          continue;
-        const double ar = 0.5 * (b - a).cross(c - a).norm();
-        const std::string gname = m.group_names[core::index_of(m.face_group[k])];
-        if (std::find(e.groups.begin(), e.groups.end(), gname) == e.groups.end())
-          e.groups.push_back(gname);
-        e.area += ar;
-        wc += ar * g;
-      }
-      e.centre = wc / e.area;
+    case EffectKind::heat_input:
+      draw_heat_box(e, declared, m, rng);
       e.follows_speed = pick(rng, 2) == 1;
       break;
-    }
     case EffectKind::speed_dependent_convection: {
       const int c = unfixed[static_cast<size_t>(pick(rng, static_cast<int>(unfixed.size())))];
       e.target = declared.groups[conv[c].group].name;
@@ -190,6 +196,52 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
   return e;
 }
 
+namespace {
+
+/// The injected air `e` of run `run_index` added to the sinks of `s` it acts on (its target's, or
+/// every unfixed group's).
+void add_injected_air(core::CaseSpec& s, const InjectedEffect& e, const core::DutyCycle& duty,
+                      int run_index) {
+  auto& conv = s.thermal.convection;
+  auto on = [&](const core::Convection& c) {
+    if (!e.target.empty()) return s.groups[c.group].name == e.target;
+    const auto& f = s.mechanical.fixed_groups;
+    return std::find(f.begin(), f.end(), c.group) == f.end();
+  };
+  const core::TimeTable t = e.air == InjectedEffect::Air::shop_day
+                                ? shop_day_air(e.magnitude, e.seed, run_index, duty.end)
+                                : waves_air(e.magnitude, e.seed, run_index, duty.end);
+  for (auto& c : conv) {
+    if (!on(c)) continue;
+    core::TimeTable own = t;
+    for (size_t k = 0; k < own.time.size(); ++k)
+      own.value[k] += solvers::table_value(c.sink, own.time[k]);
+    c.sink = own;
+  }
+}
+
+/// The injected heat input `e` declared in `s`: every group the box covers gets its part (the
+/// case format's way to put heat on faces).
+void add_injected_heat(core::CaseSpec& s, const InjectedEffect& e) {
+  HeatInput h;
+  h.box_min = e.box_min;
+  h.box_max = e.box_max;
+  h.law = e.follows_speed ? HeatLaw::speed : HeatLaw::constant;
+  h.ref_speed_rpm = 3000;
+  h.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
+  // The drawn effect names its groups (InjectedEffect is written as truth.json).
+  for (const auto& name : e.groups)
+    for (size_t g = 0; g < s.groups.size(); ++g)
+      if (s.groups[g].name == name) h.groups.push_back(static_cast<int>(g));
+  Candidate c;
+  c.effect = h;
+  AugmentedCase a{s, {}, {}};
+  a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
+  s = a.spec;
+}
+
+}  // namespace
+
 core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
                           const core::DutyCycle& duty, int run_index) {
   core::CaseSpec s = gen;
@@ -202,43 +254,12 @@ core::CaseSpec truth_case(const core::CaseSpec& gen, const InjectedEffect& e,
     throw core::DataError("generator: no convection on group '" + group + "'");
   };
   switch (e.kind) {
-    case EffectKind::ambient_temperature: {
-      auto on = [&](const core::Convection& c) {
-        if (!e.target.empty()) return s.groups[c.group].name == e.target;
-        const auto& f = s.mechanical.fixed_groups;
-        return std::find(f.begin(), f.end(), c.group) == f.end();
-      };
-      const core::TimeTable t = e.air == InjectedEffect::Air::shop_day
-                                    ? shop_day_air(e.magnitude, e.seed, run_index, duty.end)
-                                    : waves_air(e.magnitude, e.seed, run_index, duty.end);
-      for (auto& c : conv) {
-        if (!on(c)) continue;
-        core::TimeTable own = t;
-        for (size_t k = 0; k < own.time.size(); ++k)
-          own.value[k] += solvers::table_value(c.sink, own.time[k]);
-        c.sink = own;
-      }
+    case EffectKind::ambient_temperature:
+      add_injected_air(s, e, duty, run_index);
       break;
-    }
-    case EffectKind::heat_input: {
-      // Every group the box covers gets its part (the case format's way to put heat on faces).
-      HeatInput h;
-      h.box_min = e.box_min;
-      h.box_max = e.box_max;
-      h.law = e.follows_speed ? HeatLaw::speed : HeatLaw::constant;
-      h.ref_speed_rpm = 3000;
-      h.body = 0;  // the housing's faces only: its area and centre are those of the housing's faces
-      // The drawn effect names its groups (InjectedEffect is written as truth.json).
-      for (const auto& name : e.groups)
-        for (size_t g = 0; g < s.groups.size(); ++g)
-          if (s.groups[g].name == name) h.groups.push_back(static_cast<int>(g));
-      Candidate c;
-      c.effect = h;
-      AugmentedCase a{s, {}, {}};
-      a = augmented_case(a, c, {e.magnitude / e.area}, Readout{});
-      s = a.spec;
+    case EffectKind::heat_input:
+      add_injected_heat(s, e);
       break;
-    }
     case EffectKind::speed_dependent_convection: {
       auto& c = entry_of(e.target);
       c.h_speed_gain = e.magnitude;
@@ -373,6 +394,76 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
   return clean_run(mesh_in, truth, InjectedEffects{e}, inst, o, name);
 }
 
+namespace {
+
+/// `x` (a sensor's true temperature on the truth's fine times `fine_t` [s]) as sensor `id` reads
+/// it: with its injected lag and offset in `effects`.
+Eigen::VectorXd sensed(Eigen::VectorXd x, const Eigen::VectorXd& fine_t,
+                       const InjectedEffects& effects, const std::string& id) {
+  const Eigen::Index nt = fine_t.size();
+  for (const InjectedEffect& e : effects) {
+    if (!e.present || e.target != id) continue;
+    if (e.kind == EffectKind::sensor_lag) {
+      // The sensor's own first-order lag, integrated on the truth's fine time grid.
+      Eigen::VectorXd y(nt);
+      y(0) = x(0);
+      for (Eigen::Index k = 1; k < nt; ++k) {
+        const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
+        y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
+      }
+      x = y;
+    }
+    if (e.kind == EffectKind::sensor_offset) x.array() += e.magnitude;
+  }
+  return x;
+}
+
+/// `run` with an ambient sensor "AIR" reading the sink of the truth's first unfixed convection
+/// entry at its sample times.
+void add_ambient_sensor(io::MeasuredRun& run, const core::CaseSpec& truth) {
+  const Eigen::Index ns = run.time.size();
+  const auto& fixed = truth.mechanical.fixed_groups;
+  const auto air = std::find_if(
+      truth.thermal.convection.begin(), truth.thermal.convection.end(),
+      [&](const auto& c) { return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end(); });
+  if (air == truth.thermal.convection.end())
+    throw core::DataError(
+        "generator: an ambient sensor needs a convection entry on a group "
+        "that is not fixed (the air); the case has none");
+  const Eigen::Index k = run.temperature.cols();
+  run.temperature.conservativeResize(ns, k + 1);
+  for (Eigen::Index i = 0; i < ns; ++i)
+    run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + core::kCelsiusOffset;
+  run.sensors.push_back({"AIR", std::nullopt});
+  run.ambient_sensor = "AIR";
+}
+
+/// `run` with the TCP's displacement probes (dx, dy, dz from the history's first column at the
+/// samples `at`) when the instrumentation asks for them and the truth has a TCP; else none.
+void add_tcp_probes(io::MeasuredRun& run, const mesh::TetMesh& m, const core::CaseSpec& truth,
+                    const Instrumentation& inst, const solvers::ThermalHistory& th,
+                    const std::vector<Eigen::Index>& at) {
+  const Eigen::Index ns = run.time.size();
+  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
+    const int tcp = point_node(m, truth.mechanical.tcp_point);
+    const solvers::ElasticModel model(m, truth);
+    const char* ids[] = {"dx", "dy", "dz"};
+    run.displacement.resize(ns, 3);
+    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
+    for (int d = 0; d < 3; ++d) {
+      const Eigen::VectorXd a = model.influence(tcp, d);
+      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
+      const double u0 = a.dot(th.temperature.col(0));
+      for (Eigen::Index i = 0; i < ns; ++i)
+        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
+    }
+  } else {
+    run.displacement.resize(ns, 0);
+  }
+}
+
+}  // namespace
+
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {
@@ -419,57 +510,13 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
     run.sensors.push_back({inst.sensor_points[s], m.points[0].position});
     for (const auto& p : m.points)
       if (p.id == inst.sensor_points[s]) run.sensors.back().position = p.position;
-    Eigen::VectorXd x = th.temperature.row(node).transpose();
-    for (const InjectedEffect& e : effects) {
-      if (!e.present || e.target != inst.sensor_points[s]) continue;
-      if (e.kind == EffectKind::sensor_lag) {
-        // The sensor's own first-order lag, integrated on the truth's fine time grid.
-        Eigen::VectorXd y(nt);
-        y(0) = x(0);
-        for (Eigen::Index k = 1; k < nt; ++k) {
-          const double a = std::exp(-(fine_t(k) - fine_t(k - 1)) / e.magnitude);
-          y(k) = a * y(k - 1) + (1 - a) * 0.5 * (x(k) + x(k - 1));
-        }
-        x = y;
-      }
-      if (e.kind == EffectKind::sensor_offset) x.array() += e.magnitude;
-    }
+    const Eigen::VectorXd x =
+        sensed(th.temperature.row(node).transpose(), fine_t, effects, inst.sensor_points[s]);
     for (Eigen::Index i = 0; i < ns; ++i)
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
   }
-  if (inst.ambient_sensor) {
-    const auto& fixed = truth.mechanical.fixed_groups;
-    const auto air = std::find_if(
-        truth.thermal.convection.begin(), truth.thermal.convection.end(), [&](const auto& c) {
-          return std::find(fixed.begin(), fixed.end(), c.group) == fixed.end();
-        });
-    if (air == truth.thermal.convection.end())
-      throw core::DataError(
-          "generator: an ambient sensor needs a convection entry on a group "
-          "that is not fixed (the air); the case has none");
-    const Eigen::Index k = run.temperature.cols();
-    run.temperature.conservativeResize(ns, k + 1);
-    for (Eigen::Index i = 0; i < ns; ++i)
-      run.temperature(i, k) = solvers::table_value(air->sink, run.time(i)) + core::kCelsiusOffset;
-    run.sensors.push_back({"AIR", std::nullopt});
-    run.ambient_sensor = "AIR";
-  }
-  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
-    const int tcp = point_node(m, truth.mechanical.tcp_point);
-    const solvers::ElasticModel model(m, truth);
-    const char* ids[] = {"dx", "dy", "dz"};
-    run.displacement.resize(ns, 3);
-    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
-    for (int d = 0; d < 3; ++d) {
-      const Eigen::VectorXd a = model.influence(tcp, d);
-      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
-      const double u0 = a.dot(th.temperature.col(0));
-      for (Eigen::Index i = 0; i < ns; ++i)
-        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
-    }
-  } else {
-    run.displacement.resize(ns, 0);
-  }
+  if (inst.ambient_sensor) add_ambient_sensor(run, truth);
+  add_tcp_probes(run, m, truth, inst, th, at);
   return run;
 }
 
