@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "core/timing.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/calibration_model_out.hpp"
 #include "io/case_reader.hpp"
@@ -52,9 +53,10 @@ int calibrate_command_with_case(const CalibrateArgs& args) {
   out.commit();
   const calibration::CalibrationResult& res = report.result;
   std::cerr << "thermotwin: calibrate: before T " << res.before.temperature_rms_K << " K, u "
-            << res.before.displacement_rms_um << " um; after T " << res.after.temperature_rms_K
-            << " K, u " << res.after.displacement_rms_um << " um; " << res.effects.size()
-            << " effect(s) -> " << args.out.string() << "\n";
+            << res.before.displacement_rms_m * core::kMicrometresPerMetre << " um; after T "
+            << res.after.temperature_rms_K << " K, u "
+            << res.after.displacement_rms_m * core::kMicrometresPerMetre << " um; "
+            << res.effects.size() << " effect(s) -> " << args.out.string() << "\n";
   return 0;
 }
 

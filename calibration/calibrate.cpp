@@ -210,7 +210,7 @@ RmsFigures rms_figures(const std::vector<Eigen::MatrixXd>& measured,
           nu += 1;
         }
       }
-  return {nt > 0 ? std::sqrt(st / nt) : 0.0, nu > 0 ? 1e6 * std::sqrt(su / nu) : 0.0};
+  return {nt > 0 ? std::sqrt(st / nt) : 0.0, nu > 0 ? std::sqrt(su / nu) : 0.0};
 }
 
 namespace {

@@ -45,7 +45,7 @@ Eigen::MatrixXd corrected(const Eigen::MatrixXd& channels, const Eigen::VectorXd
 
 struct RmsFigures {
   double temperature_rms_K = 0;
-  double displacement_rms_um = 0;
+  double displacement_rms_m = 0;
 };
 /// RMS over the finite samples of measured - simulated (temperatures, displacements).
 RmsFigures rms_figures(const std::vector<Eigen::MatrixXd>& measured,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/calibration_effects_out.hpp"
 #include "io/calibration_head.hpp"
@@ -59,8 +60,8 @@ CalibrationHead calibration_head(const studies::ModelCalibrationReport& report) 
   for (const auto& t : res.tests) head.test_runs.push_back(t.name);
   head.temperature_rms_K_before = res.before.temperature_rms_K;
   head.temperature_rms_K_after = res.after.temperature_rms_K;
-  head.displacement_rms_um_before = res.before.displacement_rms_um;
-  head.displacement_rms_um_after = res.after.displacement_rms_um;
+  head.displacement_rms_um_before = res.before.displacement_rms_m * core::kMicrometresPerMetre;
+  head.displacement_rms_um_after = res.after.displacement_rms_m * core::kMicrometresPerMetre;
   head.channels = report.channels;
   return head;
 }
@@ -187,10 +188,10 @@ std::string report_markdown(const studies::ModelCalibrationReport& report) {
                    : "full order, " + std::to_string(m.nodes) + " nodes")
      << " (`model` in calibration.json).";
   md << "\n\n| | temperature RMS [K] | displacement RMS [um] |\n| --- | --- | --- |\n";
-  md << "| before | " << res.before.temperature_rms_K << " | " << res.before.displacement_rms_um
-     << " |\n";
-  md << "| after | " << res.after.temperature_rms_K << " | " << res.after.displacement_rms_um
-     << " |\n\n";
+  md << "| before | " << res.before.temperature_rms_K << " | "
+     << res.before.displacement_rms_m * core::kMicrometresPerMetre << " |\n";
+  md << "| after | " << res.after.temperature_rms_K << " | "
+     << res.after.displacement_rms_m * core::kMicrometresPerMetre << " |\n\n";
   const json sel = selection_json(res);
   ambiguous_markdown(md, sel["ambiguous"]);
   effects_markdown(md, sel, res.selection.null_score);

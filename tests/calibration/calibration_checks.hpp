@@ -50,11 +50,11 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
     sensor_kind &= e.kind == EffectKind::sensor_offset || e.kind == EffectKind::sensor_lag;
     kinds.insert(kind_name(e.kind));
   }
-  const double before = sensor_kind ? b.temperature_rms_K : b.displacement_rms_um;
-  const double after = sensor_kind ? a.temperature_rms_K : a.displacement_rms_um;
+  const double before = sensor_kind ? b.temperature_rms_K : 1e6 * b.displacement_rms_m;
+  const double after = sensor_kind ? a.temperature_rms_K : 1e6 * a.displacement_rms_m;
   std::printf("[calibration] measured-data RMS: T %.4g -> %.4g K, u %.4g -> %.4g um; null %.1f\n",
               res.before.temperature_rms_K, res.after.temperature_rms_K,
-              res.before.displacement_rms_um, res.after.displacement_rms_um,
+              1e6 * res.before.displacement_rms_m, 1e6 * res.after.displacement_rms_m,
               res.selection.null_score);
   for (size_t k = 0; k < res.selection.ranking.size(); ++k)
     std::printf(
@@ -123,7 +123,7 @@ inline double floor_ratio(const Study& s, const InjectedEffects& effects,
   const Eigen::MatrixXd truth = measured_channels(truth_run, r);
   const auto rms = [&](const io::MeasuredRun& run) {
     const RmsFigures f = rms_figures({truth}, {measured_channels(run, r)}, r.sensors);
-    return sensor_kind ? f.temperature_rms_K : f.displacement_rms_um;
+    return sensor_kind ? f.temperature_rms_K : 1e6 * f.displacement_rms_m;
   };
   const double at = rms(clean_run(s.mesh, with, effects, s.inst, s.gopt, "floor"));
   const double before = rms(clean_run(s.mesh, without, InjectedEffects{}, s.inst, s.gopt, "none"));

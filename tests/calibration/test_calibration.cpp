@@ -197,7 +197,7 @@ TEST(Air, SpeedOnEveryFilmIsNotTakenForAir) {
   std::printf("[calibration] claimed %s; test RMS u %.4g -> %.4g um\n",
               written["effects"].empty() ? "none"
                                          : written["effects"][0]["name"].get<std::string>().c_str(),
-              b.displacement_rms_um, a.displacement_rms_um);
+              1e6 * b.displacement_rms_m, 1e6 * a.displacement_rms_m);
   for (const auto& e : written["effects"]) EXPECT_NE(e["kind"], "ambient_temperature");
   bool air_reported = false;
   for (const auto& e : written["runners_up"])
@@ -237,8 +237,8 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
   const RmsFigures b = rms_figures({truth}, {res.tests[0].before}, s.train.readout.sensors);
   const RmsFigures a = rms_figures({truth}, {res.tests[0].after}, s.train.readout.sensors);
   std::printf("[calibration] air read from the sensor: test RMS u %.4g -> %.4g um\n",
-              b.displacement_rms_um, a.displacement_rms_um);
-  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+              1e6 * b.displacement_rms_m, 1e6 * a.displacement_rms_m);
+  EXPECT_LE(a.displacement_rms_m, 0.3 * b.displacement_rms_m);
 }
 
 // Issue 16 item 2: heat that grows with temperature feeds back on itself, so its response is
@@ -279,15 +279,15 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
       100 * (refitted / e.magnitude - 1), claim["refit"]["iterations"].get<int>(),
       claim["refit"]["converged"].get<bool>() ? "converged" : "cap",
       claim["refit"]["whitened_ss_at_linearised"].get<double>(),
-      claim["refit"]["whitened_ss_at_refitted"].get<double>(), b.displacement_rms_um,
-      a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
+      claim["refit"]["whitened_ss_at_refitted"].get<double>(), 1e6 * b.displacement_rms_m,
+      1e6 * a.displacement_rms_m, b.temperature_rms_K, a.temperature_rms_K);
   // The draw must show the linearisation's error, or the test shows nothing.
   EXPECT_GT(std::abs(linearised / e.magnitude - 1), 0.10);
   EXPECT_NEAR(refitted, e.magnitude, 0.10 * e.magnitude);
   EXPECT_TRUE(claim["refit"]["converged"].get<bool>());
   EXPECT_LT(claim["refit"]["whitened_ss_at_refitted"].get<double>(),
             claim["refit"]["whitened_ss_at_linearised"].get<double>());
-  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+  EXPECT_LE(a.displacement_rms_m, 0.3 * b.displacement_rms_m);
 }
 
 // Issue 16 item 3: two undeclared effects at once, the shaft's outer film doubled and the front
@@ -341,13 +341,13 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
     std::printf("[calibration]   claimed %s: %s, refit %s\n", e["name"].get<std::string>().c_str(),
                 e["parameters"].dump().c_str(), e.value("refit", nlohmann::json{}).dump().c_str());
   std::printf("[calibration] by pair: %s; test RMS u %.4g -> %.4g um, T %.4g -> %.4g K\n",
-              res.selection.by_pair ? "yes" : "no (greedy)", b.displacement_rms_um,
-              a.displacement_rms_um, b.temperature_rms_K, a.temperature_rms_K);
+              res.selection.by_pair ? "yes" : "no (greedy)", 1e6 * b.displacement_rms_m,
+              1e6 * a.displacement_rms_m, b.temperature_rms_K, a.temperature_rms_K);
   ASSERT_EQ(written["effects"].size(), 2u) << io::selection_json(res).dump(1);
   std::set<std::string> kinds{written["effects"][0]["kind"], written["effects"][1]["kind"]};
   EXPECT_EQ(kinds, (std::set<std::string>{"boundary_conductance", "temperature_dependent_heat"}));
   EXPECT_FALSE(res.selection.pairs.empty());
-  EXPECT_LE(a.displacement_rms_um, 0.3 * b.displacement_rms_um);
+  EXPECT_LE(a.displacement_rms_m, 0.3 * b.displacement_rms_m);
 }
 
 TEST(Clean, AtMostOneInTenGetsAnEffect) {
