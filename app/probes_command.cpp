@@ -6,11 +6,49 @@
 
 #include "app/commands.hpp"
 #include "core/errors.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/csv_out.hpp"
 #include "probes/command.hpp"
 
 namespace tt::app {
+
+namespace {
+
+/// The drift history at a finished run's two axial probe points (its thermal_error.csv, um -> m).
+probes::DriftHistory drift_history_from_run(const std::filesystem::path& run_dir) {
+  const io::CsvTable te = io::read_numeric_csv(run_dir / "thermal_error.csv");
+  const auto metres = [&](Eigen::Index r, const char* column) {
+    return core::kMetresPerMicrometre * te.rows(r, te.column_index(column));
+  };
+  probes::DriftHistory history;
+  for (Eigen::Index r = 0; r < te.rows.rows(); ++r) {
+    probes::DriftSample s;
+    s.time_s = te.rows(r, te.column_index("time_s"));
+    s.drift.x1_m = metres(r, "dx_z1_um");
+    s.drift.y1_m = metres(r, "dy_z1_um");
+    s.drift.x2_m = metres(r, "dx_z2_um");
+    s.drift.y2_m = metres(r, "dy_z2_um");
+    s.drift.z_m = metres(r, "dz_um");
+    history.push_back(s);
+  }
+  return history;
+}
+
+/// A virtual spindle with 5 um runout and 0.1 um noise, read as the command's flags say.
+probes::VirtualProbeSetup virtual_probe_setup(const ProbesArgs& args) {
+  probes::VirtualProbeSetup setup;
+  setup.speed_rpm = args.speed_rpm.value_or(3000.0);
+  setup.sample_rate_hz = args.sample_rate_hz.value_or(10000.0);
+  setup.probe_distance_m = 1e-3 * args.probe_distance_mm.value_or(70.0);
+  setup.runout_plane1 = probes::spindle_runout(5e-6, 0.3);
+  setup.runout_plane2 = probes::spindle_runout(5e-6, 1.1);
+  setup.runout_axial = probes::spindle_runout(1e-6, 0.0);
+  setup.axial_probe = true;
+  return setup;
+}
+
+}  // namespace
 
 int probes_command(const ProbesArgs& args) {
   probes::ProbeOptions options;
@@ -21,38 +59,17 @@ int probes_command(const ProbesArgs& args) {
   // The output is claimed first: one that is refused fails before any work.
   io::OutputDir out(args.out, {args.in, args.from_run, args.truth});
   std::filesystem::path raw = args.in;
-
   if (!args.from_run.empty()) {
-    // 1. The drift history at the run's two axial probe points (thermal_error.csv, um -> m).
-    const io::CsvTable te = io::read_numeric_csv(args.from_run / "thermal_error.csv");
-    probes::DriftHistory history;
-    for (Eigen::Index r = 0; r < te.rows.rows(); ++r) {
-      probes::DriftSample s;
-      s.time_s = te.rows(r, te.column_index("time_s"));
-      s.drift.x1_m = 1e-6 * te.rows(r, te.column_index("dx_z1_um"));
-      s.drift.y1_m = 1e-6 * te.rows(r, te.column_index("dy_z1_um"));
-      s.drift.x2_m = 1e-6 * te.rows(r, te.column_index("dx_z2_um"));
-      s.drift.y2_m = 1e-6 * te.rows(r, te.column_index("dy_z2_um"));
-      s.drift.z_m = 1e-6 * te.rows(r, te.column_index("dz_um"));
-      history.push_back(s);
-    }
-    // 2. A virtual spindle with 5 um runout and 0.1 um noise read at those times.
-    probes::VirtualProbeSetup setup;
-    setup.speed_rpm = args.speed_rpm.value_or(3000.0);
-    setup.sample_rate_hz = args.sample_rate_hz.value_or(10000.0);
-    setup.probe_distance_m = 1e-3 * args.probe_distance_mm.value_or(70.0);
-    setup.runout_plane1 = probes::spindle_runout(5e-6, 0.3);
-    setup.runout_plane2 = probes::spindle_runout(5e-6, 1.1);
-    setup.runout_axial = probes::spindle_runout(1e-6, 0.0);
-    setup.axial_probe = true;
-    // The virtual readings are inputs of the command and part of its result.
+    // A finished run's drift read by a virtual spindle's probes: the virtual readings are
+    // inputs of the command and part of its result.
     raw = out.path() / "virtual_raw.csv";
     const std::filesystem::path truth = out.path() / "virtual_truth.csv";
-    probes::write_virtual_raw_csv(raw, setup, history, truth);
+    probes::write_virtual_raw_csv(raw, virtual_probe_setup(args),
+                                  drift_history_from_run(args.from_run), truth);
     options.truth_csv = truth;
     options.constants = {};  // the raw file's header carries them
   }
-  // 3. Align, recover drift and tilt, compare with the other alignments; publish DIR whole.
+  // Align, recover drift and tilt, compare with the other alignments; publish DIR whole.
   const probes::ProbeRunSummary summary = probes::run_probes_command(raw, out.path(), options);
   out.commit();
   std::cerr << "thermotwin: probes: " << summary.readings << " readings -> " << args.out.string()

@@ -111,6 +111,26 @@ solvers::Checkpointing run_checkpointing(const RunArgs& args, const std::filesys
   return checkpointing;
 }
 
+/// The case's mesh; its size and time on stderr unless quiet.
+mesh::TetMesh meshed(const core::CaseSpec& spec, bool quiet, double& mesh_s) {
+  const auto t_mesh = Clock::now();
+  mesh::TetMesh mesh = mesh::mesh_case(spec);
+  mesh_s = seconds_since(t_mesh);
+  if (!quiet)
+    std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows()
+              << " tets (" << mesh_s << " s)\n";
+  return mesh;
+}
+
+/// The reduced model's error indicator above its tolerance: say so, with what to do.
+void warn_if_indicator_above_tolerance(const studies::VirtualRunReport& report) {
+  if (report.indicator && report.indicator->above_tolerance())
+    std::cerr << "thermotwin: warning: the reduced model's error indicator is "
+              << report.indicator->max_k << " K, above its tolerance of "
+              << report.indicator->tolerance_k
+              << " K: check with --verify, or rebuild the model (reduce) for this duty cycle\n";
+}
+
 }  // namespace
 
 int run_command(const RunArgs& args) {
@@ -126,15 +146,11 @@ int run_command(const RunArgs& args) {
   if (args.stop_after_steps > 0 || args.checkpoint_every_s >= 0)
     io::require_writable_checkpoint(checkpoint);
   // 2. Mesh; the reduced model, when given.
-  const auto t_mesh = Clock::now();
-  const mesh::TetMesh mesh = mesh::mesh_case(spec);
-  const double mesh_s = seconds_since(t_mesh);
+  double mesh_s = 0;
+  const mesh::TetMesh mesh = meshed(spec, args.quiet, mesh_s);
   const auto say = [&](const std::string& line) {
     if (!args.quiet) std::cerr << "thermotwin: " << line << "\n";
   };
-  if (!args.quiet)
-    std::cerr << "thermotwin: mesh: " << mesh.nodes.rows() << " nodes, " << mesh.tets.rows()
-              << " tets (" << mesh_s << " s)\n";
   const std::optional<io::ReducedModelFile> rom = run_rom(args, spec, mesh);
   // 3. Simulate: heat transfer, then thermo-elasticity.
   std::optional<solvers::ThermalCheckpoint> resumed;
@@ -145,11 +161,7 @@ int run_command(const RunArgs& args) {
   };
   const studies::VirtualRunReport report = studies::virtual_run(
       mesh, spec, {rom ? &rom->twin : nullptr, args.verify, progress, say, checkpointing});
-  if (report.indicator && report.indicator->above_tolerance())
-    std::cerr << "thermotwin: warning: the reduced model's error indicator is "
-              << report.indicator->max_k << " K, above its tolerance of "
-              << report.indicator->tolerance_k
-              << " K: check with --verify, or rebuild the model (reduce) for this duty cycle\n";
+  warn_if_indicator_above_tolerance(report);
   if (!args.dump.empty()) io::write_dump(report.run, args.dump);
   // 4. Write everything into DIR.partial, then publish it as DIR.
   io::RunModel model;
