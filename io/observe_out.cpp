@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/reports.hpp"
 
@@ -18,7 +19,8 @@ std::string observer_csv(const solvers::ObserverRun& r,
   for (Eigen::Index i = 0; i < r.times.size(); ++i) {
     csv << r.times(i);
     for (Eigen::Index k = 0; k < r.drift.cols(); ++k)
-      csv << "," << r.drift(i, k) * 1e6 << "," << r.drift_sigma(i, k) * 1e6;
+      csv << "," << r.drift(i, k) * core::kMicrometresPerMetre << ","
+          << r.drift_sigma(i, k) * core::kMicrometresPerMetre;
     const bool alarm = r.recalibrate && r.times(i) >= r.recalibrate_at_s;
     csv << "," << r.nis(i) << "," << r.dof(i) << "," << r.window_nis(i) << "," << r.window_bound(i)
         << "," << (alarm ? "recalibrate" : "ok") << "\n";

@@ -3,6 +3,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/reduced_model_io.hpp"
 
@@ -16,9 +17,9 @@ nlohmann::json validation_json(const std::vector<solvers::TwinComparison>& table
     nlohmann::json drift = nlohmann::json::object();
     for (std::size_t k = 0; k < c.drift_names.size(); ++k) {
       const auto i = static_cast<Eigen::Index>(k);
-      drift[c.drift_names[k]] = {{"max_error_um", c.drift_error_m(i) * 1e6},
-                                 {"peak_um", c.drift_peak_m(i) * 1e6},
-                                 {"limit_um", c.drift_limit_m(i) * 1e6}};
+      drift[c.drift_names[k]] = {{"max_error_um", c.drift_error_m(i) * core::kMicrometresPerMetre},
+                                 {"peak_um", c.drift_peak_m(i) * core::kMicrometresPerMetre},
+                                 {"limit_um", c.drift_limit_m(i) * core::kMicrometresPerMetre}};
     }
     rows.push_back({{"run", c.run},
                     {"shape", c.shape},
@@ -41,8 +42,10 @@ std::string validation_csv(const std::vector<solvers::TwinComparison>& table) {
       << (c.max_temperature_error_k <= solvers::kTwinTemperatureLimitK ? "yes" : "no") << "\n";
     for (std::size_t k = 0; k < c.drift_names.size(); ++k) {
       const auto i = static_cast<Eigen::Index>(k);
-      o << c.run << "," << c.drift_names[k] << "," << c.drift_error_m(i) * 1e6 << ","
-        << c.drift_limit_m(i) * 1e6 << "," << c.drift_peak_m(i) * 1e6 << ",um,"
+      o << c.run << "," << c.drift_names[k] << ","
+        << c.drift_error_m(i) * core::kMicrometresPerMetre << ","
+        << c.drift_limit_m(i) * core::kMicrometresPerMetre << ","
+        << c.drift_peak_m(i) * core::kMicrometresPerMetre << ",um,"
         << (c.drift_error_m(i) <= c.drift_limit_m(i) ? "yes" : "no") << "\n";
     }
   }
