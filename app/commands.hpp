@@ -97,6 +97,7 @@ struct ObserverOptions {
   /// factor on the reported drift sigma: one value for every target or one per target; empty: 1
   std::vector<double> drift_sigma_scale;
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
+  double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
 };
 
 /// compensate --model FIT.json | --rom DIR: live compensation (app/compensate_command.cpp).

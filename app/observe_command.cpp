@@ -47,12 +47,18 @@ int observe_command(const ObserveArgs& args) {
                      observer_noise_json(report.setup)});
   out.commit();
   const solvers::ObserverRun& r = report.result;
-  if (!args.quiet)
-    std::cerr << "thermotwin: observe: " << r.times.size() << " samples, status "
-              << (r.recalibrate
-                      ? "recalibrate since t = " + std::to_string(r.recalibrate_since_s) + " s"
-                      : std::string("ok"))
-              << "\n";
+  // A faulty sensor is a warning, written even with --quiet.
+  for (const solvers::SensorFault& f : r.sensor_faults)
+    std::cerr << "thermotwin: observe: warning: sensor "
+              << report.sensors[static_cast<std::size_t>(f.sensor)]
+              << " reads off by an offset (observer.json sensor_faults) since t = " << f.since_s
+              << " s: check its mounting and calibration\n";
+  if (args.quiet) return 0;
+  std::cerr << "thermotwin: observe: " << r.times.size() << " samples, status "
+            << (r.recalibrate
+                    ? "recalibrate since t = " + std::to_string(r.recalibrate_since_s) + " s"
+                    : std::string(r.sensor_faults.empty() ? "ok" : "sensor_fault"))
+            << "\n";
   return 0;
 }
 

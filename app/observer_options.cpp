@@ -91,6 +91,12 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
       .add_option("--probability", o.probability,
                   "consistency test: chi-square quantile of the bound (default 0.999)")
       ->check(CLI::Range(0.5, 0.999999));
+  command
+      .add_option("--sensor-fault-sigmas", o.sensor_fault_sigmas,
+                  "a sensor whose offset state stays beyond this many of its sigmas for "
+                  "--sustain-s is reported faulty, by name (status sensor_fault; default 4, 0: "
+                  "no such test)")
+      ->check(non_negative_number());
   command.add_flag("--widen-on-inconsistency", o.widen_on_inconsistency,
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
@@ -118,6 +124,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   setup.consistency.window_s = o.window_s;
   setup.consistency.sustain_s = o.sustain_s;
   setup.consistency.probability = o.probability;
+  setup.consistency.sensor_fault_sigmas = o.sensor_fault_sigmas;
   return setup;
 }
 

@@ -6,6 +6,7 @@
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
 //                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT=0]
 //                               [GEN_ONLY=-1] [SENSOR_OFFSET_K=0] [SENSOR_OFFSET_WALK_K=0]
+//                               [CHANGED_TRAINING=0]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
 //   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
 //   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
@@ -17,6 +18,12 @@
 //     and its random walk [K per sqrt(h)] (ObserverNoise::sensor_offset_*; 0 0: none).
 //     SENSOR_OFFSET_WALK_K < 0: the walk is chosen on the campaign's training runs among 0, 0.02,
 //     0.05 and 0.1, the one with the least RMS dy^2 + RMS dz^2 there (ties: the larger walk).
+//   CHANGED_TRAINING = 1: a second draw of one generator run per effect kind (another random
+//     stream: the scored runs are the same as without it), observed after the scored runs, never
+//     scored. The adapted sigma's 95 % quantile factor is then also computed on the campaign's
+//     training runs together with these changed-machine runs, and the scored runs' coverage
+//     reported with it ("calibrated with changed runs"): a sigma for a machine that may have
+//     changed in ways the alarm does not see.
 //   SENSORS: how the sensors are chosen on the fitting runs (as many as the correlation union):
 //     correlation     the four best by the standard's correlation for dy and for dz, together
 //     mutual_info     the four of the Gaussian mutual-information greedy for dy and for dz
@@ -229,6 +236,7 @@ int main(int argc, char** argv) {
     const int gen_only = argc > 11 ? std::stoi(argv[11]) : -1;
     if (argc > 12) campaign_noise.sensor_offset_initial_k = std::stod(argv[12]);
     if (argc > 13) campaign_noise.sensor_offset_walk_k = std::stod(argv[13]);
+    const bool changed_training = argc > 14 && std::stoi(argv[14]) != 0;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
         sensor_choice != "estimation" && sensor_choice != "estimation_exact")
       throw std::runtime_error("SENSORS '" + sensor_choice +
@@ -421,8 +429,9 @@ int main(int argc, char** argv) {
     // (solvers::drift_sigma_coverage_calibration). Both rules fixed before any run was scored.
     solvers::ObserverNoise adapted_noise = campaign_noise;
     adapted_noise.widen_on_inconsistency = true;
-    adapted_noise.drift_sigma_scale = solvers::drift_sigma_coverage_calibration(
-        observe_training(adapted_noise, {}), training_truth);
+    std::vector<solvers::ObserverRun> adapted_training = observe_training(adapted_noise, {});
+    adapted_noise.drift_sigma_scale =
+        solvers::drift_sigma_coverage_calibration(adapted_training, training_truth);
     const auto adapted_sigma = [&](const core::CaseSpec& c, const solvers::ObserverNoise& noise,
                                    const Eigen::VectorXd& time, const Eigen::MatrixXd& readings) {
       solvers::ObserverNoise with = noise;
@@ -483,6 +492,20 @@ int main(int argc, char** argv) {
                                     : std::string("none"))
                 << "\n";
     };
+    // Per scored run (0: campaign held out, 1: generator clean, 2: generator effect), its
+    // prediction, widened sigma at scale 1 and truth (dy, dz): CHANGED_TRAINING's coverage.
+    struct Scored {
+      Eigen::MatrixXd predicted, widened, truth;
+      int set = 0;
+    };
+    std::vector<Scored> scored;
+    const auto keep = [&](const Eigen::MatrixXd& p, const Eigen::MatrixXd& adapted,
+                          const Eigen::MatrixXd& truth, int set) {
+      Scored sc{p, adapted, truth, set};
+      for (int d = 0; d < 2; ++d) sc.widened.col(d) /= adapted_noise.drift_sigma_scale(1 + d);
+      scored.push_back(std::move(sc));
+    };
+    int held_fault_runs = 0;
     for (int i : split.test) {
       const auto& r = runs[static_cast<std::size_t>(i)];
       const auto& g = noisy_s[static_cast<std::size_t>(i)];
@@ -501,6 +524,11 @@ int main(int argc, char** argv) {
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
       held.observer.add(po, so, truth, scale, sa);
+      keep(po, sa, truth, 0);
+      held_fault_runs += !run.sensor_faults.empty();
+      for (const solvers::SensorFault& f : run.sensor_faults)
+        std::cout << r.name << ": sensor fault " << sensors[static_cast<std::size_t>(f.sensor)]
+                  << " since " << f.since_s << " s, raised at " << f.raised_s << " s\n";
       held.regression.add(pr, sr, truth);
       add_alarm(clean_alarms, run, r.spec.duty_cycle.end / 3600);
       add_alarm(clean_fast, fast_alarm(r.spec, campaign_noise, g.time, g.temperature),
@@ -517,6 +545,14 @@ int main(int argc, char** argv) {
     std::vector<Eigen::MatrixXd> gen_training_truth;
     Eigen::Vector2d own_scale = Eigen::Vector2d::Ones();
     std::size_t effect_runs = 0;
+    // CHANGED_TRAINING: the changed-machine training runs (observed with the widening, scale 1)
+    // and their truths; per scored generator run, its prediction, widened sigma at scale 1 and
+    // truth (dy, dz), and whether it has an effect.
+    std::vector<solvers::ObserverRun> changed_runs;
+    std::vector<Eigen::MatrixXd> changed_truth;
+    // Sensor faults (the offsets' test, solvers::SensorFaultMonitor): runs that raised one.
+    int clean_fault_runs = 0, effect_fault_runs = 0;
+    double clean_fault_hours = 0;
     if (gen_hours > 0) {
       const auto t_gen = Clock::now();
       calibration::GeneratorOptions gopt;
@@ -534,6 +570,15 @@ int main(int argc, char** argv) {
         const auto kind = static_cast<calibration::EffectKind>(k);
         plan.emplace_back(calibration::kind_name(kind),
                           calibration::random_effect(kind, spec, gmesh, sensors, rng));
+      }
+      const std::size_t scored_runs = plan.size();
+      if (changed_training) {
+        std::mt19937_64 other = core::generator(seed, 1);
+        for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
+          const auto kind = static_cast<calibration::EffectKind>(k);
+          plan.emplace_back(calibration::kind_name(kind),
+                            calibration::random_effect(kind, spec, gmesh, sensors, other));
+        }
       }
       for (std::size_t k = 0; k < plan.size(); ++k) {
         const auto& [kind, effect] = plan[k];
@@ -557,6 +602,18 @@ int main(int argc, char** argv) {
             calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
         const io::MeasuredRun measured = calibration::with_noise(truth, gopt, rng);
         const core::CaseSpec declared = calibration::case_for_run(spec, measured);
+        if (k >= scored_runs) {  // a changed-machine training run: observed, not scored
+          solvers::ObserverNoise widened = gen_noise;
+          widened.widen_on_inconsistency = true;
+          changed_runs.push_back(
+              solvers::observe(twin.model.system, declared,
+                               solvers::twin_observer_setup(twin, declared, sensors, widened),
+                               measured.time, measured.temperature));
+          changed_truth.push_back(as_targets(truth.displacement, changed_runs.back().drift.cols()));
+          std::cout << name << ": changed-machine training run, " << kind << " "
+                    << fmt(effect.magnitude) << " " << effect.target << "\n";
+          continue;
+        }
         const solvers::ObserverSetup setup =
             solvers::twin_observer_setup(twin, declared, sensors, gen_noise);
         const auto t_obs = Clock::now();
@@ -593,6 +650,12 @@ int main(int argc, char** argv) {
         const Eigen::MatrixXd sa =
             adapted_sigma(declared, gen_noise, measured.time, measured.temperature);
         o.add(po, so, true_drift, scale, sa);
+        keep(po, sa, true_drift, effect.present ? 2 : 1);
+        (effect.present ? effect_fault_runs : clean_fault_runs) += !run.sensor_faults.empty();
+        if (!effect.present) clean_fault_hours += gen_hours;
+        for (const solvers::SensorFault& f : run.sensor_faults)
+          std::cout << name << ": sensor fault " << sensors[static_cast<std::size_t>(f.sensor)]
+                    << " since " << f.since_s << " s, raised at " << f.raised_s << " s\n";
         const auto [pr, sr] = regression_on(reg, g);
         rr.add(pr, sr, true_drift);
         Method& m = effect.present ? geffect : gclean;
@@ -661,7 +724,7 @@ int main(int argc, char** argv) {
       }
       std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
                 << fmt(seconds_since(t_gen)) << " s)\n\n";
-      effect_runs = plan.size() - static_cast<std::size_t>(clean_runs);
+      effect_runs = scored_runs - static_cast<std::size_t>(clean_runs);
     }
 
     const auto total = [&](const std::string& what, const Method& m) {
@@ -686,6 +749,31 @@ int main(int argc, char** argv) {
              "coverage "
           << fmt(100 * geffect_own.coverage_calibrated()(0)) << " %, "
           << fmt(100 * geffect_own.coverage_calibrated()(1)) << " %\n";
+    if (!changed_runs.empty()) {
+      // The quantile factor on the campaign's training runs and the changed-machine runs together.
+      std::vector<solvers::ObserverRun> both = adapted_training;
+      std::vector<Eigen::MatrixXd> both_truth = training_truth;
+      both.insert(both.end(), changed_runs.begin(), changed_runs.end());
+      both_truth.insert(both_truth.end(), changed_truth.begin(), changed_truth.end());
+      const Eigen::VectorXd f = solvers::drift_sigma_coverage_calibration(both, both_truth);
+      Score cov[3];
+      for (const Scored& sc : scored)
+        cov[sc.set].add(sc.predicted, sc.widened, sc.truth, Eigen::Vector2d(f(1), f(2)));
+      std::cout << "calibrated with changed runs (" << changed_runs.size()
+                << " changed-machine runs + the campaign's " << adapted_training.size()
+                << " training runs): factor dy " << fmt(f(1)) << ", dz " << fmt(f(2))
+                << " (campaign alone " << fmt(adapted_noise.drift_sigma_scale(1)) << ", "
+                << fmt(adapted_noise.drift_sigma_scale(2)) << "); coverage:";
+      const char* sets[] = {"campaign held out", "generator clean", "generator effect runs"};
+      for (int k = 0; k < 3; ++k)
+        std::cout << " " << sets[k] << " " << fmt(100 * cov[k].coverage_calibrated()(0)) << " %, "
+                  << fmt(100 * cov[k].coverage_calibrated()(1)) << " %;";
+      std::cout << "\n";
+    }
+    std::cout << "sensor faults: " << held_fault_runs << " of " << split.test.size()
+              << " campaign held-out runs, " << clean_fault_runs << " of " << clean_runs
+              << " generator clean runs (" << clean_fault_hours << " h), " << effect_fault_runs
+              << " of " << effect_runs << " effect runs\n";
     std::cout << "faster alarm (window " << fast.window_s << " s): " << clean_fast.raised << " in "
               << clean_fast.hours << " h of clean runs ("
               << fmt(clean_fast.raised / clean_fast.hours) << " per hour); " << effect_fast.raised

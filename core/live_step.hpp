@@ -52,6 +52,9 @@ struct LiveStep {
   std::vector<int> held;
   /// the model no longer describes the machine (the observer's innovation test): recalibrate
   bool recalibrate = false;
+  /// columns (indices into the stream's columns) of sensors the observer found off by an offset
+  /// it is sure of (solvers::SensorFault), in the order they were raised: check these sensors
+  std::vector<int> faulty;
 };
 
 }  // namespace tt::core

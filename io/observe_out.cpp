@@ -1,17 +1,20 @@
 #include "io/observe_out.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/reports.hpp"
+#include "io/sample_stream.hpp"
 
 namespace tt::io {
 namespace {
 
 std::string observer_csv(const solvers::ObserverRun& r,
-                         const std::vector<std::string>& target_names) {
+                         const std::vector<std::string>& target_names,
+                         const std::vector<std::string>& sensors) {
   std::ostringstream csv;
   csv << std::setprecision(9) << "time_s";
   for (const auto& t : target_names) csv << "," << t << "_predicted_um," << t << "_sigma_um";
@@ -22,8 +25,12 @@ std::string observer_csv(const solvers::ObserverRun& r,
       csv << "," << r.drift(i, k) * core::kMicrometresPerMetre << ","
           << r.drift_sigma(i, k) * core::kMicrometresPerMetre;
     const bool alarm = r.recalibrate && r.times(i) >= r.recalibrate_at_s;
+    std::vector<std::string> faulty;
+    for (const solvers::SensorFault& f : r.sensor_faults)
+      if (r.times(i) >= f.raised_s) faulty.push_back(sensors[static_cast<std::size_t>(f.sensor)]);
+    const std::string status = model_status(alarm, faulty);
     csv << "," << r.nis(i) << "," << r.dof(i) << "," << r.window_nis(i) << "," << r.window_bound(i)
-        << "," << (alarm ? "recalibrate" : "ok") << "\n";
+        << "," << (status.empty() ? "ok" : status) << "\n";
   }
   return csv.str();
 }
@@ -43,13 +50,38 @@ nlohmann::json unknown_inputs_json(const solvers::ObserverRun& r) {
   return unknown;
 }
 
+/// Each sensor found off by an offset: its id, the offset's final estimate and sigma [K], since
+/// when it was beyond the bound and when the fault was raised [s].
+nlohmann::json sensor_faults_json(const solvers::ObserverRun& r,
+                                  const std::vector<std::string>& sensors) {
+  nlohmann::json faults = nlohmann::json::array();
+  const Eigen::Index last = r.times.size() - 1;
+  for (const solvers::SensorFault& f : r.sensor_faults) {
+    const std::string& id = sensors[static_cast<std::size_t>(f.sensor)];
+    const auto it =
+        std::find(r.unknown_input_names.begin(), r.unknown_input_names.end(), "offset:" + id);
+    const Eigen::Index j = it - r.unknown_input_names.begin();
+    faults.push_back({{"sensor", id},
+                      {"offset_K", r.unknown_inputs(last, j)},
+                      {"sigma_K", r.unknown_inputs_sigma(last, j)},
+                      {"since_s", f.since_s},
+                      {"raised_s", f.raised_s}});
+  }
+  return faults;
+}
+
+std::string final_status(const solvers::ObserverRun& r) {
+  if (r.recalibrate) return "recalibrate";
+  return r.sensor_faults.empty() ? "ok" : "sensor_fault";
+}
+
 }  // namespace
 
 void write_observe(const std::filesystem::path& dir, const studies::ObserveReport& report,
                    const ObserveSource& source) {
   const solvers::ObserverRun& r = report.result;
   const solvers::ObserverSetup& setup = report.setup;
-  write_file_atomically(dir / "observer.csv", observer_csv(r, setup.target_names));
+  write_file_atomically(dir / "observer.csv", observer_csv(r, setup.target_names, report.sensors));
   nlohmann::json doc = {
       {"run", source.run},
       {"case", source.case_name},
@@ -59,9 +91,11 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
       {"consistency",
        {{"window_s", setup.consistency.window_s},
         {"sustain_s", setup.consistency.sustain_s},
-        {"probability", setup.consistency.probability}}},
-      {"status", r.recalibrate ? "recalibrate" : "ok"},
+        {"probability", setup.consistency.probability},
+        {"sensor_fault_sigmas", setup.consistency.sensor_fault_sigmas}}},
+      {"status", final_status(r)},
       {"unknown_inputs", unknown_inputs_json(r)},
+      {"sensor_faults", sensor_faults_json(r, report.sensors)},
       {"recalibrate_since_s", nullptr},
       {"recalibrate_raised_s", nullptr}};
   if (r.recalibrate) {

@@ -202,12 +202,22 @@ std::string output_header(const std::vector<std::string>& targets) {
   return h + ",status\n";
 }
 
+std::string model_status(bool recalibrate, const std::vector<std::string>& faulty) {
+  std::string s = recalibrate ? "recalibrate" : "";
+  for (std::size_t k = 0; k < faulty.size(); ++k)
+    s += (k ? ";" : (s.empty() ? "sensor_fault:" : "|sensor_fault:")) + faulty[k];
+  return s;
+}
+
 std::string status_text(const core::LiveStep& step, const std::vector<std::string>& columns) {
   std::string s = core::status_name(step.status);
   for (std::size_t k = 0; k < step.held.size(); ++k)
     s += (k ? ";" : ":") + columns[static_cast<std::size_t>(step.held[k])];
-  if (!step.recalibrate) return s;
-  return step.status == core::SampleStatus::ok ? "recalibrate" : "recalibrate|" + s;
+  std::vector<std::string> faulty;
+  for (int c : step.faulty) faulty.push_back(columns[static_cast<std::size_t>(c)]);
+  const std::string model = model_status(step.recalibrate, faulty);
+  if (model.empty()) return s;
+  return step.status == core::SampleStatus::ok ? model : model + "|" + s;
 }
 
 void append_output_line(std::string& out, double time, const Eigen::VectorXd& predicted,

@@ -102,9 +102,14 @@ bool parsed_sample(std::string_view line, double& time, Eigen::Ref<Eigen::Vector
 /// status.
 std::string output_header(const std::vector<std::string>& targets);
 
+/// What the observer says of the machine and its sensors: "recalibrate", "sensor_fault:T07;T11"
+/// (the sensors found off by an offset, by name), both joined by '|', or "" when neither.
+std::string model_status(bool recalibrate, const std::vector<std::string>& faulty);
+
 /// The status field of a step: "ok", "late", "held:T07;T08" or "waiting:T07" (the columns held
-/// or still missing, by name); once the model says recalibrate, "recalibrate" in place of "ok"
-/// and before any other ("recalibrate|held:T07"). columns: the stream's columns.
+/// or still missing, by name); model_status in place of "ok" and before any other
+/// ("recalibrate|held:T07", "sensor_fault:T11", "recalibrate|sensor_fault:T11|late").
+/// columns: the stream's columns.
 std::string status_text(const core::LiveStep& step, const std::vector<std::string>& columns);
 
 /// Appends one output line: the time, predicted errors and their 1-σ [µm] (empty fields where

@@ -151,13 +151,34 @@ double InnovationMonitor::change_start() const {
   return t_[std::min(after, t_.size() - 1)];
 }
 
+void SensorFaultMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& offset,
+                             const Eigen::Ref<const Eigen::VectorXd>& sigma) {
+  if (!(sigmas_ > 0)) return;
+  const auto n = static_cast<std::size_t>(offset.size());
+  beyond_since_.resize(n, std::numeric_limits<double>::quiet_NaN());
+  raised_.resize(n, false);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (!(std::abs(offset(i)) > sigmas_ * sigma(i))) {
+      beyond_since_[k] = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    if (std::isnan(beyond_since_[k])) beyond_since_[k] = t;
+    if (!raised_[k] && t - beyond_since_[k] >= sustain_s_) {
+      raised_[k] = true;
+      faults_.push_back({static_cast<int>(k), beyond_since_[k], t});
+    }
+  }
+}
+
 KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                                const ObserverSetup& setup)
     : sys_(system),
       spec_(spec),
       setup_(setup),
       stepper_(system, spec),
-      monitor_(setup.consistency) {
+      monitor_(setup.consistency),
+      faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s) {
   r_ = system.states();
   const auto fail = [](const std::string& what) { throw core::SolverError("observer: " + what); };
   if (setup_.sensor_rows.cols() != r_ || setup_.target_rows.cols() != r_)
@@ -177,6 +198,9 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                    n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
+  const double fault = setup_.consistency.sensor_fault_sigmas;
+  if (!(fault >= 0) || !std::isfinite(fault))
+    fail("sensor fault bound " + number(fault) + " sigma: expected a finite value >= 0");
   const Eigen::VectorXd& scale = n.drift_sigma_scale;
   if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
                             !(scale.array() > 0).all() || !scale.allFinite()))
@@ -381,6 +405,11 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
     e.drift_sigma *= std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
   e.recalibrate_since_s = monitor_.since_s();
+  if (offsets_ >= 0) {
+    const Eigen::Index o = r_ + offsets_;
+    faults_.add(t, x_.segment(o, m), p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt());
+    e.sensor_faults = faults_.faults();
+  }
   return e;
 }
 
@@ -441,6 +470,7 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
       run.recalibrate_at_s = e.time;
     }
   }
+  if (n > 0) run.sensor_faults = kf.sensor_faults();
   return run;
 }
 

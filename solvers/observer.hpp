@@ -71,6 +71,11 @@ struct ConsistencyOptions {
   double window_s = 1800;
   double probability = 0.999;
   double sustain_s = 900;
+  /// The sensors' offsets (ObserverNoise::sensor_offset_initial_k): a sensor whose estimated
+  /// offset stays beyond this many of its standard deviations for `sustain_s` is reported faulty
+  /// (SensorFaultMonitor); 0: no such test. Under the noise model an offset's estimate is beyond
+  /// 4 sigma with probability 6e-5 (two-sided), and the test asks it to stay there.
+  double sensor_fault_sigmas = 4;
 };
 
 /// The observer's set-up on a reduced system.
@@ -129,6 +134,32 @@ class InnovationMonitor {
   bool alarm_ = false;
 };
 
+/// A sensor whose reading is off by an offset the observer is sure of (SensorFaultMonitor): not the
+/// machine's change but the sensor's (its mounting, its cable, its calibration).
+struct SensorFault {
+  int sensor = 0;                                              /// index into the setup's sensors
+  double since_s = std::numeric_limits<double>::quiet_NaN();   /// first beyond the bound
+  double raised_s = std::numeric_limits<double>::quiet_NaN();  /// held for sustain_s: raised
+};
+
+/// The test of the sensors' offsets, fed one assimilation at a time: sensor k is faulty once
+/// |offset_k| > sigmas * sigma_k has held for sustain_s (ConsistencyOptions); a fault stays raised.
+class SensorFaultMonitor {
+ public:
+  SensorFaultMonitor(double sigmas, double sustain_s) : sigmas_(sigmas), sustain_s_(sustain_s) {}
+  /// The offsets' estimates and standard deviations at time t [K], one per sensor.
+  void add(double t, const Eigen::Ref<const Eigen::VectorXd>& offset,
+           const Eigen::Ref<const Eigen::VectorXd>& sigma);
+  /// The faults raised so far, in the order they were raised.
+  const std::vector<SensorFault>& faults() const { return faults_; }
+
+ private:
+  double sigmas_, sustain_s_;
+  std::vector<double> beyond_since_;  /// per sensor: NaN while within the bound
+  std::vector<bool> raised_;
+  std::vector<SensorFault> faults_;
+};
+
 /// What the observer says after one assimilation.
 struct ObserverEstimate {
   double time = 0;              /// [s]
@@ -139,6 +170,9 @@ struct ObserverEstimate {
   int dof = 0;                  /// readings used
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
+  /// Sensors found faulty so far (an offset beyond ConsistencyOptions::sensor_fault_sigmas),
+  /// in the order they were raised; empty without offset states.
+  std::vector<SensorFault> sensor_faults;
 };
 
 /// How the filter's covariance goes from one time to a later one with no reading between:
@@ -179,6 +213,8 @@ class KalmanObserver {
   std::vector<UnknownInputKind> unknown_input_kinds() const;
   Eigen::Index states() const { return r_; }
   const InnovationMonitor& monitor() const { return monitor_; }
+  /// The sensors found faulty so far (empty without offset states).
+  const std::vector<SensorFault>& sensor_faults() const { return faults_.faults(); }
 
  private:
   void advance_to(double t);
@@ -198,6 +234,7 @@ class KalmanObserver {
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
+  SensorFaultMonitor faults_;
   CovarianceMap* map_ = nullptr;  /// while advance() runs: the steps' map, accumulated
 };
 
@@ -215,6 +252,7 @@ struct ObserverRun {
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// change point
   double recalibrate_at_s = std::numeric_limits<double>::quiet_NaN();     /// when it was raised
+  std::vector<SensorFault> sensor_faults;  /// raised over the run, in that order
 };
 
 /// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle).

@@ -183,6 +183,26 @@ TEST(Compensation, MissingReadingHoldsTheLastGoodValueAndSaysWhich) {
   EXPECT_GT((live - predicted_error(model, g)).cwiseAbs().maxCoeff(), 0.0);
 }
 
+TEST(Compensation, StatusTextPutsWhatTheObserverSaysFirst) {
+  // The observer's word on the machine (recalibrate) and on its sensors (sensor_fault, by name)
+  // in place of ok, and before a sample's own status.
+  const std::vector<std::string> columns{"speed_rpm", "T02", "T11"};
+  LiveStep s;
+  s.status = SampleStatus::ok;
+  EXPECT_EQ(tt::io::status_text(s, columns), "ok");
+  s.faulty = {2};
+  EXPECT_EQ(tt::io::status_text(s, columns), "sensor_fault:T11");
+  s.faulty = {2, 1};
+  s.recalibrate = true;
+  EXPECT_EQ(tt::io::status_text(s, columns), "recalibrate|sensor_fault:T11;T02");
+  s.status = SampleStatus::held;
+  s.held = {0};
+  EXPECT_EQ(tt::io::status_text(s, columns), "recalibrate|sensor_fault:T11;T02|held:speed_rpm");
+  s.faulty.clear();
+  EXPECT_EQ(tt::io::status_text(s, columns), "recalibrate|held:speed_rpm");
+  EXPECT_EQ(tt::io::model_status(false, {}), "");
+}
+
 TEST(Compensation, WaitsForACompleteFirstSampleAndSkipsLateOnes) {
   const auto groups = runs();
   const FittedModel model = fitted_model(ModelSpec{}, {groups[0], groups[1]}, {0, 1}, 0);

@@ -86,13 +86,16 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
   EXPECT_FALSE(j["unknown_inputs"].contains("offset:T11"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
-  // With the default offset states the offset is found as T11's, and explained: no alarm.
+  // With the default offset states the offset is found as T11's, and explained: no alarm, but
+  // the sensor is reported (status sensor_fault, below).
   const fs::path with_offsets = dir / "with_offsets";
   observe_args.resize(observe_args.size() - no_offsets.size());
   observe_args[7] = with_offsets.string();
   ASSERT_EQ(rt::run(observe_args, {}, log), 0) << rt::read_text(log);
+  EXPECT_NE(rt::read_text(log).find("warning: sensor T11 reads off by an offset"),
+            std::string::npos)
+      << rt::read_text(log);
   const auto jo = nlohmann::json::parse(std::ifstream(with_offsets / "observer.json"));
-  EXPECT_EQ(jo["status"], "ok");
   EXPECT_EQ(jo["noise"]["sensor_offset_K"], 0.5);
   ASSERT_TRUE(jo["unknown_inputs"].contains("offset:T11"));
   // Offsets are in kelvin, heat inputs in watts.
@@ -100,7 +103,14 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   for (const char* other : {"offset:T02", "offset:T17"})
     EXPECT_LT(std::abs(jo.at("unknown_inputs").at(other).at("final_K").get<double>()), 0.1)
         << other;
+  // The 0.6 K offset is sure: T11 alone is reported faulty, with its estimate and times.
+  EXPECT_EQ(jo["status"], "sensor_fault");
+  ASSERT_EQ(jo["sensor_faults"].size(), 1u);
+  EXPECT_EQ(jo["sensor_faults"][0]["sensor"], "T11");
+  EXPECT_NEAR(jo["sensor_faults"][0]["offset_K"].get<double>(), 0.6, 0.1);
+  EXPECT_LE(jo["sensor_faults"][0]["since_s"].get<double>(), 900.0);
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", with_offsets));
+  EXPECT_TRUE(j["sensor_faults"].empty());  // without offset states no offset test
   // 3. The recorded run streamed through compensate --rom: the offline observer's figures.
   const io::MeasuredRun measured = io::read_measured_run(data);
   const fs::path live = dir / "live.csv", live_log = dir / "live.log";
@@ -142,9 +152,10 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
           largest = std::max(largest, std::abs(a));
           worst = std::max(worst, std::abs(a - b));
         }
-      const bool raised = offline[i].at("status") == "recalibrate";
-      EXPECT_EQ(streamed[i].at("status").rfind("recalibrate", 0) == 0, raised) << "sample " << i;
-      alarms += raised;
+      // The same status: what the observer says (recalibrate, sensor_fault:T11) or ok.
+      const std::string& said = offline[i].at("status");
+      EXPECT_EQ(streamed[i].at("status"), said) << "sample " << i;
+      alarms += said.rfind("recalibrate", 0) == 0;
     }
     EXPECT_GT(largest, 0.5);           // microns of drift were compared
     EXPECT_LE(worst, 1e-7 * largest);  // observer.csv holds 9 digits
@@ -194,9 +205,9 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
   for (const char* command : {"observe", "compensate"}) {
     ASSERT_EQ(rt::run({command, "--help"}, {}, log), 0) << rt::read_text(log);
     const std::string help = rt::read_text(log);
-    for (const char* flag :
-         {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
-          "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale"})
+    for (const char* flag : {"--sensor-offset-k", "--sensor-offset-walk-k",
+                             "--widen-on-inconsistency", "--heat-initial-w", "--air-initial-k",
+                             "--state-walk-k", "--drift-sigma-scale", "--sensor-fault-sigmas"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
@@ -207,6 +218,7 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
       {{"--sensor-offset-walk-k", "nan"},
        "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
       {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},
+      {{"--sensor-fault-sigmas", "-1"}, "--sensor-fault-sigmas: -1: expected a finite number >= 0"},
       {{"--widen-on-inconsistency=maybe"}, "--widen-on-inconsistency"}};
   for (const auto& [flags, message] : bad) {
     std::vector<std::string> args = base;

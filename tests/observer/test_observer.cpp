@@ -391,7 +391,19 @@ TEST_F(Observer, ASensorOffsetIsEstimatedAsAnOffsetNotAsHeat) {
   EXPECT_FALSE(offset.recalibrate)
       << "the offset is explained: alarm at " << offset.recalibrate_at_s << " s";
   EXPECT_FALSE(clean.recalibrate);
-  // A negative or infinite offset spread is refused.
+  // The offset is sure (0.5 K against a sigma under 0.1 K): T17 alone is reported faulty, from
+  // the first readings (the known start shows an offset at once) and raised after the sustain.
+  ASSERT_EQ(offset.sensor_faults.size(), 1u);
+  EXPECT_EQ(offset.sensor_faults[0].sensor, faulty);
+  EXPECT_LE(offset.sensor_faults[0].since_s, 600.0);
+  EXPECT_GE(offset.sensor_faults[0].raised_s - offset.sensor_faults[0].since_s,
+            solvers::ConsistencyOptions{}.sustain_s);
+  EXPECT_TRUE(clean.sensor_faults.empty()) << "sensor " << clean.sensor_faults[0].sensor;
+  EXPECT_TRUE(plain.sensor_faults.empty());  // no offset states, no offset test
+  // A negative or infinite offset spread, or fault bound, is refused.
+  solvers::ObserverSetup no_bound = setup(with);
+  no_bound.consistency.sensor_fault_sigmas = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, no_bound), core::SolverError);
   solvers::ObserverSetup bad = setup(with);
   bad.noise.sensor_offset_walk_k = -0.1;
   EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
@@ -540,6 +552,27 @@ TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
   }
   EXPECT_TRUE(loud.recalibrate());
   EXPECT_NEAR(loud.since_s(), 1800.0, 60.0);  // the change point, not the window's end
+}
+
+TEST(ObserverPieces, SensorFaultMonitor) {
+  // Sensor 1 goes beyond 4 sigma at t = 600 s and stays: raised once at 600 + 300 s. Sensor 0
+  // crosses for less than the sustain time, twice: never raised. Sensor 2 stays within.
+  solvers::SensorFaultMonitor m(4, 300);
+  for (int k = 0; k <= 30; ++k) {
+    const double t = 60.0 * k;
+    const bool blip = (k >= 3 && k <= 6) || (k >= 10 && k <= 13);  // 180 s each
+    m.add(t, Eigen::Vector3d(blip ? -0.5 : 0.1, k >= 10 ? 0.45 : 0.0, 0.39),
+          Eigen::Vector3d(0.1, 0.1, 0.1));
+  }
+  ASSERT_EQ(m.faults().size(), 1u);
+  EXPECT_EQ(m.faults()[0].sensor, 1);
+  EXPECT_DOUBLE_EQ(m.faults()[0].since_s, 600.0);
+  EXPECT_DOUBLE_EQ(m.faults()[0].raised_s, 900.0);
+  // A bound of 0: no test.
+  solvers::SensorFaultMonitor off(0, 300);
+  for (int k = 0; k <= 30; ++k)
+    off.add(60.0 * k, Eigen::Vector3d(9, 9, 9), Eigen::Vector3d::Ones());
+  EXPECT_TRUE(off.faults().empty());
 }
 
 }  // namespace
