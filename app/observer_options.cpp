@@ -73,11 +73,21 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "error of the drift rows (elastic model) relative to the drift (default 0.04)")
       ->check(non_negative_number());
   command
+      .add_option("--correction-relative-sigma", o.correction_relative_sigma,
+                  "error of the drift the filter's corrections account for (how far the unknown "
+                  "inputs and readings moved it from the declared model's own run), relative to "
+                  "it, added after --drift-sigma-scale (default 0: none)")
+      ->check(non_negative_number());
+  command
       .add_option("--drift-sigma-scale", o.drift_sigma_scale,
                   "factor on the reported drift sigma, calibrated on training runs: one value for "
                   "all targets or one per target, comma-separated (default 1)")
       ->delimiter(',')
       ->check(positive_number());
+  add_consistency_options(command, o);
+}
+
+void add_consistency_options(CLI::App& command, ObserverOptions& o) {
   command
       .add_option("--window-s", o.window_s,
                   "consistency test: window of the summed NIS [s] (default 1800)")
@@ -116,6 +126,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.sensor_offset_initial_k = o.sensor_offset_k;
   noise.sensor_offset_walk_k = o.sensor_offset_walk_k;
   noise.drift_relative_sigma = o.drift_relative_sigma;
+  noise.correction_relative_sigma = o.correction_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
   solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
   if (!o.drift_sigma_scale.empty())
@@ -142,6 +153,7 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
           {"sensor_offset_K", n.sensor_offset_initial_k},
           {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
           {"drift_relative_sigma", n.drift_relative_sigma},
+          {"correction_relative_sigma", n.correction_relative_sigma},
           {"drift_sigma_scale", as_vector(scale)},
           {"widen_on_inconsistency", n.widen_on_inconsistency}};
 }

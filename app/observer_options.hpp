@@ -16,9 +16,14 @@ namespace tt::app {
 
 /// --sensors, --sensor-sigma-k, --heat-walk-w, --heat-initial-w, --air-walk-k, --air-initial-k,
 /// --state-walk-k, --sensor-offset-k, --sensor-offset-walk-k, --drift-relative-sigma,
-/// --drift-sigma-scale, --widen-on-inconsistency, --window-s, --sustain-s, --probability,
+/// --correction-relative-sigma, --drift-sigma-scale, --widen-on-inconsistency, --window-s,
+/// --sustain-s, --probability,
 /// --sensor-fault-sigmas on `command`.
 void add_observer_options(CLI::App& command, ObserverOptions& options);
+
+/// The consistency test's and the sensor-fault test's options (--window-s, --sustain-s,
+/// --probability, --sensor-fault-sigmas), a part of add_observer_options.
+void add_consistency_options(CLI::App& command, ObserverOptions& options);
 
 /// The set-up on `twin` for `sensors` (ids): the noise and the consistency test of `options`.
 /// Throws DataError when --sensor-sigma-k or --drift-sigma-scale has neither one value nor one

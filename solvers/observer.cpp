@@ -195,7 +195,8 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
          " sensors; expected one finite sigma > 0 K each");
   const ObserverNoise& n = setup_.noise;
   for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
-                   n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k})
+                   n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k,
+                   n.correction_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
   const double fault = setup_.consistency.sensor_fault_sigmas;
@@ -242,6 +243,7 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                           ? spec.thermal.initial_temperature_c + core::kCelsiusOffset
                           : setup_.initial_temperature_k;
   z0_ = t0_k * system.uniform;
+  if (n.correction_relative_sigma > 0) z_open_ = z0_;
   x_ = Eigen::VectorXd::Zero(r_ + nb_);
   x_.head(r_) = z0_;
   p_ = Eigen::MatrixXd::Zero(r_ + nb_, r_ + nb_);
@@ -308,6 +310,7 @@ void KalmanObserver::step(double t1) {
     add_process_noise(map_->process, dt);
   }
   x_.head(r_) = std::move(z);
+  if (z_open_.size() != 0) z_open_ = (phi * z_open_ + a.input).eval();
   t_ = t1;
   prev_speed_ = a.speed;
 }
@@ -389,18 +392,8 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
     e.dof = static_cast<int>(nu);
     for (Eigen::Index i = 0; i < nu; ++i) e.innovation(used[i]) = innovation(i);
   }
-  const Eigen::MatrixXd& l = setup_.target_rows;
-  e.drift = l * (x_.head(r_) - z0_);
-  const double rel = setup_.noise.drift_relative_sigma;
-  e.drift_sigma = ((l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
-                       .diagonal()
-                       .cwiseMax(0.0)
-                       .array() +
-                   (rel * e.drift.array()).square())
-                      .sqrt()
-                      .matrix();
-  if (setup_.noise.drift_sigma_scale.size() != 0)
-    e.drift_sigma.array() *= setup_.noise.drift_sigma_scale.array();
+  e.drift = setup_.target_rows * (x_.head(r_) - z0_);
+  e.drift_sigma = drift_sigma(e.drift);
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
   if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
     e.drift_sigma *= std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
@@ -411,6 +404,20 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
     e.sensor_faults = faults_.faults();
   }
   return e;
+}
+
+Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const {
+  const Eigen::MatrixXd& l = setup_.target_rows;
+  const ObserverNoise& n = setup_.noise;
+  Eigen::ArrayXd var = (l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
+                           .diagonal()
+                           .cwiseMax(0.0)
+                           .array() +
+                       (n.drift_relative_sigma * drift.array()).square();
+  if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
+  if (z_open_.size() != 0)
+    var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
+  return var.sqrt().matrix();
 }
 
 CovarianceMap KalmanObserver::advance(double t) {

@@ -50,6 +50,17 @@ struct ObserverNoise {
   /// Error of the drift rows themselves (the elastic model's discretisation, its material
   /// values), relative to the predicted drift [-]: added to the drift's variance as (e d)^2.
   double drift_relative_sigma = 0;
+  /// Error of the drift that the filter's corrections account for, relative to it [-]. The
+  /// correction d_c = L (z - z_open) is how far the estimated unknown inputs and the readings have
+  /// moved the drift from the declared model's own run (z_open: the same steps with no unknown
+  /// input and no reading). It rests on the unknown inputs' assumed shapes (heat on a source's
+  /// shape or spread over a film's surface, the air on the sinks), which an undeclared effect
+  /// need not have: added to the drift's variance as (c d_c)^2, after drift_sigma_scale (which is
+  /// calibrated where the declared model holds and the corrections are small) and before the
+  /// widening. 0: none, and z_open is not stepped. (z_open takes each step's affine map as the
+  /// filter does, at the filtered state: the same map unless the case's heat depends on
+  /// temperature.)
+  double correction_relative_sigma = 0;
   /// Per target: a factor on the reported standard deviation of the drift, calibrated on runs
   /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
   /// alarm) as it is. Empty: 1 for every target.
@@ -220,6 +231,9 @@ class KalmanObserver {
   void advance_to(double t);
   void step(double t1);
   void add_process_noise(Eigen::MatrixXd& p, double dt) const;
+  /// The drift's standard deviation at the current estimate, `drift` = L (z - z(0)): the
+  /// filter's, the drift rows' relative error, the scale, the correction's error (ObserverNoise).
+  Eigen::VectorXd drift_sigma(const Eigen::VectorXd& drift) const;
 
   const ReducedThermalSystem& sys_;
   const core::CaseSpec& spec_;
@@ -231,6 +245,7 @@ class KalmanObserver {
   Eigen::Index offsets_ = 0;             /// the sensor offsets' first index in b (-1: none)
   Eigen::VectorXd bias_walk_;            /// per bias: variance per second
   Eigen::VectorXd x_, z0_;
+  Eigen::VectorXd z_open_;  /// the declared model's own run (correction_relative_sigma > 0)
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;

@@ -432,6 +432,47 @@ TEST_F(Observer, DriftSigmaGrowsWithTheDriftRowsRelativeError) {
   EXPECT_GT(wide.drift_sigma(last, 2), plain.drift_sigma(last, 2));
 }
 
+TEST_F(Observer, CorrectionSigmaFollowsWhatTheFilterMovedFromTheDeclaredRun) {
+  // ObserverNoise::correction_relative_sigma c: sigma^2 = sigma_0^2 + (c (d - d_open))^2, d_open
+  // the declared model's own run (the observer with every reading missing and no unknown input
+  // keeps its mean there); the estimate is the same. On the run with an undeclared heat input the
+  // filter moves the drift far from the declared run, on the clean run hardly.
+  const core::CaseSpec c = run_spec();
+  const auto& sys = s_->twin.model.system;
+  solvers::ObserverNoise corr = default_noise();
+  corr.correction_relative_sigma = 0.5;
+  for (const auto* run : {&s_->clean, &s_->heat}) {
+    const solvers::ObserverRun plain =
+        solvers::observe(sys, c, setup(default_noise()), run->time, run->temperature);
+    const solvers::ObserverRun wide =
+        solvers::observe(sys, c, setup(corr), run->time, run->temperature);
+    const Eigen::MatrixXd none = Eigen::MatrixXd::Constant(
+        run->temperature.rows(), run->temperature.cols(), std::numeric_limits<double>::quiet_NaN());
+    const solvers::ObserverRun open =
+        solvers::observe(sys, c, setup(default_noise()), run->time, none);
+    EXPECT_EQ(wide.drift, plain.drift);
+    for (Eigen::Index i = 0; i < plain.times.size(); ++i)
+      for (int d = 0; d < 3; ++d) {
+        const double s0 = plain.drift_sigma(i, d);
+        const double e = 0.5 * (plain.drift(i, d) - open.drift(i, d));
+        EXPECT_NEAR(wide.drift_sigma(i, d), std::sqrt(s0 * s0 + e * e), 1e-8 * (s0 + std::abs(e)))
+            << "sample " << i << " direction " << d;
+      }
+    const Eigen::Index last = plain.times.size() - 1;
+    const double moved = std::abs(plain.drift(last, 2) - open.drift(last, 2));
+    std::cerr << (run == &s_->heat ? "heat" : "clean") << " run: dz moved " << moved * 1e6
+              << " um from the declared run, of " << std::abs(plain.drift(last, 2)) * 1e6
+              << " um\n";
+    if (run == &s_->heat)
+      EXPECT_GT(moved, 0.05 * std::abs(plain.drift(last, 2)));
+    else
+      EXPECT_LT(moved, 0.05 * std::abs(plain.drift(last, 2)));
+  }
+  solvers::ObserverSetup bad = setup(corr);
+  bad.noise.correction_relative_sigma = -1;
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
+}
+
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
   // The run sample by sample, its speed column read as it comes and two readings missing, gives
   // what the observer gives on the whole recorded run (its duty cycle from the same column).
