@@ -801,6 +801,8 @@ int main(int argc, char** argv) {
       std::cout << "correction relative sigma c: coverage dy, dz (RMS unchanged)\n";
       for (double c : grid) {
         Score cov[4];
+        Eigen::Vector2d sigma_ss[4] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
+                                       Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
         for (const Replay& rp : replays) {
           solvers::ObserverNoise n = rp.noise;
           n.widen_on_inconsistency = true;
@@ -811,11 +813,16 @@ int main(int argc, char** argv) {
               rp.time, rp.readings);
           const auto [p, sd] = dy_dz(run);
           cov[rp.set].add(p, sd, rp.truth);
+          sigma_ss[rp.set] += sd.bottomRows(sd.rows() - 1).colwise().squaredNorm().transpose();
         }
         std::cout << "  c = " << c << ":";
         for (int k = 0; k < 4; ++k)
           std::cout << " " << sets[k] << " " << fmt(100 * cov[k].coverage()(0)) << " %, "
-                    << fmt(100 * cov[k].coverage()(1)) << " %;";
+                    << fmt(100 * cov[k].coverage()(1)) << " % (RMS sigma / RMS error "
+                    << fmt((sigma_ss[k] / cov[k].n).cwiseSqrt()(0) * 1e6 / cov[k].rms_um()(0), 2)
+                    << ", "
+                    << fmt((sigma_ss[k] / cov[k].n).cwiseSqrt()(1) * 1e6 / cov[k].rms_um()(1), 2)
+                    << ");";
         std::cout << "\n";
         const double low = cov[3].coverage().minCoeff();
         if (chosen < 0 && low >= 0.95) chosen = c;
