@@ -45,6 +45,23 @@ with tempfile.TemporaryDirectory() as tmp:
     code, out = check("observe", d)
     expect(code == 0, f"a matching observer.json fails: {out}")
 
+    # A sensor found faulty: the status and the list (absent in files written before it).
+    faulty = dict(observer, status="sensor_fault",
+                  sensor_faults=[{"sensor": "T02", "offset_K": 0.6, "sigma_K": 0.05,
+                                  "since_s": 0.0, "raised_s": 900.0}])
+    (d / "observer.json").write_text(json.dumps(faulty))
+    code, out = check("observe", d)
+    expect(code == 0, f"an observer.json with a sensor fault fails: {out}")
+    faulty["sensor_faults"] = [{"sensor": "T02"}]
+    (d / "observer.json").write_text(json.dumps(faulty))
+    code, out = check("observe", d)
+    expect(code == 1 and "'offset_K' is a required property" in out,
+           f"a sensor fault without its offset passes: exit {code}: {out}")
+    faulty = dict(observer, status="sensor fault")
+    (d / "observer.json").write_text(json.dumps(faulty))
+    code, out = check("observe", d)
+    expect(code == 1, f"an unknown status passes: exit {code}")
+
     bad = dict(observer)
     del bad["status"]
     bad["sensors"] = "T02"
