@@ -157,9 +157,16 @@ void SensorFaultMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& 
   const auto n = static_cast<std::size_t>(offset.size());
   beyond_since_.resize(n, std::numeric_limits<double>::quiet_NaN());
   raised_.resize(n, false);
-  for (std::size_t k = 0; k < n; ++k) {
+  const auto beyond = [&](std::size_t k) {
     const auto i = static_cast<Eigen::Index>(k);
-    if (!(std::abs(offset(i)) > sigmas_ * sigma(i))) {
+    return std::abs(offset(i)) > sigmas_ * sigma(i);
+  };
+  // Several sensors not yet faulty beyond the bound together: heat or air read as offsets, more
+  // likely than several sensors failing at once; none of them is counted.
+  std::size_t together = 0;
+  for (std::size_t k = 0; k < n; ++k) together += !raised_[k] && beyond(k);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!beyond(k) || (together > 1 && !raised_[k])) {
       beyond_since_[k] = std::numeric_limits<double>::quiet_NaN();
       continue;
     }

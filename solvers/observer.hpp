@@ -154,7 +154,9 @@ struct SensorFault {
 };
 
 /// The test of the sensors' offsets, fed one assimilation at a time: sensor k is faulty once
-/// |offset_k| > sigmas * sigma_k has held for sustain_s (ConsistencyOptions); a fault stays raised.
+/// |offset_k| > sigmas * sigma_k has held for sustain_s (ConsistencyOptions), as the only sensor
+/// not yet faulty beyond the bound (several together are heat or air read as offsets, likelier
+/// than several sensors failing at once: their clocks restart); a fault stays raised.
 class SensorFaultMonitor {
  public:
   SensorFaultMonitor(double sigmas, double sustain_s) : sigmas_(sigmas), sustain_s_(sustain_s) {}

@@ -597,18 +597,31 @@ TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
 
 TEST(ObserverPieces, SensorFaultMonitor) {
   // Sensor 1 goes beyond 4 sigma at t = 600 s and stays: raised once at 600 + 300 s. Sensor 0
-  // crosses for less than the sustain time, twice: never raised. Sensor 2 stays within.
+  // crosses for less than the sustain time, alone (180 s): not raised; then from 1200 s, beside
+  // the faulty sensor 1, for good: raised at 1500 s. Sensor 2 stays within.
   solvers::SensorFaultMonitor m(4, 300);
   for (int k = 0; k <= 30; ++k) {
     const double t = 60.0 * k;
-    const bool blip = (k >= 3 && k <= 6) || (k >= 10 && k <= 13);  // 180 s each
-    m.add(t, Eigen::Vector3d(blip ? -0.5 : 0.1, k >= 10 ? 0.45 : 0.0, 0.39),
+    const bool beyond = (k >= 3 && k <= 6) || k >= 20;
+    m.add(t, Eigen::Vector3d(beyond ? -0.5 : 0.1, k >= 10 ? 0.45 : 0.0, 0.39),
           Eigen::Vector3d(0.1, 0.1, 0.1));
   }
-  ASSERT_EQ(m.faults().size(), 1u);
+  ASSERT_EQ(m.faults().size(), 2u);
   EXPECT_EQ(m.faults()[0].sensor, 1);
   EXPECT_DOUBLE_EQ(m.faults()[0].since_s, 600.0);
   EXPECT_DOUBLE_EQ(m.faults()[0].raised_s, 900.0);
+  EXPECT_EQ(m.faults()[1].sensor, 0);
+  EXPECT_DOUBLE_EQ(m.faults()[1].raised_s, 1500.0);
+  // Two sensors beyond together, neither faulty yet: heat or air, not two faults. One of them
+  // alone again afterwards: raised a sustain time after it is alone.
+  solvers::SensorFaultMonitor pair(4, 300);
+  for (int k = 0; k <= 30; ++k)
+    pair.add(60.0 * k, Eigen::Vector3d(0.5, k < 20 ? 0.5 : 0.0, 0.0),
+             Eigen::Vector3d::Constant(0.1));
+  ASSERT_EQ(pair.faults().size(), 1u);
+  EXPECT_EQ(pair.faults()[0].sensor, 0);
+  EXPECT_DOUBLE_EQ(pair.faults()[0].since_s, 1200.0);
+  EXPECT_DOUBLE_EQ(pair.faults()[0].raised_s, 1500.0);
   // A bound of 0: no test.
   solvers::SensorFaultMonitor off(0, 300);
   for (int k = 0; k <= 30; ++k)
