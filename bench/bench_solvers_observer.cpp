@@ -515,6 +515,7 @@ int main(int argc, char** argv) {
       Eigen::VectorXd time;
       Eigen::MatrixXd readings, truth;  // truth: dy, dz [m]
       int set = 0;
+      std::string name;
     };
     std::vector<Replay> replays;
     int held_fault_runs = 0;
@@ -538,7 +539,7 @@ int main(int argc, char** argv) {
       held.observer.add(po, so, truth, scale, sa);
       keep(po, sa, truth, 0);
       if (changed_training)
-        replays.push_back({r.spec, campaign_noise, g.time, g.temperature, truth});
+        replays.push_back({r.spec, campaign_noise, g.time, g.temperature, truth, 0, r.name});
       held_fault_runs += !run.sensor_faults.empty();
       for (const solvers::SensorFault& f : run.sensor_faults)
         std::cout << r.name << ": sensor fault " << sensors[static_cast<std::size_t>(f.sensor)]
@@ -625,7 +626,7 @@ int main(int argc, char** argv) {
                                measured.time, measured.temperature));
           changed_truth.push_back(as_targets(truth.displacement, changed_runs.back().drift.cols()));
           replays.push_back({declared, gen_noise, measured.time, measured.temperature,
-                             truth.displacement.middleCols(1, 2), 3});
+                             truth.displacement.middleCols(1, 2), 3, name + " " + kind});
           std::cout << name << ": changed-machine training run, " << kind << " "
                     << fmt(effect.magnitude) << " " << effect.target << "\n";
           continue;
@@ -669,7 +670,7 @@ int main(int argc, char** argv) {
         keep(po, sa, true_drift, effect.present ? 2 : 1);
         if (changed_training)
           replays.push_back({declared, gen_noise, measured.time, measured.temperature, true_drift,
-                             effect.present ? 2 : 1});
+                             effect.present ? 2 : 1, name + " " + kind});
         (effect.present ? effect_fault_runs : clean_fault_runs) += !run.sensor_faults.empty();
         if (!effect.present) clean_fault_hours += gen_hours;
         for (const solvers::SensorFault& f : run.sensor_faults)
@@ -813,6 +814,13 @@ int main(int argc, char** argv) {
               rp.time, rp.readings);
           const auto [p, sd] = dy_dz(run);
           cov[rp.set].add(p, sd, rp.truth);
+          if (rp.set >= 2 && (c == 1 || c == 4)) {  // per run, where an effect acts
+            Score one;
+            one.add(p, sd, rp.truth);
+            std::cout << "    c = " << c << " " << rp.name << (rp.set == 3 ? " (changed)" : "")
+                      << ": " << fmt(100 * one.coverage()(0)) << " %, "
+                      << fmt(100 * one.coverage()(1)) << " %\n";
+          }
           sigma_ss[rp.set] += sd.bottomRows(sd.rows() - 1).colwise().squaredNorm().transpose();
         }
         std::cout << "  c = " << c << ":";
