@@ -17,12 +17,12 @@ namespace tt::app {
 /// --sensors, --sensor-sigma-k, --heat-walk-w, --heat-initial-w, --air-walk-k, --air-initial-k,
 /// --state-walk-k, --sensor-offset-k, --sensor-offset-walk-k, --drift-relative-sigma,
 /// --correction-relative-sigma, --drift-sigma-scale, --widen-on-inconsistency, --window-s,
-/// --sustain-s, --probability,
-/// --sensor-fault-sigmas on `command`.
+/// --sustain-s, --probability, --sensor-fault-sigmas on `command`.
 void add_observer_options(CLI::App& command, ObserverOptions& options);
 
 /// The consistency test's and the sensor-fault test's options (--window-s, --sustain-s,
-/// --probability, --sensor-fault-sigmas), a part of add_observer_options.
+/// --probability, --sensor-fault-sigmas) and --widen-on-inconsistency, which widens by that
+/// test's window; a part of add_observer_options.
 void add_consistency_options(CLI::App& command, ObserverOptions& options);
 
 /// The set-up on `twin` for `sensors` (ids): the noise and the consistency test of `options`.

@@ -408,7 +408,6 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   if (offsets_ >= 0) {
     const Eigen::Index o = r_ + offsets_;
     faults_.add(t, x_.segment(o, m), p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt());
-    e.sensor_faults = faults_.faults();
   }
   return e;
 }

@@ -183,9 +183,6 @@ struct ObserverEstimate {
   int dof = 0;                  /// readings used
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
-  /// Sensors found faulty so far (an offset beyond ConsistencyOptions::sensor_fault_sigmas),
-  /// in the order they were raised; empty without offset states.
-  std::vector<SensorFault> sensor_faults;
 };
 
 /// How the filter's covariance goes from one time to a later one with no reading between:
@@ -226,7 +223,8 @@ class KalmanObserver {
   std::vector<UnknownInputKind> unknown_input_kinds() const;
   Eigen::Index states() const { return r_; }
   const InnovationMonitor& monitor() const { return monitor_; }
-  /// The sensors found faulty so far (empty without offset states).
+  /// The sensors found faulty so far (an offset beyond ConsistencyOptions::sensor_fault_sigmas),
+  /// in the order they were raised; empty without offset states.
   const std::vector<SensorFault>& sensor_faults() const { return faults_.faults(); }
 
  private:

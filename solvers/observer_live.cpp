@@ -71,9 +71,10 @@ const core::LiveStep& LiveObserver::next(double time,
   step_.predicted = e.drift;
   step_.sigma = e.drift_sigma;
   step_.recalibrate = e.recalibrate;
-  step_.faulty.clear();
-  for (const SensorFault& f : e.sensor_faults)
-    step_.faulty.push_back(sensor_columns_[static_cast<std::size_t>(f.sensor)]);
+  // Faults are only ever added: map the new ones to their columns.
+  const std::vector<SensorFault>& faults = filter_->sensor_faults();
+  for (std::size_t k = step_.faulty.size(); k < faults.size(); ++k)
+    step_.faulty.push_back(sensor_columns_[static_cast<std::size_t>(faults[k].sensor)]);
   step_.status = step_.held.empty() ? core::SampleStatus::ok : core::SampleStatus::held;
   return step_;
 }
