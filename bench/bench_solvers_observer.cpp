@@ -494,19 +494,6 @@ int main(int argc, char** argv) {
                                     : std::string("none"))
                 << "\n";
     };
-    // Per scored run (0: campaign held out, 1: generator clean, 2: generator effect), its
-    // prediction, widened sigma at scale 1 and truth (dy, dz): CHANGED_TRAINING's coverage.
-    struct Scored {
-      Eigen::MatrixXd predicted, widened, truth;
-      int set = 0;
-    };
-    std::vector<Scored> scored;
-    const auto keep = [&](const Eigen::MatrixXd& p, const Eigen::MatrixXd& adapted,
-                          const Eigen::MatrixXd& truth, int set) {
-      Scored sc{p, adapted, truth, set};
-      for (int d = 0; d < 2; ++d) sc.widened.col(d) /= adapted_noise.drift_sigma_scale(1 + d);
-      scored.push_back(std::move(sc));
-    };
     // CHANGED_TRAINING's correction term (ObserverNoise::correction_relative_sigma): every run
     // kept to be observed again (sets 0-2 as above, 3: the changed-machine training runs).
     struct Replay {
@@ -537,7 +524,6 @@ int main(int argc, char** argv) {
       const auto [pr, sr] = regression_on(reg, g);
       rr.add(pr, sr, truth);
       held.observer.add(po, so, truth, scale, sa);
-      keep(po, sa, truth, 0);
       if (changed_training)
         replays.push_back({r.spec, campaign_noise, g.time, g.temperature, truth, 0, r.name});
       held_fault_runs += !run.sensor_faults.empty();
@@ -561,8 +547,7 @@ int main(int argc, char** argv) {
     Eigen::Vector2d own_scale = Eigen::Vector2d::Ones();
     std::size_t effect_runs = 0;
     // CHANGED_TRAINING: the changed-machine training runs (observed with the widening, scale 1)
-    // and their truths; per scored generator run, its prediction, widened sigma at scale 1 and
-    // truth (dy, dz), and whether it has an effect.
+    // and their truths.
     std::vector<solvers::ObserverRun> changed_runs;
     std::vector<Eigen::MatrixXd> changed_truth;
     // Sensor faults (the offsets' test, solvers::SensorFaultMonitor): runs that raised one.
@@ -667,7 +652,6 @@ int main(int argc, char** argv) {
         const Eigen::MatrixXd sa =
             adapted_sigma(declared, gen_noise, measured.time, measured.temperature);
         o.add(po, so, true_drift, scale, sa);
-        keep(po, sa, true_drift, effect.present ? 2 : 1);
         if (changed_training)
           replays.push_back({declared, gen_noise, measured.time, measured.temperature, true_drift,
                              effect.present ? 2 : 1, name + " " + kind});
@@ -769,27 +753,6 @@ int main(int argc, char** argv) {
              "coverage "
           << fmt(100 * geffect_own.coverage_calibrated()(0)) << " %, "
           << fmt(100 * geffect_own.coverage_calibrated()(1)) << " %\n";
-    if (!changed_runs.empty()) {
-      // The quantile factor on the campaign's training runs and the changed-machine runs together.
-      std::vector<solvers::ObserverRun> both = adapted_training;
-      std::vector<Eigen::MatrixXd> both_truth = training_truth;
-      both.insert(both.end(), changed_runs.begin(), changed_runs.end());
-      both_truth.insert(both_truth.end(), changed_truth.begin(), changed_truth.end());
-      const Eigen::VectorXd f = solvers::drift_sigma_coverage_calibration(both, both_truth);
-      Score cov[3];
-      for (const Scored& sc : scored)
-        cov[sc.set].add(sc.predicted, sc.widened, sc.truth, Eigen::Vector2d(f(1), f(2)));
-      std::cout << "calibrated with changed runs (" << changed_runs.size()
-                << " changed-machine runs + the campaign's " << adapted_training.size()
-                << " training runs): factor dy " << fmt(f(1)) << ", dz " << fmt(f(2))
-                << " (campaign alone " << fmt(adapted_noise.drift_sigma_scale(1)) << ", "
-                << fmt(adapted_noise.drift_sigma_scale(2)) << "); coverage:";
-      const char* sets[] = {"campaign held out", "generator clean", "generator effect runs"};
-      for (int k = 0; k < 3; ++k)
-        std::cout << " " << sets[k] << " " << fmt(100 * cov[k].coverage_calibrated()(0)) << " %, "
-                  << fmt(100 * cov[k].coverage_calibrated()(1)) << " %;";
-      std::cout << "\n";
-    }
     if (!replays.empty()) {
       // The correction's relative sigma c (ObserverNoise::correction_relative_sigma) on top of the
       // adapted sigma (widening, the campaign's quantile factor). Rule fixed before scoring: the
@@ -798,6 +761,16 @@ int main(int argc, char** argv) {
       const double grid[] = {0, 0.25, 0.5, 1, 2, 4};
       const char* sets[] = {"campaign held out", "generator clean", "generator effect runs",
                             "changed-machine training runs"};
+      // One quantile factor on the campaign's training runs and the changed-machine runs
+      // together, in place of the campaign's: scored from the c = 0 pass (the adapted sigma).
+      std::vector<solvers::ObserverRun> both = adapted_training;
+      std::vector<Eigen::MatrixXd> both_truth = training_truth;
+      both.insert(both.end(), changed_runs.begin(), changed_runs.end());
+      both_truth.insert(both_truth.end(), changed_truth.begin(), changed_truth.end());
+      const Eigen::VectorXd f = solvers::drift_sigma_coverage_calibration(both, both_truth);
+      const Eigen::Vector2d f_over_campaign =
+          f.segment(1, 2).cwiseQuotient(adapted_noise.drift_sigma_scale.segment(1, 2));
+      Score single[3];
       double chosen = -1, best = -1, best_c = 0;
       std::cout << "correction relative sigma c: coverage dy, dz (RMS unchanged)\n";
       for (double c : grid) {
@@ -814,6 +787,7 @@ int main(int argc, char** argv) {
               rp.time, rp.readings);
           const auto [p, sd] = dy_dz(run);
           cov[rp.set].add(p, sd, rp.truth);
+          if (c == 0 && rp.set < 3) single[rp.set].add(p, sd, rp.truth, f_over_campaign);
           if (rp.set >= 2 && (c == 1 || c == 4)) {  // per run, where an effect acts
             Score one;
             one.add(p, sd, rp.truth);
@@ -836,6 +810,15 @@ int main(int argc, char** argv) {
         if (chosen < 0 && low >= 0.95) chosen = c;
         if (low > best) best = low, best_c = c;
       }
+      std::cout << "calibrated with changed runs (" << changed_runs.size()
+                << " changed-machine runs + the campaign's " << adapted_training.size()
+                << " training runs): factor dy " << fmt(f(1)) << ", dz " << fmt(f(2))
+                << " (campaign alone " << fmt(adapted_noise.drift_sigma_scale(1)) << ", "
+                << fmt(adapted_noise.drift_sigma_scale(2)) << "); coverage:";
+      for (int k = 0; k < 3; ++k)
+        std::cout << " " << sets[k] << " " << fmt(100 * single[k].coverage_calibrated()(0))
+                  << " %, " << fmt(100 * single[k].coverage_calibrated()(1)) << " %;";
+      std::cout << "\n";
       std::cout << "correction relative sigma chosen on the changed-machine training runs: c = "
                 << (chosen >= 0 ? chosen : best_c) << "\n";
     }
