@@ -79,6 +79,12 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "it, added after --drift-sigma-scale (default 0: none)")
       ->check(non_negative_number());
   command
+      .add_option("--expansion-relative-sigma", o.expansion_relative_sigma,
+                  "error of each material's expansion coefficient relative to its declared "
+                  "value, the materials independent: adds each material's part of the drift "
+                  "times it, after --drift-sigma-scale (default 0: none)")
+      ->check(non_negative_number());
+  command
       .add_option("--drift-sigma-scale", o.drift_sigma_scale,
                   "factor on the reported drift sigma, calibrated on training runs: one value for "
                   "all targets or one per target, comma-separated (default 1)")
@@ -127,6 +133,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.sensor_offset_walk_k = o.sensor_offset_walk_k;
   noise.drift_relative_sigma = o.drift_relative_sigma;
   noise.correction_relative_sigma = o.correction_relative_sigma;
+  noise.expansion_relative_sigma = o.expansion_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
   solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
   if (!o.drift_sigma_scale.empty())
@@ -154,6 +161,7 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
           {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
           {"drift_relative_sigma", n.drift_relative_sigma},
           {"correction_relative_sigma", n.correction_relative_sigma},
+          {"expansion_relative_sigma", n.expansion_relative_sigma},
           {"drift_sigma_scale", as_vector(scale)},
           {"widen_on_inconsistency", n.widen_on_inconsistency}};
 }

@@ -152,6 +152,8 @@ void write_reduced_model(const fs::path& dir, const ReducedModelFile& f) {
   put(w, "uniform", column(s.uniform));
   put(w, "basis", f.twin.model.basis);
   put(w, "outputs", out.rows);
+  for (std::size_t k = 0; k < out.expansion.size(); ++k)
+    put(w, indexed("expansion", k), out.expansion[k]);
   for (std::size_t k = 0; k < s.film.size(); ++k) {
     put(w, indexed("film", k), s.film[k]);
     put(w, indexed("film_area", k), column(s.film_area[k]));
@@ -189,7 +191,8 @@ void write_reduced_model(const fs::path& dir, const ReducedModelFile& f) {
                   {"temperatures", out.temperatures},
                   {"tcp", out.tcp},
                   {"reference_K", out.reference_k},
-                  {"probe_distance_m", out.probe_distance}};
+                  {"probe_distance_m", out.probe_distance},
+                  {"expansion_materials", out.materials}};
   const auto& st = f.twin.model.stats;
   j["basis"] = {{"method", "block rational Krylov (moment matching), capacity-orthonormal"},
                 {"shifts_per_s", st.shifts_per_s},
@@ -232,6 +235,7 @@ nlohmann::json read_header(const fs::path& json_file, ReducedModelFile& f) {
   out.tcp = jo.value("tcp", false);
   out.reference_k = jo.value("reference_K", 0.0);
   out.probe_distance = jo.value("probe_distance_m", 0.0);
+  out.materials = jo.value("expansion_materials", std::vector<std::string>{});
   if (out.temperatures < 0 || static_cast<std::size_t>(out.temperatures) > out.names.size() ||
       (out.tcp && static_cast<std::size_t>(out.temperatures) + 9 > out.names.size()))
     throw core::DataError(json_file.string() + ": outputs: " + std::to_string(out.temperatures) +
@@ -303,8 +307,10 @@ ReducedModelFile read_reduced_model(const fs::path& dir) {
   s.capacity = m.need("capacity", r, r);
   s.conduction = m.need("conduction", r, r);
   s.uniform = m.need("uniform", r, 1);
-  f.twin.outputs.rows =
-      m.need("outputs", static_cast<Eigen::Index>(f.twin.outputs.names.size()), r);
+  auto& out = f.twin.outputs;
+  out.rows = m.need("outputs", static_cast<Eigen::Index>(out.names.size()), r);
+  for (std::size_t k = 0; k < out.materials.size(); ++k)
+    out.expansion.push_back(m.need(indexed("expansion", k), out.rows.rows() - out.temperatures, r));
   for (std::size_t k = 0, n = count_of(j, "films", json_file); k < n; ++k) {
     s.film.push_back(m.need(indexed("film", k), r, r));
     s.film_area.push_back(m.need(indexed("film_area", k), r, 1));

@@ -256,7 +256,7 @@ Eigen::VectorXd ElasticModel::influence(int node, int direction) const {
   return influence_rows({{node, direction}}).row(0).transpose();
 }
 
-Eigen::MatrixXd ElasticModel::influence_rows(
+Eigen::SparseMatrix<double> ElasticModel::unit_functionals(
     const std::vector<std::pair<int, int>>& node_directions) const {
   std::vector<Eigen::Triplet<double>> unit;
   for (const auto& [node, direction] : node_directions) {
@@ -268,7 +268,12 @@ Eigen::MatrixXd ElasticModel::influence_rows(
   }
   Eigen::SparseMatrix<double> f(static_cast<Eigen::Index>(unit.size()), impl_->coupling.rows());
   f.setFromTriplets(unit.begin(), unit.end());
-  return influence_rows(f);
+  return f;
+}
+
+Eigen::MatrixXd ElasticModel::influence_rows(
+    const std::vector<std::pair<int, int>>& node_directions) const {
+  return influence_rows(unit_functionals(node_directions));
 }
 
 Eigen::MatrixXd ElasticModel::adjoint_solutions(
@@ -294,15 +299,27 @@ Eigen::MatrixXd ElasticModel::influence_rows(const Eigen::SparseMatrix<double>& 
   return (impl_->coupling.transpose() * adjoint_solutions(functionals)).transpose();
 }
 
-std::vector<Eigen::MatrixXd> ElasticModel::influence_rows_by_material(
-    const Eigen::SparseMatrix<double>& functionals, const mesh::TetMesh& mesh,
-    const core::CaseSpec& spec) const {
+std::vector<Eigen::MatrixXd> ElasticModel::split_by_material(const Eigen::MatrixXd& w,
+                                                             const mesh::TetMesh& mesh,
+                                                             const core::CaseSpec& spec) const {
   if (mesh.nodes.rows() != impl_->coupling.cols())
     throw core::SolverError("influence rows by material: the mesh has " +
                             std::to_string(mesh.nodes.rows()) + " nodes, the model " +
                             std::to_string(impl_->coupling.cols()));
-  const Eigen::MatrixXd w = adjoint_solutions(functionals);
   return mesh.order == 1 ? rows_by_material<4>(mesh, spec, w) : rows_by_material<10>(mesh, spec, w);
+}
+
+std::vector<Eigen::MatrixXd> ElasticModel::influence_rows_by_material(
+    const Eigen::SparseMatrix<double>& functionals, const mesh::TetMesh& mesh,
+    const core::CaseSpec& spec) const {
+  return split_by_material(adjoint_solutions(functionals), mesh, spec);
+}
+
+ElasticModel::SplitRows ElasticModel::influence_rows_split(
+    const std::vector<std::pair<int, int>>& node_directions, const mesh::TetMesh& mesh,
+    const core::CaseSpec& spec) const {
+  const Eigen::MatrixXd w = adjoint_solutions(unit_functionals(node_directions));
+  return {(impl_->coupling.transpose() * w).transpose(), split_by_material(w, mesh, spec)};
 }
 
 ElasticHistory elastic_history(const mesh::TetMesh& m, const core::CaseSpec& spec,

@@ -52,6 +52,13 @@ class ElasticModel {
   std::vector<Eigen::MatrixXd> influence_rows_by_material(
       const Eigen::SparseMatrix<double>& functionals, const mesh::TetMesh& mesh,
       const core::CaseSpec& spec) const;
+  /// influence_rows and influence_rows_by_material from one block solve.
+  struct SplitRows {
+    Eigen::MatrixXd rows;                      /// influence_rows
+    std::vector<Eigen::MatrixXd> by_material;  /// influence_rows_by_material
+  };
+  SplitRows influence_rows_split(const std::vector<std::pair<int, int>>& node_directions,
+                                 const mesh::TetMesh& mesh, const core::CaseSpec& spec) const;
   double reference_temperature_k() const { return reference_k_; }
   const ElasticTimings& timings() const { return timings_; }
 
@@ -59,6 +66,14 @@ class ElasticModel {
   struct Impl;
   /// K^-1 f^T on the free dofs, scattered to all dofs (held ones 0): 3 #nodes x #rows.
   Eigen::MatrixXd adjoint_solutions(const Eigen::SparseMatrix<double>& functionals) const;
+  /// The unit functionals of (node, direction) pairs: #pairs x 3 #nodes; SolverError when a
+  /// node or direction is out of range.
+  Eigen::SparseMatrix<double> unit_functionals(
+      const std::vector<std::pair<int, int>>& node_directions) const;
+  /// rows_by_material on the adjoint solutions w, the mesh checked to be the model's.
+  std::vector<Eigen::MatrixXd> split_by_material(const Eigen::MatrixXd& w,
+                                                 const mesh::TetMesh& mesh,
+                                                 const core::CaseSpec& spec) const;
   std::unique_ptr<Impl> impl_;
   double reference_k_ = 0;
   ElasticTimings timings_;

@@ -51,6 +51,22 @@ Eigen::MatrixXd unknown_heat_columns(const ReducedThermalSystem& system, const c
   return columns;
 }
 
+/// ObserverNoise::expansion_relative_sigma needs the per-material target rows, of the target
+/// rows' shape: SolverError otherwise.
+void check_expansion_rows(const ObserverSetup& s) {
+  if (s.target_expansion.empty())
+    throw core::SolverError(
+        "observer: an expansion relative sigma needs the drift rows per material, which this "
+        "reduced model does not keep (written before they were); rebuild it with `thermotwin "
+        "reduce`");
+  for (const Eigen::MatrixXd& part : s.target_expansion)
+    if (part.rows() != s.target_rows.rows() || part.cols() != s.target_rows.cols())
+      throw core::SolverError("observer: drift rows per material of " +
+                              std::to_string(part.rows()) + " x " + std::to_string(part.cols()) +
+                              ", the target rows " + std::to_string(s.target_rows.rows()) + " x " +
+                              std::to_string(s.target_rows.cols()));
+}
+
 }  // namespace
 
 std::vector<int> air_entries(const core::CaseSpec& spec) {
@@ -86,14 +102,18 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
   }
   const Eigen::Index first = out.temperatures;
   const Eigen::Index axis = static_cast<Eigen::Index>(out.names.size()) - first - 9;
-  s.target_rows.resize(3 + axis, out.rows.cols());
-  s.target_rows.topRows(3) = out.rows.middleRows(first, 3);
+  // The TCP's three rows and the axis points' (after the two probes' six).
+  const auto targets = [&](const Eigen::MatrixXd& displacement_rows) {
+    Eigen::MatrixXd t(3 + axis, displacement_rows.cols());
+    t.topRows(3) = displacement_rows.topRows(3);
+    t.bottomRows(axis) = displacement_rows.bottomRows(axis);
+    return t;
+  };
+  s.target_rows = targets(out.rows.bottomRows(out.rows.rows() - first));
+  for (const Eigen::MatrixXd& part : out.expansion) s.target_expansion.push_back(targets(part));
   s.target_names.assign(std::begin(core::kDirectionNames), std::end(core::kDirectionNames));
-  if (axis > 0) {
-    s.target_rows.bottomRows(axis) = out.rows.bottomRows(axis);
-    for (Eigen::Index k = 0; k < axis; ++k)
-      s.target_names.push_back(out.names[static_cast<std::size_t>(first + 9 + k)]);
-  }
+  for (Eigen::Index k = 0; k < axis; ++k)
+    s.target_names.push_back(out.names[static_cast<std::size_t>(first + 9 + k)]);
   s.air_entries = air_entries(spec);
   s.sensor_names = sensors;
   s.noise = noise;
@@ -203,12 +223,13 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
   const ObserverNoise& n = setup_.noise;
   for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
                    n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k,
-                   n.correction_relative_sigma})
+                   n.correction_relative_sigma, n.expansion_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
   const double fault = setup_.consistency.sensor_fault_sigmas;
   if (!(fault >= 0) || !std::isfinite(fault))
     fail("sensor fault bound " + number(fault) + " sigma: expected a finite value >= 0");
+  if (n.expansion_relative_sigma > 0) check_expansion_rows(setup_);
   const Eigen::VectorXd& scale = n.drift_sigma_scale;
   if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
                             !(scale.array() > 0).all() || !scale.allFinite()))
@@ -423,6 +444,9 @@ Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const 
   if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
   if (z_open_.size() != 0)
     var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
+  if (n.expansion_relative_sigma > 0)
+    for (const Eigen::MatrixXd& part : setup_.target_expansion)
+      var += (n.expansion_relative_sigma * (part * (x_.head(r_) - z0_)).array()).square();
   return var.sqrt().matrix();
 }
 

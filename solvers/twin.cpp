@@ -62,9 +62,11 @@ TwinOutputs full_outputs(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
         dofs.emplace_back(node, d);
       }
     }
-    const Eigen::MatrixXd influence = elastic->influence_rows(dofs);
-    for (Eigen::Index i = 0; i < influence.rows(); ++i)
-      rows.push_back(influence.row(i).transpose());
+    ElasticModel::SplitRows influence = elastic->influence_rows_split(dofs, mesh, spec);
+    for (Eigen::Index i = 0; i < influence.rows.rows(); ++i)
+      rows.push_back(influence.rows.row(i).transpose());
+    out.expansion = std::move(influence.by_material);
+    for (const core::Material& m : spec.materials) out.materials.push_back(m.name);
   }
   out.rows.resize(static_cast<Eigen::Index>(rows.size()), n);
   for (std::size_t i = 0; i < rows.size(); ++i)
@@ -79,6 +81,7 @@ TwinOutputs projected_outputs(const TwinOutputs& full, const Eigen::MatrixXd& ba
                             " rows: built for another mesh");
   TwinOutputs out = full;
   out.rows = full.rows * basis;
+  for (Eigen::MatrixXd& part : out.expansion) part = part * basis;
   return out;
 }
 

@@ -26,6 +26,12 @@ struct TwinOutputs {
   bool tcp = false;                /// rows [temperatures, temperatures + 9) are the TCP and probes
   double reference_k = 0;          /// stress-free temperature [K]
   double probe_distance = 0;       /// between the two probe points [m]
+  /// With tcp, per material of the case (its order; `materials` their names): the part of the
+  /// displacement rows (rows [temperatures, #names)) that material's thermal strain makes, so that
+  /// its expansion coefficient times (1 + x) adds x times it. The entries sum to those rows. Empty
+  /// without tcp (and in reduced models written before they were kept).
+  std::vector<Eigen::MatrixXd> expansion;
+  std::vector<std::string> materials;
 };
 
 /// The case's outputs on the full mesh: every named point's temperature, and with `elastic` (the

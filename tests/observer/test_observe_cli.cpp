@@ -111,6 +111,30 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(jo["sensor_faults"][0]["since_s"].get<double>(), 900.0);
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", with_offsets));
   EXPECT_TRUE(j["sensor_faults"].empty());  // without offset states no offset test
+  // Each material's expansion error widens the drift's sigma and leaves the prediction.
+  const fs::path expansion = dir / "expansion";
+  std::vector<std::string> expansion_args = observe_args;
+  expansion_args[7] = expansion.string();
+  expansion_args.insert(expansion_args.end(), {"--expansion-relative-sigma", "0.15"});
+  ASSERT_EQ(rt::run(expansion_args, {}, log), 0) << rt::read_text(log);
+  const auto je = nlohmann::json::parse(std::ifstream(expansion / "observer.json"));
+  EXPECT_EQ(je["noise"]["expansion_relative_sigma"], 0.15);
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", expansion));
+  const auto last_row = [](const fs::path& f) {
+    const std::string text = rt::read_text(f);
+    const auto end = text.find_last_not_of('\n');
+    std::vector<double> v;
+    std::stringstream row(text.substr(text.rfind('\n', end) + 1, end - text.rfind('\n', end)));
+    for (std::string cell; std::getline(row, cell, ',') && v.size() < 7;)
+      v.push_back(std::stod(cell));
+    return v;  // time, dx, sigma, dy, sigma, dz, sigma
+  };
+  const std::vector<double> narrow = last_row(with_offsets / "observer.csv"),
+                            wide = last_row(expansion / "observer.csv");
+  ASSERT_EQ(narrow.size(), 7u);
+  ASSERT_EQ(wide.size(), 7u);
+  EXPECT_EQ(wide[5], narrow[5]);                             // dz predicted
+  EXPECT_GT(wide[6], narrow[6] + 0.05 * std::abs(wide[5]));  // dz sigma: 0.15 of its parts
   // 3. The recorded run streamed through compensate --rom: the offline observer's figures.
   const io::MeasuredRun measured = io::read_measured_run(data);
   const fs::path live = dir / "live.csv", live_log = dir / "live.log";
@@ -205,9 +229,10 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
   for (const char* command : {"observe", "compensate"}) {
     ASSERT_EQ(rt::run({command, "--help"}, {}, log), 0) << rt::read_text(log);
     const std::string help = rt::read_text(log);
-    for (const char* flag : {"--sensor-offset-k", "--sensor-offset-walk-k",
-                             "--widen-on-inconsistency", "--heat-initial-w", "--air-initial-k",
-                             "--state-walk-k", "--drift-sigma-scale", "--sensor-fault-sigmas"})
+    for (const char* flag :
+         {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
+          "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale",
+          "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
@@ -219,6 +244,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
        "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
       {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},
       {{"--sensor-fault-sigmas", "-1"}, "--sensor-fault-sigmas: -1: expected a finite number >= 0"},
+      {{"--expansion-relative-sigma", "-0.1"},
+       "--expansion-relative-sigma: -0.1: expected a finite number >= 0"},
       {{"--widen-on-inconsistency=maybe"}, "--widen-on-inconsistency"}};
   for (const auto& [flags, message] : bad) {
     std::vector<std::string> args = base;

@@ -473,6 +473,67 @@ TEST_F(Observer, CorrectionSigmaFollowsWhatTheFilterMovedFromTheDeclaredRun) {
   EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
 }
 
+TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
+  // ObserverNoise::expansion_relative_sigma e: sigma^2 = sigma_0^2 + sum_m (e d_m)^2, d_m the
+  // part of the drift material m's thermal strain makes. Checked against the full-order model:
+  // truth runs (the generator on the case's own mesh) with one material's expansion coefficient
+  // 10 % up move the drift by 0.1 d_m and no temperature; the observer reads the clean truth.
+  const core::CaseSpec c = run_spec();
+  calibration::GeneratorOptions g;
+  g.mesh_scale = 1;
+  g.step_s = s_->spec.thermal.step;
+  const core::CaseSpec gen = calibration::generator_case(s_->spec, g);
+  calibration::Instrumentation inst;
+  inst.sensor_points = kSensors;
+  const Eigen::MatrixXd clean = s_->clean_truth.displacement.leftCols(3);
+  Eigen::MatrixXd sum_squares = Eigen::MatrixXd::Zero(clean.rows(), 3);
+  for (std::size_t m = 0; m < s_->spec.materials.size(); ++m) {
+    calibration::InjectedEffect e;
+    e.present = true;
+    e.kind = calibration::EffectKind::material_parameter;
+    e.target = s_->spec.materials[m].name + ".expansion";
+    e.magnitude = 0.1;
+    const io::MeasuredRun run = calibration::clean_run(
+        s_->mesh, calibration::truth_case(gen, e, s_->duty, 2), e, inst, g, "expansion");
+    EXPECT_LT((run.temperature - s_->clean_truth.temperature).cwiseAbs().maxCoeff(), 1e-9);
+    Eigen::MatrixXd part = (run.displacement.leftCols(3) - clean) / 0.1;
+    part.rowwise() -= part.row(0);  // the drift: from t = 0
+    sum_squares += part.cwiseAbs2();
+  }
+  const auto& sys = s_->twin.model.system;
+  solvers::ObserverNoise wide = default_noise();
+  wide.expansion_relative_sigma = 0.2;
+  const solvers::ObserverRun plain =
+      solvers::observe(sys, c, setup(default_noise()), s_->clean.time, s_->clean_truth.temperature);
+  const solvers::ObserverRun with =
+      solvers::observe(sys, c, setup(wide), s_->clean.time, s_->clean_truth.temperature);
+  EXPECT_EQ(with.drift, plain.drift);
+  ASSERT_EQ(with.times.size(), sum_squares.rows());
+  const Eigen::ArrayXXd added = (with.drift_sigma.leftCols(3).array().square() -
+                                 plain.drift_sigma.leftCols(3).array().square())
+                                    .cwiseMax(0.0)
+                                    .sqrt();
+  const Eigen::ArrayXXd expected = 0.2 * sum_squares.array().sqrt();
+  for (int d = 0; d < 3; ++d) {
+    const double peak = expected.col(d).maxCoeff();
+    std::cerr << "direction " << d << ": added sigma at the end "
+              << added(added.rows() - 1, d) * 1e6 << " um, full order "
+              << expected(expected.rows() - 1, d) * 1e6 << " um, peak " << peak * 1e6
+              << " um, worst difference " << (added.col(d) - expected.col(d)).abs().maxCoeff() * 1e6
+              << " um\n";
+    if (d > 0) EXPECT_GT(peak, 0.5e-6) << "direction " << d;  // dx: the plane of symmetry
+    EXPECT_LT((added.col(d) - expected.col(d)).abs().maxCoeff(), 1e-3 * peak + 1e-10)
+        << "direction " << d;
+  }
+  // Without the rows per material (a model written before they were kept) it is refused.
+  solvers::ObserverSetup old = setup(wide);
+  old.target_expansion.clear();
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, old), core::SolverError);
+  old = setup(wide);
+  old.noise.expansion_relative_sigma = -0.1;
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, old), core::SolverError);
+}
+
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
   // The run sample by sample, its speed column read as it comes and two readings missing, gives
   // what the observer gives on the whole recorded run (its duty cycle from the same column).

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/case_reader.hpp"
+#include "io/reduced_model_io.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/campaign.hpp"
 #include "solvers/twin.hpp"
@@ -53,6 +54,26 @@ TEST_F(Twin, ReduceWritesAModelItsValidationPasses) {
   EXPECT_LE(v["max_temperature_error_K"].get<double>(), 0.01);
   EXPECT_TRUE(fs::exists(rom_ / "validation.csv"));
   EXPECT_TRUE(tt::test::matches_output_schemas("reduce", rom_));
+}
+
+TEST_F(Twin, ReducedModelKeepsTheDriftRowsPerMaterial) {
+  // reduced_model.bin keeps each material's part of the displacement rows (expansion_<k>, for the
+  // observer's expansion sigma); the parts sum to the rows.
+  const io::ReducedModelFile f = io::read_reduced_model(rom_);
+  const solvers::TwinOutputs& out = f.twin.outputs;
+  const core::CaseSpec spec = io::read_case(rt::kCoarseCase);
+  ASSERT_EQ(out.materials.size(), spec.materials.size());
+  ASSERT_EQ(out.expansion.size(), spec.materials.size());
+  const Eigen::MatrixXd rows = out.rows.bottomRows(out.rows.rows() - out.temperatures);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(rows.rows(), rows.cols());
+  for (std::size_t m = 0; m < out.expansion.size(); ++m) {
+    EXPECT_EQ(out.materials[m], spec.materials[m].name);
+    ASSERT_EQ(out.expansion[m].rows(), rows.rows());
+    ASSERT_EQ(out.expansion[m].cols(), rows.cols());
+    EXPECT_GT(out.expansion[m].norm(), 1e-3 * rows.norm()) << out.materials[m];
+    sum += out.expansion[m];
+  }
+  EXPECT_LT((sum - rows).norm(), 1e-10 * rows.norm());
 }
 
 TEST_F(Twin, RunFromTheReducedModelMatchesTheFullRun) {
