@@ -56,6 +56,7 @@
 //    given the declared case and the run's duty cycle only. The effect runs' coverage also with
 //    the sigma calibrated on the generator's clean runs (the machine's own runs before it changed).
 // Prints one line per run and the totals.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -612,7 +613,8 @@ int main(int argc, char** argv) {
                                measured.time, measured.temperature));
           changed_truth.push_back(as_targets(truth.displacement, changed_runs.back().drift.cols()));
           replays.push_back({declared, gen_noise, measured.time, measured.temperature,
-                             truth.displacement.middleCols(1, 2), 3, name + " " + kind});
+                             truth.displacement.middleCols(1, 2), 3,
+                             name + " " + kind + " " + effect.target});
           std::cout << name << ": changed-machine training run, " << kind << " "
                     << fmt(effect.magnitude) << " " << effect.target << "\n";
           continue;
@@ -655,7 +657,8 @@ int main(int argc, char** argv) {
         o.add(po, so, true_drift, scale, sa);
         if (changed_training)
           replays.push_back({declared, gen_noise, measured.time, measured.temperature, true_drift,
-                             effect.present ? 2 : 1, name + " " + kind});
+                             effect.present ? 2 : 1,
+                             name + " " + kind + (effect.present ? " " + effect.target : "")});
         (effect.present ? effect_fault_runs : clean_fault_runs) += !run.sensor_faults.empty();
         if (!effect.present) clean_fault_hours += gen_hours;
         for (const solvers::SensorFault& f : run.sensor_faults)
@@ -762,8 +765,10 @@ int main(int argc, char** argv) {
       const double grid[] = {0, 0.25, 0.5, 1, 2, 4};
       // Each material's expansion error e (ObserverNoise::expansion_relative_sigma), beside c.
       const double expansion_grid[] = {0, 0.05, 0.1, 0.15, 0.2, 0.3};
+      // Set 4: the scored effect runs without those of a wrong expansion coefficient (which
+      // changes no temperature: no term but e can see it).
       const char* sets[] = {"campaign held out", "generator clean", "generator effect runs",
-                            "changed-machine training runs"};
+                            "changed-machine training runs", "effect runs but expansion"};
       // One quantile factor on the campaign's training runs and the changed-machine runs
       // together, in place of the campaign's: scored from the c = 0 pass (the adapted sigma).
       std::vector<solvers::ObserverRun> both = adapted_training;
@@ -787,9 +792,9 @@ int main(int argc, char** argv) {
                    "(RMS unchanged)\n";
       for (double e : expansion_grid)
         for (double c : grid) {
-          Score cov[4];
-          Eigen::Vector2d sigma_ss[4] = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero(),
-                                         Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+          Score cov[5];
+          std::array<Eigen::Vector2d, 5> sigma_ss;
+          sigma_ss.fill(Eigen::Vector2d::Zero());
           for (const Replay& rp : replays) {
             solvers::ObserverNoise n = rp.noise;
             n.widen_on_inconsistency = true;
@@ -810,12 +815,17 @@ int main(int argc, char** argv) {
                         << (rp.set == 3 ? " (changed)" : "") << ": " << fmt(100 * one.coverage()(0))
                         << " %, " << fmt(100 * one.coverage()(1)) << " %\n";
             }
-            sigma_ss[rp.set] += sd.bottomRows(sd.rows() - 1).colwise().squaredNorm().transpose();
+            const Eigen::Vector2d ss = sd.bottomRows(sd.rows() - 1).colwise().squaredNorm();
+            sigma_ss[static_cast<std::size_t>(rp.set)] += ss;
+            if (rp.set == 2 && !rp.name.ends_with(".expansion")) {
+              cov[4].add(p, sd, rp.truth);
+              sigma_ss[4] += ss;
+            }
           }
           std::cout << "  c = " << c << ", e = " << e << ":";
-          Eigen::Vector2d width[4];
-          for (int k = 0; k < 4; ++k) {
-            width[k] = (sigma_ss[k] / cov[k].n).cwiseSqrt() * 1e6;
+          Eigen::Vector2d width[5];
+          for (int k = 0; k < 5; ++k) {
+            width[k] = (sigma_ss[static_cast<std::size_t>(k)] / cov[k].n).cwiseSqrt() * 1e6;
             width[k] = width[k].cwiseQuotient(cov[k].rms_um());
             std::cout << " " << sets[k] << " " << fmt(100 * cov[k].coverage()(0)) << " %, "
                       << fmt(100 * cov[k].coverage()(1)) << " % (RMS sigma / RMS error "

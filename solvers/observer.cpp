@@ -428,7 +428,20 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   e.recalibrate_since_s = monitor_.since_s();
   if (offsets_ >= 0) {
     const Eigen::Index o = r_ + offsets_;
+    const std::size_t before = faults_.faults().size();
     faults_.add(t, x_.segment(o, m), p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt());
+    // An offset that appears after the first consistency window was not there from the start:
+    // the sensor may have failed, or the machine changed beside it (heat near one sensor is
+    // followed by its offset state and leaves the innovations consistent); the filter cannot
+    // tell, so it also says recalibrate, dated from the offset's crossing.
+    for (std::size_t k = before; k < faults_.faults().size(); ++k)
+      if (faults_.faults()[k].since_s > setup_.consistency.window_s && std::isnan(late_fault_s_))
+        late_fault_s_ = faults_.faults()[k].since_s;
+  }
+  if (!std::isnan(late_fault_s_)) {
+    e.recalibrate_since_s =
+        e.recalibrate ? std::min(e.recalibrate_since_s, late_fault_s_) : late_fault_s_;
+    e.recalibrate = true;
   }
   return e;
 }

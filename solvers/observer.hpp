@@ -92,7 +92,9 @@ struct ConsistencyOptions {
   /// The sensors' offsets (ObserverNoise::sensor_offset_initial_k): a sensor whose estimated
   /// offset stays beyond this many of its standard deviations for `sustain_s` is reported faulty
   /// (SensorFaultMonitor); 0: no such test. Under the noise model an offset's estimate is beyond
-  /// 4 sigma with probability 6e-5 (two-sided), and the test asks it to stay there.
+  /// 4 sigma with probability 6e-5 (two-sided), and the test asks it to stay there. A fault
+  /// whose offset crossed the bound after the first window (`window_s`) was not there from the
+  /// start, and heat near that one sensor looks the same: it raises recalibrate as well.
   double sensor_fault_sigmas = 4;
 };
 
@@ -260,6 +262,9 @@ class KalmanObserver {
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
   SensorFaultMonitor faults_;
+  /// The first fault whose offset appeared after the first consistency window: its crossing [s]
+  /// (NaN: none). It raises recalibrate too.
+  double late_fault_s_ = std::numeric_limits<double>::quiet_NaN();
   CovarianceMap* map_ = nullptr;  /// while advance() runs: the steps' map, accumulated
 };
 

@@ -221,6 +221,76 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
+  // Issue 20, item 3 end to end: an undeclared 15 W heat input (constant, at a place the
+  // generator draws) on the coarse SB-1. `observe` with its default settings reads the run and
+  // raises recalibrate, dated; `calibrate --case` on that run and two earlier runs of the same
+  // machine then names a heat input near the true place.
+  const fs::path dir = rt::scratch("observe_then_calibrate");
+  const fs::path rom = dir / "rom", observed = dir / "observed", log = dir / "log";
+  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
+                     "--quick-validation", "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const core::CaseSpec spec = io::read_case(rt::kCoarseCase);
+  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+  calibration::GeneratorOptions g;
+  g.mesh_scale = 1;
+  g.step_s = spec.thermal.step;
+  calibration::Instrumentation inst;
+  inst.sensor_points = {"T02", "T08", "T11", "T14", "T17", "T25", "T33", "T44", "T52"};
+  std::mt19937_64 rng = core::generator(11, 0);
+  calibration::InjectedEffect heat = calibration::random_effect(
+      calibration::EffectKind::heat_input, spec, mesh, inst.sensor_points, rng);
+  heat.magnitude = 15;  // W, within the generator's range (4 .. 25 W)
+  heat.follows_speed = false;
+  const auto gen = calibration::generator_case(spec, g);
+  std::vector<std::string> runs;
+  const double hours[] = {2, 3, 4};
+  for (int k = 0; k < 3; ++k) {
+    const core::DutyCycle duty = calibration::random_duty_cycle(hours[k], rng);
+    runs.push_back((dir / ("run_" + std::to_string(k))).string());
+    io::write_measured_run(
+        runs.back(), calibration::synthetic_run(mesh, calibration::truth_case(gen, heat, duty, k),
+                                                heat, inst, g, "heat " + std::to_string(k), rng));
+  }
+  ASSERT_EQ(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data", runs[2],
+                     "--out", observed.string(), "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const auto alarm = nlohmann::json::parse(std::ifstream(observed / "observer.json"));
+  std::printf(
+      "[observe then calibrate] %.1f W at (%.3f, %.3f, %.3f): status %s, raised at %s s, "
+      "since %s s\n",
+      heat.magnitude, heat.centre(0), heat.centre(1), heat.centre(2),
+      alarm["status"].dump().c_str(), alarm["recalibrate_raised_s"].dump().c_str(),
+      alarm["recalibrate_since_s"].dump().c_str());
+  ASSERT_EQ(alarm["status"], "recalibrate");
+  EXPECT_LT(alarm["recalibrate_raised_s"].get<double>(), 4 * 3600.0);
+  const fs::path out = dir / "calibrated";
+  ASSERT_EQ(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0], runs[1],
+                     "--test", runs[2], "--out", out.string()},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const auto j = nlohmann::json::parse(std::ifstream(out / "calibration.json"));
+  ASSERT_FALSE(j["effects"].empty()) << j.dump(1);
+  const auto& first = j["effects"][0];
+  EXPECT_EQ(first["kind"], "heat_input") << j.dump(1);
+  const auto& c = first["location"]["centre_m"];
+  const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+  std::printf(
+      "[observe then calibrate] calibrate: %s at (%.3f, %.3f, %.3f), %s W; u RMS %.3f -> "
+      "%.3f um\n",
+      first["kind"].dump().c_str(), found(0), found(1), found(2),
+      first["parameters"].value("power_W", nlohmann::json()).dump().c_str(),
+      j["before"]["displacement_rms_um"].get<double>(),
+      j["after"]["displacement_rms_um"].get<double>());
+  EXPECT_LT((found - heat.centre).norm(), 0.06);
+}
+
 TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
   // The observer's settings are flags of `observe` and `compensate --rom`, in their --help; a
   // value that makes no sense is refused before any file is read, naming the flag and the value,

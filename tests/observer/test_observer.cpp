@@ -409,6 +409,37 @@ TEST_F(Observer, ASensorOffsetIsEstimatedAsAnOffsetNotAsHeat) {
   EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
 }
 
+TEST_F(Observer, AnOffsetThatAppearsLateAlsoSaysRecalibrate) {
+  // T17 reads high by 0.25 K per hour from 1 h on (a sensor drifting, or heat growing beside that
+  // one sensor: the filter cannot tell them apart). Its offset state and the heat inputs follow
+  // it with consistent innovations, so the NIS test raises nothing (no fault test: no alarm at
+  // all); the offset crosses the fault bound hours in. Not there from the start, it is reported
+  // as T17's fault and as recalibrate, dated from its crossing; the same offset from t = 0
+  // (above) raises the fault alone.
+  const core::CaseSpec c = run_spec();
+  const Eigen::Index faulty = 4;  // T17
+  Eigen::MatrixXd y = s_->clean.temperature;
+  for (Eigen::Index i = 0; i < y.rows(); ++i)
+    y(i, faulty) += 0.25 * std::max(0.0, s_->clean.time(i) / 3600 - 1);
+  solvers::ObserverSetup with = setup(default_noise());
+  with.noise.sensor_offset_initial_k = 0.5;
+  with.noise.sensor_offset_walk_k = 0.05;
+  const auto& sys = s_->twin.model.system;
+  const solvers::ObserverRun late = solvers::observe(sys, c, with, s_->clean.time, y);
+  ASSERT_EQ(late.sensor_faults.size(), 1u);
+  const solvers::SensorFault& f = late.sensor_faults.front();
+  std::cerr << "T17 drifting from 3600 s: fault since " << f.since_s << " s, raised at "
+            << f.raised_s << " s; recalibrate at " << late.recalibrate_at_s << " s since "
+            << late.recalibrate_since_s << " s\n";
+  EXPECT_EQ(f.sensor, faulty);
+  EXPECT_GT(f.since_s, 3600.0);
+  ASSERT_TRUE(late.recalibrate);
+  EXPECT_EQ(late.recalibrate_at_s, f.raised_s);
+  EXPECT_EQ(late.recalibrate_since_s, f.since_s);
+  with.consistency.sensor_fault_sigmas = 0;  // no fault test: the innovations alone say nothing
+  EXPECT_FALSE(solvers::observe(sys, c, with, s_->clean.time, y).recalibrate);
+}
+
 TEST_F(Observer, DriftSigmaGrowsWithTheDriftRowsRelativeError) {
   // The drift rows' own error e (ObserverNoise::drift_relative_sigma): the reported sigma is
   // sqrt(sigma_0^2 + (e d)^2), sigma_0 the filter's; the estimate is the same.
