@@ -49,6 +49,8 @@ struct FitArgs {
   double hours = 5, required_sm_um = 1.0;
   bool quick = false, quiet = false;
   bool network = false;  /// also try the CNN-BiGRU-attention network (seed 004)
+  /// also place for estimation (observer_variance) on the campaign's reduced model
+  bool estimation = false;
 };
 
 /// fit --data RUN...: measured runs with no machine model (app/fit_data_command.cpp).

@@ -1,12 +1,13 @@
 // thermotwin fit: how well a thermal-error model fed by m sensors predicts the drift on duty
 // cycles it was not fitted on (DB3401/T 326-2024 metrics S, S_M, S_sigma).
 //   thermotwin fit CASE --out DIR [--hours 5] [--required-sm-um 1] [--quick] [--network]
-//                       [--rom DIR | --full]
+//                       [--rom DIR | --full] [--estimation]
 // 1. The case and its mesh. 2. The virtual test campaign (solvers::campaign_runs) on the chosen
-// thermal model. 3. The study: studies/fit_on_campaign.hpp. 4. The files (fit.json,
-// modelling_record.{json,md}, compensation.csv, sensor_count_<target>.csv/.png,
-// held_out/<group>_temperatures.csv; axis_fit.md on a case with feed-axis points; the networks'
-// .pt files with --network): io/fit_campaign_out.hpp.
+// thermal model (with --estimation, its reduced model also places for estimation in 3). 3. The
+// study: studies/fit_on_campaign.hpp. 4. The files (fit.json, modelling_record.{json,md},
+// compensation.csv, sensor_count_<target>.csv/.png, held_out/<group>_temperatures.csv; axis_fit.md
+// on a case with feed-axis points; the networks' .pt files with --network):
+// io/fit_campaign_out.hpp.
 #include <iostream>
 
 #include "app/commands.hpp"
@@ -28,8 +29,15 @@ int fit_command(const FitArgs& args) {
   const auto runs = solvers::campaign_runs(spec, args.hours, spec.seed);
   const CampaignOnModel campaign =
       campaign_on_model(mesh, spec, runs, {args.rom, args.full}, {}, args.quiet);
+  if (args.estimation && !args.quiet)
+    std::cerr << "thermotwin: fit: placement and models; placement for estimation steps the "
+                 "observer on the reduced model (order "
+              << (campaign.twin ? campaign.twin->model.states() : 0)
+              << ") over the fitting runs first\n";
   const studies::CampaignFitReport report = studies::fit_on_campaign(
-      spec, campaign.results, {args.quick, args.network, args.required_sm_um * 1e-6});
+      spec, campaign.results,
+      {args.quick, args.network, args.required_sm_um * 1e-6,
+       args.estimation && campaign.twin ? &*campaign.twin : nullptr, &runs});
   io::write_campaign_fit(out.path(), spec, runs, report, campaign.model);
   out.commit();
   std::cerr << "thermotwin: fit: " << io::campaign_fit_summary(report).dump() << "\n";

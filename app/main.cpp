@@ -243,8 +243,14 @@ Command fit_line(CLI::App& cli) {
   fit->add_option("--rom", fit_args.rom,
                   "a reduced model (thermotwin reduce CASE --out DIR) to run the campaign on")
       ->check(CLI::ExistingDirectory);
-  fit->add_flag("--full", fit_args.full,
-                "the campaign in full order (default: a reduced model built on the fly)");
+  auto* full =
+      fit->add_flag("--full", fit_args.full,
+                    "the campaign in full order (default: a reduced model built on the fly)");
+  fit->add_flag("--estimation", fit_args.estimation,
+                "also place for estimation (observer_variance: the physics observer's posterior "
+                "variance of the drift over the fitting runs' duty cycles) on the campaign's "
+                "reduced model; costs minutes on a model of several hundred states")
+      ->excludes(full);
   return {fit, [args, data_args] {
             if (!data_args->runs.empty()) {
               FitDataArgs d = *data_args;

@@ -29,7 +29,9 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
   studies::CampaignOnModel study =
       studies::campaign_on_model(mesh, spec, runs, request, sampled_nodes, say, progress);
   if (study.model.indicator) std::cerr << io::indicator_warning(*study.model.indicator);
-  return {std::move(study.results), io::campaign_model_json(study.model)};
+  std::optional<solvers::Twin> twin = std::move(study.built);
+  if (request.given) twin = std::move(file.twin);
+  return {std::move(study.results), io::campaign_model_json(study.model), std::move(twin)};
 }
 
 }  // namespace tt::app

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "mesh/tet_mesh.hpp"
 #include "solvers/campaign.hpp"
 #include "solvers/reduction.hpp"
+#include "solvers/twin.hpp"
 #include "studies/histories.hpp"
 
 namespace tt::app {
@@ -43,6 +45,8 @@ struct ModelChoice {
 struct CampaignOnModel {
   std::vector<solvers::CampaignResult> results;
   nlohmann::json model;
+  /// The reduced model the campaign stepped (read from --rom or built); empty in full order.
+  std::optional<solvers::Twin> twin;
 };
 
 /// Runs the campaign on the model `choice` names (app/model_choice.cpp), saying on stderr which one

@@ -6,6 +6,7 @@
 #include "fitting/models.hpp"
 #include "fitting/noise.hpp"
 #include "placement/place.hpp"
+#include "studies/estimation_input.hpp"
 #include "studies/histories.hpp"
 #include "studies/placement_input.hpp"
 
@@ -41,6 +42,22 @@ std::vector<int> indices_of(const std::vector<fitting::Group>& groups,
     for (size_t i = 0; i < groups.size(); ++i)
       if (groups[i].name == n) out.push_back(static_cast<int>(i));
   return out;
+}
+
+/// Placement for estimation on the campaign's reduced model: the physics observer (its default
+/// process noise, the campaign's sensor noise) over the fitting runs' duty cycles, read every
+/// output interval but at least every 300 s (the criterion's cost grows with the readings).
+placement::EstimationProblem fitting_estimation(const core::CaseSpec& spec, const Histories& h,
+                                                const CampaignFitOptions& o,
+                                                const std::vector<int>& fitting) {
+  std::vector<core::CaseSpec> cycles;
+  for (int i : fitting) cycles.push_back(o.runs->at(static_cast<std::size_t>(i)).spec);
+  const EstimationCandidates candidates{h.names, h.nodes, fitting::SensorNoise{}.temperature_sigma};
+  solvers::ObserverNoise noise;
+  noise.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(h.names.size()),
+                                                   candidates.sensor_sigma_k);
+  return observer_estimation_problem(*o.twin, cycles, candidates, h.target_names, noise,
+                                     std::max(spec.thermal.output_interval, 300.0));
 }
 
 /// Sensor sets per placement method and m for one target, as fitting takes them.
@@ -155,15 +172,17 @@ CampaignFitReport fit_on_campaign(const core::CaseSpec& spec,
   placement::PlacementOptions placing;
   placing.samples = 0;  // every reading of the campaign, not the patent's 100
   placing.seed = spec.seed;
-  Context c{
-      spec,
-      options,
-      r.groups,
-      r.split,
-      placement::place_all(
-          groups_end_to_end(r.groups, r.split.fitting, first.positions, tcp_targets), placing),
-      options.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
-                    : fitting::default_model_candidates()};
+  placement::PlacementInput placed =
+      groups_end_to_end(r.groups, r.split.fitting, first.positions, tcp_targets);
+  if (options.twin && options.runs)
+    placed.estimation = fitting_estimation(spec, first, options, r.split.fitting);
+  Context c{spec,
+            options,
+            r.groups,
+            r.split,
+            placement::place_all(placed, placing),
+            options.quick ? std::vector<fitting::ModelSpec>{fitting::ModelSpec{}}
+                          : fitting::default_model_candidates()};
   std::vector<fitting::SensorSet> tcp_chosen, network_inputs;
   for (int target = 0; target < tcp_targets; ++target) {
     r.targets.push_back(target_fit(c, target, network_inputs));

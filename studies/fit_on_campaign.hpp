@@ -4,7 +4,8 @@
 // the sensor-count tables and the held-out groups' readings.
 // 1. The virtual campaign's runs as groups with sensor noise on every reading (seeded from the
 //    case), split into fitting, validation and test runs by name.
-// 2. Placement on the fitting groups only.
+// 2. Placement on the fitting groups only (with the campaign's reduced model, placement for
+//    estimation too, on the fitting runs' duty cycles).
 // 3. Per TCP target: model, settings and placement method chosen on validation, refitted, tested;
 //    the test S_M by number of sensors; with the network, its own figures beside the choice.
 // 4. On a case with feed-axis points: models of the error at those points and the axis polynomial
@@ -18,6 +19,7 @@
 #include "fitting/group.hpp"
 #include "fitting/selection.hpp"
 #include "solvers/campaign.hpp"
+#include "solvers/twin.hpp"
 #include "studies/axis_fit.hpp"
 #include "studies/network_candidate.hpp"
 
@@ -30,6 +32,11 @@ struct CampaignFitOptions {
   bool network = false;
   /// the accuracy asked for: the sensor-count tables' smallest m with test S_M below it [m]
   double required_sm = 1e-6;
+  /// The reduced model the campaign ran on and the campaign's runs (the results' order): with
+  /// both, placement for estimation (observer_variance, the physics observer's posterior
+  /// variance over the fitting runs' duty cycles) is one more placement method; nullptr: not.
+  const solvers::Twin* twin = nullptr;
+  const std::vector<solvers::CampaignRun>* runs = nullptr;
 };
 
 /// One TCP target's choice, tested.

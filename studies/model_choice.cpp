@@ -54,6 +54,7 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
        std::to_string(mesh.nodes.rows()) + " nodes");
   out.results = solvers::twin_campaign(*twin, runs, stepping, sampled_nodes);
   out.model.indicator = indicator_check(mesh, spec, runs, twin->model, full_system);
+  out.built = std::move(built);
   return out;
 }
 

@@ -47,6 +47,9 @@ struct ModelUsed {
 struct CampaignOnModel {
   std::vector<solvers::CampaignResult> results;
   ModelUsed model;
+  /// The reduced model built here and stepped (empty in full order, and when the request gave
+  /// one: that stays the caller's).
+  std::optional<solvers::Twin> built;
 };
 
 /// Runs the campaign on the requested model, saying which one; a reduced model's indicator is

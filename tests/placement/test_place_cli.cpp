@@ -3,7 +3,7 @@
 // and `place --from` the run chooses among them with every method, for dy and dz, m = 1..6;
 // `--methods observer_variance` places for the physics observer on the reduced model built on the
 // fly (the vertices read through the basis rows) and writes it into placement.json as its schema
-// says; a name that is not a method is refused.
+// says; a name that is not a method is refused. `fit --estimation` adds it to fit's methods.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -151,6 +151,40 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
       << text_of(dir / "place.log");
   EXPECT_FALSE(fs::exists(dir / "place_bad" / "placement.json"));
   if (!HasFailure()) fs::remove_all(dir);  // kept for a look when something failed
+}
+
+TEST(FitCli, PlacesForEstimationWhenAsked) {
+  // `fit --estimation` adds placement for estimation (observer_variance, on the campaign's reduced
+  // model) to the methods the sensor sets come from: one more column in each sensor-count table,
+  // its sets fitted and tested as the others are; without the flag, none. With --full there is
+  // no reduced model, so the flag is refused before any work.
+  const fs::path dir = fs::temp_directory_path() / "tt_fit_estimation";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const bool estimation : {false, true}) {
+    const fs::path out = dir / (estimation ? "with" : "without");
+    std::vector<std::string> args{"fit", kCoarse.string(), "--out",  out.string(), "--hours",
+                                  "2",   "--quick",        "--quiet"};
+    if (estimation) args.push_back("--estimation");
+    ASSERT_EQ(thermotwin(args, dir / "fit.log"), 0) << text_of(dir / "fit.log");
+    EXPECT_TRUE(tt::test::matches_output_schemas("fit", out));
+    for (const char* target : {"dy", "dz"}) {
+      const std::string table = text_of(out / ("sensor_count_" + std::string(target) + ".csv"));
+      const std::string header = table.substr(0, table.find('\n'));
+      EXPECT_EQ(header.find("observer_variance_test_sm_um") != std::string::npos, estimation)
+          << target << ": " << header;
+      EXPECT_NE(header.find("gaussian_greedy_test_sm_um"), std::string::npos) << header;
+      EXPECT_EQ(data_lines(out / ("sensor_count_" + std::string(target) + ".csv")), 6) << target;
+    }
+  }
+  EXPECT_NE(thermotwin({"fit", kCoarse.string(), "--out", (dir / "full").string(), "--full",
+                        "--estimation", "--quiet"},
+                       dir / "fit.log"),
+            0);
+  EXPECT_NE(text_of(dir / "fit.log").find("--estimation"), std::string::npos)
+      << text_of(dir / "fit.log");
+  EXPECT_FALSE(fs::exists(dir / "full"));
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 }  // namespace
