@@ -27,17 +27,18 @@ int fit_command(const FitArgs& args) {
   io::OutputDir out(args.out, inputs);  // refused at once, not after the work
   const mesh::TetMesh mesh = mesh::mesh_case(spec);
   const auto runs = solvers::campaign_runs(spec, args.hours, spec.seed);
-  const CampaignOnModel campaign =
+  CampaignOnModel campaign =
       campaign_on_model(mesh, spec, runs, {args.rom, args.full}, {}, args.quiet);
+  if (!args.estimation) campaign.twin.reset();  // its basis is #nodes x order: not kept unused
   if (args.estimation && !args.quiet)
     std::cerr << "thermotwin: fit: placement and models; placement for estimation steps the "
                  "observer on the reduced model (order "
               << (campaign.twin ? campaign.twin->model.states() : 0)
               << ") over the fitting runs first\n";
-  const studies::CampaignFitReport report = studies::fit_on_campaign(
-      spec, campaign.results,
-      {args.quick, args.network, args.required_sm_um * 1e-6,
-       args.estimation && campaign.twin ? &*campaign.twin : nullptr, &runs});
+  const studies::CampaignFitReport report =
+      studies::fit_on_campaign(spec, campaign.results,
+                               {args.quick, args.network, args.required_sm_um * 1e-6,
+                                campaign.twin ? &*campaign.twin : nullptr, &runs});
   io::write_campaign_fit(out.path(), spec, runs, report, campaign.model);
   out.commit();
   std::cerr << "thermotwin: fit: " << io::campaign_fit_summary(report).dump() << "\n";
