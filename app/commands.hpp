@@ -97,7 +97,8 @@ struct ObserverOptions {
   bool widen_on_inconsistency = false;   /// widen sigma by sqrt(window NIS / readings) when > 1
   double drift_relative_sigma = 0.04;    /// the drift rows' own error, relative to the drift [-]
   double correction_relative_sigma = 0;  /// the corrections' error, relative to them [-]
-  double expansion_relative_sigma = 0;   /// each material's expansion error, relative [-]
+  /// each material's expansion error, relative [-]: one value for all or one per material
+  std::vector<double> expansion_relative_sigma{0};
   /// factor on the reported drift sigma: one value for every target or one per target; empty: 1
   std::vector<double> drift_sigma_scale;
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test

@@ -1,5 +1,7 @@
 #include "app/observer_options.hpp"
 
+#include <algorithm>
+
 #include "app/cli_numbers.hpp"
 #include "core/errors.hpp"
 
@@ -19,8 +21,30 @@ Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<st
                         "); expected one value for all or one per " + what + " in that order");
 }
 
+/// --expansion-relative-sigma per material of the set-up; none when every value is 0. DataError
+/// when one is above 0 and the reduced model keeps no drift rows per material.
+Eigen::VectorXd expansion_sigmas(const std::vector<double>& values,
+                                 const solvers::ObserverSetup& setup) {
+  if (std::all_of(values.begin(), values.end(), [](double v) { return v == 0; }))
+    return Eigen::VectorXd();
+  if (setup.expansion_materials.empty())
+    throw core::DataError(
+        "--expansion-relative-sigma: the reduced model keeps no drift rows per material (written "
+        "before they were); rebuild it with `thermotwin reduce`");
+  return per_name(values, setup.expansion_materials, "--expansion-relative-sigma", "materials");
+}
+
 std::vector<double> as_vector(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+/// Each material's expansion relative sigma by name ({} when none).
+nlohmann::json expansion_json(const solvers::ObserverSetup& setup) {
+  nlohmann::json j = nlohmann::json::object();
+  const Eigen::VectorXd& e = setup.noise.expansion_relative_sigma;
+  for (Eigen::Index m = 0; m < e.size(); ++m)
+    j[setup.expansion_materials.at(static_cast<std::size_t>(m))] = e(m);
+  return j;
 }
 
 }  // namespace
@@ -81,8 +105,10 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
   command
       .add_option("--expansion-relative-sigma", o.expansion_relative_sigma,
                   "error of each material's expansion coefficient relative to its declared "
-                  "value, the materials independent: adds each material's part of the drift "
+                  "value, the materials independent: one value for all or one per material in "
+                  "the case's order, comma-separated; adds each material's part of the drift "
                   "times it, after --drift-sigma-scale (default 0: none)")
+      ->delimiter(',')
       ->check(non_negative_number());
   command
       .add_option("--drift-sigma-scale", o.drift_sigma_scale,
@@ -133,9 +159,9 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.sensor_offset_walk_k = o.sensor_offset_walk_k;
   noise.drift_relative_sigma = o.drift_relative_sigma;
   noise.correction_relative_sigma = o.correction_relative_sigma;
-  noise.expansion_relative_sigma = o.expansion_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
   solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
+  setup.noise.expansion_relative_sigma = expansion_sigmas(o.expansion_relative_sigma, setup);
   if (!o.drift_sigma_scale.empty())
     setup.noise.drift_sigma_scale =
         per_name(o.drift_sigma_scale, setup.target_names, "--drift-sigma-scale", "targets");
@@ -161,7 +187,7 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
           {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
           {"drift_relative_sigma", n.drift_relative_sigma},
           {"correction_relative_sigma", n.correction_relative_sigma},
-          {"expansion_relative_sigma", n.expansion_relative_sigma},
+          {"expansion_relative_sigma", expansion_json(setup)},
           {"drift_sigma_scale", as_vector(scale)},
           {"widen_on_inconsistency", n.widen_on_inconsistency}};
 }

@@ -803,7 +803,8 @@ int main(int argc, char** argv) {
             n.widen_on_inconsistency = true;
             n.drift_sigma_scale = adapted_noise.drift_sigma_scale;
             n.correction_relative_sigma = c;
-            n.expansion_relative_sigma = e;
+            n.expansion_relative_sigma = Eigen::VectorXd::Constant(
+                static_cast<Eigen::Index>(twin.outputs.materials.size()), e);
             const solvers::ObserverRun run = solvers::observe(
                 twin.model.system, rp.spec, solvers::twin_observer_setup(twin, rp.spec, sensors, n),
                 rp.time, rp.readings);

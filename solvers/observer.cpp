@@ -51,9 +51,14 @@ Eigen::MatrixXd unknown_heat_columns(const ReducedThermalSystem& system, const c
   return columns;
 }
 
-/// ObserverNoise::expansion_relative_sigma needs the per-material target rows, of the target
-/// rows' shape: SolverError otherwise.
+/// ObserverNoise::expansion_relative_sigma: one finite value >= 0 per material, and the
+/// per-material target rows, of the target rows' shape, when one is above 0; SolverError
+/// otherwise.
 void check_expansion_rows(const ObserverSetup& s) {
+  const Eigen::VectorXd& e = s.noise.expansion_relative_sigma;
+  if (!e.allFinite() || (e.array() < 0).any())
+    throw core::SolverError("observer: an expansion relative sigma is negative or not finite");
+  if ((e.array() == 0).all()) return;
   if (s.target_expansion.empty())
     throw core::SolverError(
         "observer: an expansion relative sigma needs the drift rows per material, which this "
@@ -65,6 +70,10 @@ void check_expansion_rows(const ObserverSetup& s) {
                               std::to_string(part.rows()) + " x " + std::to_string(part.cols()) +
                               ", the target rows " + std::to_string(s.target_rows.rows()) + " x " +
                               std::to_string(s.target_rows.cols()));
+  if (static_cast<std::size_t>(e.size()) != s.target_expansion.size())
+    throw core::SolverError("observer: " + std::to_string(e.size()) +
+                            " expansion relative sigmas for " +
+                            std::to_string(s.target_expansion.size()) + " materials");
 }
 
 }  // namespace
@@ -111,6 +120,7 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
   };
   s.target_rows = targets(out.rows.bottomRows(out.rows.rows() - first));
   for (const Eigen::MatrixXd& part : out.expansion) s.target_expansion.push_back(targets(part));
+  s.expansion_materials = out.materials;
   s.target_names.assign(std::begin(core::kDirectionNames), std::end(core::kDirectionNames));
   for (Eigen::Index k = 0; k < axis; ++k)
     s.target_names.push_back(out.names[static_cast<std::size_t>(first + 9 + k)]);
@@ -223,13 +233,13 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
   const ObserverNoise& n = setup_.noise;
   for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
                    n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k,
-                   n.correction_relative_sigma, n.expansion_relative_sigma})
+                   n.correction_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
   const double fault = setup_.consistency.sensor_fault_sigmas;
   if (!(fault >= 0) || !std::isfinite(fault))
     fail("sensor fault bound " + number(fault) + " sigma: expected a finite value >= 0");
-  if (n.expansion_relative_sigma > 0) check_expansion_rows(setup_);
+  if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup_);
   const Eigen::VectorXd& scale = n.drift_sigma_scale;
   if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
                             !(scale.array() > 0).all() || !scale.allFinite()))
@@ -457,9 +467,11 @@ Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const 
   if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
   if (z_open_.size() != 0)
     var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
-  if (n.expansion_relative_sigma > 0)
-    for (const Eigen::MatrixXd& part : setup_.target_expansion)
-      var += (n.expansion_relative_sigma * (part * (x_.head(r_) - z0_)).array()).square();
+  for (Eigen::Index m = 0; m < n.expansion_relative_sigma.size(); ++m)
+    if (n.expansion_relative_sigma(m) > 0)
+      var += (n.expansion_relative_sigma(m) *
+              (setup_.target_expansion[static_cast<std::size_t>(m)] * (x_.head(r_) - z0_)).array())
+                 .square();
   return var.sqrt().matrix();
 }
 

@@ -61,13 +61,13 @@ struct ObserverNoise {
   /// filter does, at the filtered state: the same map unless the case's heat depends on
   /// temperature.)
   double correction_relative_sigma = 0;
-  /// Error of each material's expansion coefficient, relative to its declared value, the
-  /// materials independent of each other [-]: added to the drift's variance as the sum over the
-  /// materials of (e d_m)^2, d_m the part of the drift that material m's thermal strain makes
-  /// (ObserverSetup::target_expansion; a wrong expansion coefficient changes no temperature, so no
-  /// reading and no other term sees it). After drift_sigma_scale, like the correction's, and before
-  /// the widening. 0: none.
-  double expansion_relative_sigma = 0;
+  /// Per material (ObserverSetup::target_expansion's order): the error of its expansion
+  /// coefficient, relative to its declared value, the materials independent of each other [-]:
+  /// added to the drift's variance as the sum over the materials of (e_m d_m)^2, d_m the part of
+  /// the drift that material m's thermal strain makes (a wrong expansion coefficient changes no
+  /// temperature, so no reading and no other term sees it). After drift_sigma_scale, like the
+  /// correction's, and before the widening. Empty (or zeros): none.
+  Eigen::VectorXd expansion_relative_sigma;
   /// Per target: a factor on the reported standard deviation of the drift, calibrated on runs
   /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
   /// alarm) as it is. Empty: 1 for every target.
@@ -104,8 +104,9 @@ struct ObserverSetup {
   Eigen::MatrixXd target_rows;            /// #targets x r: drift [m] = row (z - z(0))
   std::vector<std::string> target_names;  /// e.g. "dx", "dy", "dz", "<axis point>_dx"
   /// Per material: the part of target_rows its thermal strain makes (#targets x r each, summing to
-  /// target_rows); needed when noise.expansion_relative_sigma > 0.
+  /// target_rows), and the materials' names; needed for noise.expansion_relative_sigma.
   std::vector<Eigen::MatrixXd> target_expansion;
+  std::vector<std::string> expansion_materials;
   std::vector<int> air_entries;           /// convection entries whose sink the air offset moves
   std::vector<std::string> sensor_names;  /// the sensors' ids (the offsets' names); empty: indices
   double initial_temperature_k = std::numeric_limits<double>::quiet_NaN();  /// NaN: the case's

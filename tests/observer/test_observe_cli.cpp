@@ -118,7 +118,19 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   expansion_args.insert(expansion_args.end(), {"--expansion-relative-sigma", "0.15"});
   ASSERT_EQ(rt::run(expansion_args, {}, log), 0) << rt::read_text(log);
   const auto je = nlohmann::json::parse(std::ifstream(expansion / "observer.json"));
-  EXPECT_EQ(je["noise"]["expansion_relative_sigma"], 0.15);
+  ASSERT_EQ(je["noise"]["expansion_relative_sigma"].size(), spec.materials.size());
+  for (const auto& m : spec.materials)
+    EXPECT_EQ(je["noise"]["expansion_relative_sigma"][m.name], 0.15) << m.name;
+  // One value per material, or one for all: two for three materials is refused, naming them,
+  // and nothing is written.
+  std::vector<std::string> miscounted = expansion_args;
+  miscounted[7] = (dir / "miscounted").string();
+  miscounted.back() = "0.1,0.2";
+  EXPECT_NE(rt::run(miscounted, {}, log), 0);
+  EXPECT_NE(rt::read_text(log).find("--expansion-relative-sigma: 2 values for 3 materials"),
+            std::string::npos)
+      << rt::read_text(log);
+  EXPECT_FALSE(fs::exists(dir / "miscounted" / "observer.json"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", expansion));
   const auto last_row = [](const fs::path& f) {
     const std::string text = rt::read_text(f);

@@ -533,7 +533,7 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
   }
   const auto& sys = s_->twin.model.system;
   solvers::ObserverNoise wide = default_noise();
-  wide.expansion_relative_sigma = 0.2;
+  wide.expansion_relative_sigma = Eigen::VectorXd::Constant(3, 0.2);  // three materials
   const solvers::ObserverRun plain =
       solvers::observe(sys, c, setup(default_noise()), s_->clean.time, s_->clean_truth.temperature);
   const solvers::ObserverRun with =
@@ -561,8 +561,20 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
   old.target_expansion.clear();
   EXPECT_THROW(solvers::KalmanObserver(sys, c, old), core::SolverError);
   old = setup(wide);
-  old.noise.expansion_relative_sigma = -0.1;
+  old.noise.expansion_relative_sigma = Eigen::VectorXd::Constant(3, -0.1);
   EXPECT_THROW(solvers::KalmanObserver(sys, c, old), core::SolverError);
+  old.noise.expansion_relative_sigma = Eigen::VectorXd::Constant(2, 0.1);  // not one per material
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, old), core::SolverError);
+  // One material's alone: its part only (the others' e 0).
+  solvers::ObserverNoise one = default_noise();
+  one.expansion_relative_sigma = Eigen::VectorXd::Zero(3);
+  one.expansion_relative_sigma(0) = 0.2;
+  const solvers::ObserverRun first =
+      solvers::observe(sys, c, setup(one), s_->clean.time, s_->clean_truth.temperature);
+  EXPECT_GT(first.drift_sigma(first.times.size() - 1, 2),
+            plain.drift_sigma(plain.times.size() - 1, 2));
+  EXPECT_LT(first.drift_sigma(first.times.size() - 1, 2),
+            with.drift_sigma(with.times.size() - 1, 2));
 }
 
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
