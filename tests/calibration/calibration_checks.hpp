@@ -10,6 +10,7 @@
 #include "calibration_fixture.hpp"
 #include "core/timing.hpp"
 #include "io/calibration_model_out.hpp"
+#include "tests/common/calibration_json.hpp"
 
 namespace tt::calibration::testing {
 
@@ -145,8 +146,7 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
   ASSERT_FALSE(claims.empty()) << "no effect claimed";
   EXPECT_EQ(out.first, kind_name(kind)) << claims.dump(1);
   if (kind == EffectKind::heat_input && out.first == "heat_input") {
-    const auto c = claims[0]["location"]["centre_m"];
-    const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+    const Eigen::Vector3d found = tt::test::effect_centre_m(claims[0]);
     const double err = (found - e.centre).norm();
     std::printf(
         "[calibration] heat input at (%.3f, %.3f, %.3f), found (%.3f, %.3f, %.3f): place error "

@@ -16,6 +16,7 @@
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
+#include "tests/common/calibration_json.hpp"
 #include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
 
@@ -68,8 +69,7 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
   ASSERT_FALSE(j["effects"].empty()) << j.dump(1);
   const auto& first = j["effects"][0];
   EXPECT_EQ(first["kind"], "heat_input") << j.dump(1);
-  const auto& c = first["location"]["centre_m"];
-  const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+  const Eigen::Vector3d found = tt::test::effect_centre_m(first);
   std::printf(
       "[calibrate cli] heat input %.2f W at (%.3f, %.3f, %.3f), found %.2f W at "
       "(%.3f, %.3f, %.3f); u RMS %.3f -> %.3f um\n",

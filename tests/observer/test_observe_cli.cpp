@@ -19,6 +19,7 @@
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/mesher.hpp"
+#include "tests/common/calibration_json.hpp"
 #include "tests/common/csv_rows.hpp"
 #include "tests/common/output_schema.hpp"
 #include "tests/reliability/process.hpp"
@@ -29,6 +30,22 @@ namespace {
 namespace fs = std::filesystem;
 namespace rt = reliability_test;
 
+/// The coarse SB-1, its mesh, and the calibration generator on that mesh and step (a clean run is
+/// the declared model) reading nine sensors.
+struct OwnMeshGenerator {
+  OwnMeshGenerator() : spec(io::read_case(rt::kCoarseCase)), mesh(mesh::mesh_case(spec)) {
+    g.mesh_scale = 1;
+    g.step_s = spec.thermal.step;
+    gen = calibration::generator_case(spec, g);
+    inst.sensor_points = {"T02", "T08", "T11", "T14", "T17", "T25", "T33", "T44", "T52"};
+  }
+  core::CaseSpec spec;
+  mesh::TetMesh mesh;
+  calibration::GeneratorOptions g;
+  core::CaseSpec gen;
+  calibration::Instrumentation inst;
+};
+
 TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   const fs::path dir = rt::scratch("observe");
   const fs::path rom = dir / "rom", data = dir / "run", out = dir / "out";
@@ -38,13 +55,8 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
             0)
       << rt::read_text(dir / "reduce.log");
   // 1. A generated run with a sensor offset.
-  const core::CaseSpec spec = io::read_case(rt::kCoarseCase);
-  const mesh::TetMesh mesh = mesh::mesh_case(spec);
-  calibration::GeneratorOptions g;
-  g.mesh_scale = 1;
-  g.step_s = spec.thermal.step;
-  calibration::Instrumentation inst;
-  inst.sensor_points = {"T02", "T08", "T11", "T14", "T17", "T25", "T33", "T44", "T52"};
+  const OwnMeshGenerator o;
+  const core::CaseSpec& spec = o.spec;
   std::mt19937_64 rng = core::generator(5, 0);
   calibration::InjectedEffect e;
   e.present = true;
@@ -52,10 +64,9 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   e.target = "T11";
   e.magnitude = 0.6;
   const core::DutyCycle duty = calibration::random_duty_cycle(3, rng);
-  const auto gen = calibration::generator_case(spec, g);
   io::write_measured_run(
-      data, calibration::synthetic_run(mesh, calibration::truth_case(gen, e, duty, 0), e, inst, g,
-                                       "offset", rng));
+      data, calibration::synthetic_run(o.mesh, calibration::truth_case(o.gen, e, duty, 0), e,
+                                       o.inst, o.g, "offset", rng));
   // 2. The observer without offset states (the offset is read as heat and alarms).
   const fs::path log = dir / "observe.log";
   const std::vector<std::string> no_offsets{"--sensor-offset-k", "0", "--sensor-offset-walk-k",
@@ -245,27 +256,20 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
                     {}, log),
             0)
       << rt::read_text(log);
-  const core::CaseSpec spec = io::read_case(rt::kCoarseCase);
-  const mesh::TetMesh mesh = mesh::mesh_case(spec);
-  calibration::GeneratorOptions g;
-  g.mesh_scale = 1;
-  g.step_s = spec.thermal.step;
-  calibration::Instrumentation inst;
-  inst.sensor_points = {"T02", "T08", "T11", "T14", "T17", "T25", "T33", "T44", "T52"};
+  const OwnMeshGenerator o;
   std::mt19937_64 rng = core::generator(11, 0);
   calibration::InjectedEffect heat = calibration::random_effect(
-      calibration::EffectKind::heat_input, spec, mesh, inst.sensor_points, rng);
+      calibration::EffectKind::heat_input, o.spec, o.mesh, o.inst.sensor_points, rng);
   heat.magnitude = 15;  // W, within the generator's range (4 .. 25 W)
   heat.follows_speed = false;
-  const auto gen = calibration::generator_case(spec, g);
   std::vector<std::string> runs;
   const double hours[] = {2, 3, 4};
   for (int k = 0; k < 3; ++k) {
     const core::DutyCycle duty = calibration::random_duty_cycle(hours[k], rng);
     runs.push_back((dir / ("run_" + std::to_string(k))).string());
-    io::write_measured_run(
-        runs.back(), calibration::synthetic_run(mesh, calibration::truth_case(gen, heat, duty, k),
-                                                heat, inst, g, "heat " + std::to_string(k), rng));
+    io::write_measured_run(runs.back(), calibration::synthetic_run(
+                                            o.mesh, calibration::truth_case(o.gen, heat, duty, k),
+                                            heat, o.inst, o.g, "heat " + std::to_string(k), rng));
   }
   ASSERT_EQ(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data", runs[2],
                      "--out", observed.string(), "--quiet"},
@@ -291,8 +295,7 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
   ASSERT_FALSE(j["effects"].empty()) << j.dump(1);
   const auto& first = j["effects"][0];
   EXPECT_EQ(first["kind"], "heat_input") << j.dump(1);
-  const auto& c = first["location"]["centre_m"];
-  const Eigen::Vector3d found(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+  const Eigen::Vector3d found = tt::test::effect_centre_m(first);
   std::printf(
       "[observe then calibrate] calibrate: %s at (%.3f, %.3f, %.3f), %s W; u RMS %.3f -> "
       "%.3f um\n",

@@ -35,6 +35,11 @@ struct Study {
   mesh::TetMesh mesh;
   solvers::Twin twin;
   core::DutyCycle duty;
+  /// The generator on the case's own mesh and step (a clean run is the declared model), reading
+  /// kSensors.
+  calibration::GeneratorOptions g;
+  core::CaseSpec gen;
+  calibration::Instrumentation inst;
   io::MeasuredRun clean_truth;  /// a generated run without effect, without noise
   io::MeasuredRun clean, heat;  /// noisy generated runs: no effect, an undeclared heat input
 };
@@ -53,11 +58,12 @@ class Observer : public ::testing::Test {
     s_->mesh = mesh::mesh_case(s_->spec);
     s_->twin = solvers::case_twin(s_->mesh, s_->spec);
     s_->duty = duty_cycle(7);
-    calibration::GeneratorOptions g;
-    g.mesh_scale = 1;  // the case's own mesh and step: a clean run is the declared model
+    calibration::GeneratorOptions& g = s_->g;
+    g.mesh_scale = 1;
     g.step_s = s_->spec.thermal.step;
-    const core::CaseSpec gen = calibration::generator_case(s_->spec, g);
-    calibration::Instrumentation inst;
+    s_->gen = calibration::generator_case(s_->spec, g);
+    const core::CaseSpec& gen = s_->gen;
+    calibration::Instrumentation& inst = s_->inst;
     inst.sensor_points = kSensors;
     std::mt19937_64 rng = core::generator(11, 0);
     const calibration::InjectedEffect none;
@@ -510,12 +516,6 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
   // truth runs (the generator on the case's own mesh) with one material's expansion coefficient
   // 10 % up move the drift by 0.1 d_m and no temperature; the observer reads the clean truth.
   const core::CaseSpec c = run_spec();
-  calibration::GeneratorOptions g;
-  g.mesh_scale = 1;
-  g.step_s = s_->spec.thermal.step;
-  const core::CaseSpec gen = calibration::generator_case(s_->spec, g);
-  calibration::Instrumentation inst;
-  inst.sensor_points = kSensors;
   const Eigen::MatrixXd clean = s_->clean_truth.displacement.leftCols(3);
   Eigen::MatrixXd sum_squares = Eigen::MatrixXd::Zero(clean.rows(), 3);
   for (std::size_t m = 0; m < s_->spec.materials.size(); ++m) {
@@ -524,8 +524,9 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
     e.kind = calibration::EffectKind::material_parameter;
     e.target = s_->spec.materials[m].name + ".expansion";
     e.magnitude = 0.1;
-    const io::MeasuredRun run = calibration::clean_run(
-        s_->mesh, calibration::truth_case(gen, e, s_->duty, 2), e, inst, g, "expansion");
+    const io::MeasuredRun run =
+        calibration::clean_run(s_->mesh, calibration::truth_case(s_->gen, e, s_->duty, 2), e,
+                               s_->inst, s_->g, "expansion");
     EXPECT_LT((run.temperature - s_->clean_truth.temperature).cwiseAbs().maxCoeff(), 1e-9);
     Eigen::MatrixXd part = (run.displacement.leftCols(3) - clean) / 0.1;
     part.rowwise() -= part.row(0);  // the drift: from t = 0
