@@ -467,11 +467,14 @@ Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const 
   if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
   if (z_open_.size() != 0)
     var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
-  for (Eigen::Index m = 0; m < n.expansion_relative_sigma.size(); ++m)
-    if (n.expansion_relative_sigma(m) > 0)
-      var += (n.expansion_relative_sigma(m) *
-              (setup_.target_expansion[static_cast<std::size_t>(m)] * (x_.head(r_) - z0_)).array())
-                 .square();
+  if (n.expansion_relative_sigma.size() != 0) {
+    const Eigen::VectorXd dz = x_.head(r_) - z0_;  // the states' change: the drift's, per material
+    for (Eigen::Index m = 0; m < n.expansion_relative_sigma.size(); ++m)
+      if (n.expansion_relative_sigma(m) > 0)
+        var += (n.expansion_relative_sigma(m) *
+                (setup_.target_expansion[static_cast<std::size_t>(m)] * dz).array())
+                   .square();
+  }
   return var.sqrt().matrix();
 }
 
