@@ -48,7 +48,7 @@ int observe_command(const ObserveArgs& args) {
   out.commit();
   const solvers::ObserverRun& r = report.result;
   // A faulty sensor is a warning, written even with --quiet.
-  for (const solvers::SensorFault& f : r.sensor_faults)
+  for (const solvers::HeldSensor& f : r.sensor_faults)
     std::cerr << "thermotwin: observe: warning: sensor "
               << report.sensors[static_cast<std::size_t>(f.sensor)]
               << " reads off by an offset (observer.json sensor_faults) since t = " << f.since_s
@@ -59,6 +59,11 @@ int observe_command(const ObserveArgs& args) {
                     ? "recalibrate since t = " + std::to_string(r.recalibrate_since_s) + " s"
                     : std::string(r.sensor_faults.empty() ? "ok" : "sensor_fault"))
             << "\n";
+  for (const solvers::HeldSensor& d : r.model_departures)
+    std::cerr << "thermotwin: observe: sensor "
+              << report.sensors[static_cast<std::size_t>(d.sensor)]
+              << " read away from the declared model's run since t = " << d.since_s
+              << " s (observer.json model_departures)\n";
   return 0;
 }
 

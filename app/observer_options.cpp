@@ -139,6 +139,12 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
                   "--sustain-s is reported faulty, by name (status sensor_fault; default 4, 0: "
                   "no such test)")
       ->check(non_negative_number());
+  command
+      .add_option("--model-residual-sigmas", o.model_residual_sigmas,
+                  "a sensor whose reading stays more than this many of its sigmas from the "
+                  "declared model's own run (no unknown input, no correction) for --sustain-s "
+                  "says recalibrate (observer.json model_departures; default 3, 0: no such test)")
+      ->check(non_negative_number());
   command.add_flag("--widen-on-inconsistency", o.widen_on_inconsistency,
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
@@ -169,6 +175,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   setup.consistency.sustain_s = o.sustain_s;
   setup.consistency.probability = o.probability;
   setup.consistency.sensor_fault_sigmas = o.sensor_fault_sigmas;
+  setup.consistency.model_residual_sigmas = o.model_residual_sigmas;
   return setup;
 }
 

@@ -495,6 +495,10 @@ int main(int argc, char** argv) {
                                           fmt(run.recalibrate_since_s, 5) + ")"
                                     : std::string("none"))
                 << "\n";
+      for (const solvers::HeldSensor& d : run.model_departures)
+        std::cout << name << ": " << sensors[static_cast<std::size_t>(d.sensor)]
+                  << " away from the declared model's run since " << d.since_s << " s, raised at "
+                  << d.raised_s << " s\n";
     };
     // CHANGED_TRAINING's correction term (ObserverNoise::correction_relative_sigma): every run
     // kept to be observed again (sets 0-2 as above, 3: the changed-machine training runs).
@@ -529,7 +533,7 @@ int main(int argc, char** argv) {
       if (changed_training)
         replays.push_back({r.spec, campaign_noise, g.time, g.temperature, truth, 0, r.name});
       held_fault_runs += !run.sensor_faults.empty();
-      for (const solvers::SensorFault& f : run.sensor_faults)
+      for (const solvers::HeldSensor& f : run.sensor_faults)
         std::cout << r.name << ": sensor fault " << sensors[static_cast<std::size_t>(f.sensor)]
                   << " since " << f.since_s << " s, raised at " << f.raised_s << " s\n";
       held.regression.add(pr, sr, truth);
@@ -552,7 +556,7 @@ int main(int argc, char** argv) {
     // and their truths.
     std::vector<solvers::ObserverRun> changed_runs;
     std::vector<Eigen::MatrixXd> changed_truth;
-    // Sensor faults (the offsets' test, solvers::SensorFaultMonitor): runs that raised one.
+    // Sensor faults (the offsets' test, solvers::HeldBeyondMonitor): runs that raised one.
     int clean_fault_runs = 0, effect_fault_runs = 0;
     double clean_fault_hours = 0;
     if (gen_hours > 0) {
@@ -661,7 +665,7 @@ int main(int argc, char** argv) {
                              name + " " + kind + (effect.present ? " " + effect.target : "")});
         (effect.present ? effect_fault_runs : clean_fault_runs) += !run.sensor_faults.empty();
         if (!effect.present) clean_fault_hours += gen_hours;
-        for (const solvers::SensorFault& f : run.sensor_faults)
+        for (const solvers::HeldSensor& f : run.sensor_faults)
           std::cout << name << ": sensor fault " << sensors[static_cast<std::size_t>(f.sensor)]
                     << " since " << f.since_s << " s, raised at " << f.raised_s << " s\n";
         const auto [pr, sr] = regression_on(reg, g);

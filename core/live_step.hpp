@@ -50,10 +50,11 @@ struct LiveStep {
   /// columns (indices into the stream's columns) held at their last good reading or left out,
   /// or still missing while waiting
   std::vector<int> held;
-  /// the model no longer describes the machine (the observer's innovation test): recalibrate
+  /// the model no longer describes the machine (the observer's innovation test, a reading held
+  /// away from the declared model's run, a sensor offset that appeared late): recalibrate
   bool recalibrate = false;
   /// columns (indices into the stream's columns) of sensors the observer found off by an offset
-  /// it is sure of (solvers::SensorFault), in the order they were raised: check these sensors
+  /// it is sure of (solvers::HeldSensor), in the order they were raised: check these sensors
   std::vector<int> faulty;
 };
 

@@ -26,7 +26,7 @@ std::string observer_csv(const solvers::ObserverRun& r,
           << r.drift_sigma(i, k) * core::kMicrometresPerMetre;
     const bool alarm = r.recalibrate && r.times(i) >= r.recalibrate_at_s;
     std::vector<std::string> faulty;
-    for (const solvers::SensorFault& f : r.sensor_faults)
+    for (const solvers::HeldSensor& f : r.sensor_faults)
       if (r.times(i) >= f.raised_s) faulty.push_back(sensors[static_cast<std::size_t>(f.sensor)]);
     const std::string status = model_status(alarm, faulty);
     csv << "," << r.nis(i) << "," << r.dof(i) << "," << r.window_nis(i) << "," << r.window_bound(i)
@@ -56,7 +56,7 @@ nlohmann::json sensor_faults_json(const solvers::ObserverRun& r,
                                   const std::vector<std::string>& sensors) {
   nlohmann::json faults = nlohmann::json::array();
   const Eigen::Index last = r.times.size() - 1;
-  for (const solvers::SensorFault& f : r.sensor_faults) {
+  for (const solvers::HeldSensor& f : r.sensor_faults) {
     const std::string& id = sensors[static_cast<std::size_t>(f.sensor)];
     const auto it =
         std::find(r.unknown_input_names.begin(), r.unknown_input_names.end(), "offset:" + id);
@@ -68,6 +68,18 @@ nlohmann::json sensor_faults_json(const solvers::ObserverRun& r,
                       {"raised_s", f.raised_s}});
   }
   return faults;
+}
+
+/// Each sensor whose readings stayed away from the declared model's run: its id, since when and
+/// when it was raised [s].
+nlohmann::json departures_json(const solvers::ObserverRun& r,
+                               const std::vector<std::string>& sensors) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const solvers::HeldSensor& d : r.model_departures)
+    out.push_back({{"sensor", sensors[static_cast<std::size_t>(d.sensor)]},
+                   {"since_s", d.since_s},
+                   {"raised_s", d.raised_s}});
+  return out;
 }
 
 std::string final_status(const solvers::ObserverRun& r) {
@@ -92,10 +104,12 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
        {{"window_s", setup.consistency.window_s},
         {"sustain_s", setup.consistency.sustain_s},
         {"probability", setup.consistency.probability},
-        {"sensor_fault_sigmas", setup.consistency.sensor_fault_sigmas}}},
+        {"sensor_fault_sigmas", setup.consistency.sensor_fault_sigmas},
+        {"model_residual_sigmas", setup.consistency.model_residual_sigmas}}},
       {"status", final_status(r)},
       {"unknown_inputs", unknown_inputs_json(r)},
       {"sensor_faults", sensor_faults_json(r, report.sensors)},
+      {"model_departures", departures_json(r, report.sensors)},
       {"recalibrate_since_s", nullptr},
       {"recalibrate_raised_s", nullptr}};
   if (r.recalibrate) {

@@ -181,29 +181,29 @@ double InnovationMonitor::change_start() const {
   return t_[std::min(after, t_.size() - 1)];
 }
 
-void SensorFaultMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& offset,
-                             const Eigen::Ref<const Eigen::VectorXd>& sigma) {
+void HeldBeyondMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
+                            const Eigen::Ref<const Eigen::VectorXd>& sigma) {
   if (!(sigmas_ > 0)) return;
-  const auto n = static_cast<std::size_t>(offset.size());
+  const auto n = static_cast<std::size_t>(value.size());
   beyond_since_.resize(n, std::numeric_limits<double>::quiet_NaN());
   raised_.resize(n, false);
   const auto beyond = [&](std::size_t k) {
     const auto i = static_cast<Eigen::Index>(k);
-    return std::abs(offset(i)) > sigmas_ * sigma(i);
+    return std::abs(value(i)) > sigmas_ * sigma(i);
   };
-  // Several sensors not yet faulty beyond the bound together: heat or air read as offsets, more
-  // likely than several sensors failing at once; none of them is counted.
+  // Exclusive: several sensors not yet raised beyond the bound together are heat or air read as
+  // offsets, more likely than several sensors failing at once; none of them is counted.
   std::size_t together = 0;
   for (std::size_t k = 0; k < n; ++k) together += !raised_[k] && beyond(k);
   for (std::size_t k = 0; k < n; ++k) {
-    if (!beyond(k) || (together > 1 && !raised_[k])) {
+    if (!beyond(k) || (exclusive_ && together > 1 && !raised_[k])) {
       beyond_since_[k] = std::numeric_limits<double>::quiet_NaN();
       continue;
     }
     if (std::isnan(beyond_since_[k])) beyond_since_[k] = t;
     if (!raised_[k] && t - beyond_since_[k] >= sustain_s_) {
       raised_[k] = true;
-      faults_.push_back({static_cast<int>(k), beyond_since_[k], t});
+      held_.push_back({static_cast<int>(k), beyond_since_[k], t});
     }
   }
 }
@@ -215,7 +215,8 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       setup_(setup),
       stepper_(system, spec),
       monitor_(setup.consistency),
-      faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s) {
+      faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s),
+      departures_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false) {
   r_ = system.states();
   const auto fail = [](const std::string& what) { throw core::SolverError("observer: " + what); };
   if (setup_.sensor_rows.cols() != r_ || setup_.target_rows.cols() != r_)
@@ -236,9 +237,11 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                    n.correction_relative_sigma})
     if (!(v >= 0) || !std::isfinite(v))
       fail("process noise " + number(v) + ": expected a finite value >= 0");
-  const double fault = setup_.consistency.sensor_fault_sigmas;
-  if (!(fault >= 0) || !std::isfinite(fault))
-    fail("sensor fault bound " + number(fault) + " sigma: expected a finite value >= 0");
+  for (double bound :
+       {setup_.consistency.sensor_fault_sigmas, setup_.consistency.model_residual_sigmas})
+    if (!(bound >= 0) || !std::isfinite(bound))
+      fail("sensor fault or model residual bound " + number(bound) +
+           " sigma: expected a finite value >= 0");
   if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup_);
   const Eigen::VectorXd& scale = n.drift_sigma_scale;
   if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
@@ -281,7 +284,8 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                           ? spec.thermal.initial_temperature_c + core::kCelsiusOffset
                           : setup_.initial_temperature_k;
   z0_ = t0_k * system.uniform;
-  if (n.correction_relative_sigma > 0) z_open_ = z0_;
+  if (n.correction_relative_sigma > 0 || setup_.consistency.model_residual_sigmas > 0)
+    z_open_ = z0_;
   x_ = Eigen::VectorXd::Zero(r_ + nb_);
   x_.head(r_) = z0_;
   p_ = Eigen::MatrixXd::Zero(r_ + nb_, r_ + nb_);
@@ -436,24 +440,49 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
     e.drift_sigma *= std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
   e.recalibrate_since_s = monitor_.since_s();
+  test_departures(t, readings, e);
+  return e;
+}
+
+void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
+                                     ObserverEstimate& e) {
+  const Eigen::Index m = setup_.sensor_rows.rows();
+  const auto earliest = [this](const std::vector<HeldSensor>& raised, std::size_t from) {
+    for (std::size_t k = from; k < raised.size(); ++k)
+      if (std::isnan(departure_s_) || raised[k].since_s < departure_s_)
+        departure_s_ = raised[k].since_s;
+  };
+  Eigen::VectorXd offset = Eigen::VectorXd::Zero(m), offset_sigma = offset;
   if (offsets_ >= 0) {
     const Eigen::Index o = r_ + offsets_;
-    const std::size_t before = faults_.faults().size();
-    faults_.add(t, x_.segment(o, m), p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt());
+    offset = x_.segment(o, m);
+    offset_sigma = p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt();
+    const std::size_t before = faults_.raised().size();
+    faults_.add(t, offset, offset_sigma);
     // An offset that appears after the first consistency window was not there from the start:
     // the sensor may have failed, or the machine changed beside it (heat near one sensor is
     // followed by its offset state and leaves the innovations consistent); the filter cannot
     // tell, so it also says recalibrate, dated from the offset's crossing.
-    for (std::size_t k = before; k < faults_.faults().size(); ++k)
-      if (faults_.faults()[k].since_s > setup_.consistency.window_s && std::isnan(late_fault_s_))
-        late_fault_s_ = faults_.faults()[k].since_s;
+    for (std::size_t k = before; k < faults_.raised().size(); ++k)
+      if (faults_.raised()[k].since_s > setup_.consistency.window_s) earliest(faults_.raised(), k);
   }
-  if (!std::isnan(late_fault_s_)) {
+  if (setup_.consistency.model_residual_sigmas > 0) {
+    // Each reading against the declared model's own run, less the sensor's estimated offset; a
+    // sensor whose offset is beyond its fault bound is left out (NaN: not beyond).
+    const double fault = setup_.consistency.sensor_fault_sigmas;
+    Eigen::VectorXd residual = readings - setup_.sensor_rows * z_open_ - offset;
+    for (Eigen::Index k = 0; k < m; ++k)
+      if (fault > 0 && std::abs(offset(k)) > fault * offset_sigma(k))
+        residual(k) = std::numeric_limits<double>::quiet_NaN();
+    const std::size_t before = departures_.raised().size();
+    departures_.add(t, residual, setup_.noise.sensor_sigma_k);
+    earliest(departures_.raised(), before);
+  }
+  if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
-        e.recalibrate ? std::min(e.recalibrate_since_s, late_fault_s_) : late_fault_s_;
+        e.recalibrate ? std::min(e.recalibrate_since_s, departure_s_) : departure_s_;
     e.recalibrate = true;
   }
-  return e;
 }
 
 Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const {
@@ -465,7 +494,7 @@ Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const 
                            .array() +
                        (n.drift_relative_sigma * drift.array()).square();
   if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
-  if (z_open_.size() != 0)
+  if (n.correction_relative_sigma > 0)
     var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
   if (n.expansion_relative_sigma.size() != 0) {
     const Eigen::VectorXd dz = x_.head(r_) - z0_;  // the states' change: the drift's, per material
@@ -535,7 +564,10 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
       run.recalibrate_at_s = e.time;
     }
   }
-  if (n > 0) run.sensor_faults = kf.sensor_faults();
+  if (n > 0) {
+    run.sensor_faults = kf.sensor_faults();
+    run.model_departures = kf.model_departures();
+  }
   return run;
 }
 

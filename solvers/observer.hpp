@@ -91,11 +91,21 @@ struct ConsistencyOptions {
   double sustain_s = 900;
   /// The sensors' offsets (ObserverNoise::sensor_offset_initial_k): a sensor whose estimated
   /// offset stays beyond this many of its standard deviations for `sustain_s` is reported faulty
-  /// (SensorFaultMonitor); 0: no such test. Under the noise model an offset's estimate is beyond
+  /// (HeldBeyondMonitor); 0: no such test. Under the noise model an offset's estimate is beyond
   /// 4 sigma with probability 6e-5 (two-sided), and the test asks it to stay there. A fault
   /// whose offset crossed the bound after the first window (`window_s`) was not there from the
   /// start, and heat near that one sensor looks the same: it raises recalibrate as well.
   double sensor_fault_sigmas = 4;
+  /// The declared model's own run (the case's inputs stepped with no unknown input and no
+  /// reading) against the readings: a sensor whose reading stays more than this many of its
+  /// sigmas (ObserverNoise::sensor_sigma_k) from it for `sustain_s` says the machine is no longer
+  /// the declared one, and raises recalibrate dated from when it began to stay there. The
+  /// unknown inputs follow heat, air and films that the case does not declare, so their
+  /// innovations stay consistent and the NIS test alone sees none of them; the declared model's
+  /// run does not follow them. With offset states the sensor's estimated offset is taken off its
+  /// reading, and a sensor whose offset is beyond its fault bound is left out (its own fault,
+  /// not the machine's). 0: no such test.
+  double model_residual_sigmas = 3;
 };
 
 /// The observer's set-up on a reduced system.
@@ -158,32 +168,35 @@ class InnovationMonitor {
   bool alarm_ = false;
 };
 
-/// A sensor whose reading is off by an offset the observer is sure of (SensorFaultMonitor): not the
-/// machine's change but the sensor's (its mounting, its cable, its calibration).
-struct SensorFault {
+/// A sensor whose value (its offset state, or its reading's distance from the declared model's
+/// run) was held beyond a bound (HeldBeyondMonitor): a sensor fault, or the machine's departure.
+struct HeldSensor {
   int sensor = 0;                                              /// index into the setup's sensors
   double since_s = std::numeric_limits<double>::quiet_NaN();   /// first beyond the bound
   double raised_s = std::numeric_limits<double>::quiet_NaN();  /// held for sustain_s: raised
 };
 
-/// The test of the sensors' offsets, fed one assimilation at a time: sensor k is faulty once
-/// |offset_k| > sigmas * sigma_k has held for sustain_s (ConsistencyOptions), as the only sensor
-/// not yet faulty beyond the bound (several together are heat or air read as offsets, likelier
-/// than several sensors failing at once: their clocks restart); a fault stays raised.
-class SensorFaultMonitor {
+/// A per-sensor value held beyond a bound, fed one assimilation at a time: sensor k is raised
+/// once |value_k| > sigmas * sigma_k has held for sustain_s (a NaN value is not beyond); a raised
+/// sensor stays raised. `exclusive` (the offsets' fault test): only as the only sensor not yet
+/// raised beyond the bound (several together are heat or air read as offsets, likelier than
+/// several sensors failing at once: their clocks restart).
+class HeldBeyondMonitor {
  public:
-  SensorFaultMonitor(double sigmas, double sustain_s) : sigmas_(sigmas), sustain_s_(sustain_s) {}
-  /// The offsets' estimates and standard deviations at time t [K], one per sensor.
-  void add(double t, const Eigen::Ref<const Eigen::VectorXd>& offset,
+  HeldBeyondMonitor(double sigmas, double sustain_s, bool exclusive = true)
+      : sigmas_(sigmas), sustain_s_(sustain_s), exclusive_(exclusive) {}
+  /// The values and their standard deviations at time t, one per sensor.
+  void add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
            const Eigen::Ref<const Eigen::VectorXd>& sigma);
-  /// The faults raised so far, in the order they were raised.
-  const std::vector<SensorFault>& faults() const { return faults_; }
+  /// The sensors raised so far, in the order they were raised.
+  const std::vector<HeldSensor>& raised() const { return held_; }
 
  private:
   double sigmas_, sustain_s_;
+  bool exclusive_;
   std::vector<double> beyond_since_;  /// per sensor: NaN while within the bound
   std::vector<bool> raised_;
-  std::vector<SensorFault> faults_;
+  std::vector<HeldSensor> held_;
 };
 
 /// What the observer says after one assimilation.
@@ -238,7 +251,10 @@ class KalmanObserver {
   const InnovationMonitor& monitor() const { return monitor_; }
   /// The sensors found faulty so far (an offset beyond ConsistencyOptions::sensor_fault_sigmas),
   /// in the order they were raised; empty without offset states.
-  const std::vector<SensorFault>& sensor_faults() const { return faults_.faults(); }
+  const std::vector<HeldSensor>& sensor_faults() const { return faults_.raised(); }
+  /// The sensors whose readings stayed away from the declared model's own run
+  /// (ConsistencyOptions::model_residual_sigmas), in the order they were raised.
+  const std::vector<HeldSensor>& model_departures() const { return departures_.raised(); }
 
  private:
   void advance_to(double t);
@@ -247,6 +263,9 @@ class KalmanObserver {
   /// The drift's standard deviation at the current estimate, `drift` = L (z - z(0)): the
   /// filter's, the drift rows' relative error, the scale, the correction's error (ObserverNoise).
   Eigen::VectorXd drift_sigma(const Eigen::VectorXd& drift) const;
+  /// The tests beside the NIS's after an assimilation at t (the offsets' faults, the readings
+  /// against the declared model's run): raises `e.recalibrate` where they say so.
+  void test_departures(double t, const Eigen::VectorXd& readings, ObserverEstimate& e);
 
   const ReducedThermalSystem& sys_;
   const core::CaseSpec& spec_;
@@ -258,14 +277,15 @@ class KalmanObserver {
   Eigen::Index offsets_ = 0;             /// the sensor offsets' first index in b (-1: none)
   Eigen::VectorXd bias_walk_;            /// per bias: variance per second
   Eigen::VectorXd x_, z0_;
-  Eigen::VectorXd z_open_;  /// the declared model's own run (correction_relative_sigma > 0)
+  Eigen::VectorXd z_open_;  /// the declared model's own run (empty when no test uses it)
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
-  SensorFaultMonitor faults_;
-  /// The first fault whose offset appeared after the first consistency window: its crossing [s]
-  /// (NaN: none). It raises recalibrate too.
-  double late_fault_s_ = std::numeric_limits<double>::quiet_NaN();
+  HeldBeyondMonitor faults_, departures_;
+  /// The earliest start of what says recalibrate besides the NIS test [s] (NaN: none yet): a
+  /// fault whose offset appeared after the first consistency window, or a reading held away
+  /// from the declared model's run.
+  double departure_s_ = std::numeric_limits<double>::quiet_NaN();
   CovarianceMap* map_ = nullptr;  /// while advance() runs: the steps' map, accumulated
 };
 
@@ -283,7 +303,10 @@ struct ObserverRun {
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();  /// change point
   double recalibrate_at_s = std::numeric_limits<double>::quiet_NaN();     /// when it was raised
-  std::vector<SensorFault> sensor_faults;  /// raised over the run, in that order
+  std::vector<HeldSensor> sensor_faults;  /// raised over the run, in that order
+  /// Readings held away from the declared model's run, in the order raised (the first says
+  /// recalibrate; ConsistencyOptions::model_residual_sigmas).
+  std::vector<HeldSensor> model_departures;
 };
 
 /// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle).

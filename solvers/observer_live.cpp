@@ -72,7 +72,7 @@ const core::LiveStep& LiveObserver::next(double time,
   step_.sigma = e.drift_sigma;
   step_.recalibrate = e.recalibrate;
   // Faults are only ever added: map the new ones to their columns.
-  const std::vector<SensorFault>& faults = filter_->sensor_faults();
+  const std::vector<HeldSensor>& faults = filter_->sensor_faults();
   for (std::size_t k = step_.faulty.size(); k < faults.size(); ++k)
     step_.faulty.push_back(sensor_columns_[static_cast<std::size_t>(faults[k].sensor)]);
   step_.status = step_.held.empty() ? core::SampleStatus::ok : core::SampleStatus::held;

@@ -34,8 +34,8 @@ class LiveObserver {
   /// [rpm]), NaN where missing. `late` for a time not after the last sample used; `waiting` until
   /// a speed has been read; `held` with the columns whose readings were missing (sensors left out
   /// of the update, the speed held). Predicted drift and sigma per target [m] (the setup's
-  /// targets); recalibrate once the innovation test raised it; faulty: the columns of the sensors
-  /// whose offset test raised a fault (SensorFaultMonitor).
+  /// targets); recalibrate once the observer raised it; faulty: the columns of the sensors
+  /// whose offset test raised a fault (HeldBeyondMonitor).
   const core::LiveStep& next(double time, const Eigen::Ref<const Eigen::VectorXd>& values);
 
   const std::vector<std::string>& target_names() const { return target_names_; }

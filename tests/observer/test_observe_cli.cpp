@@ -96,6 +96,10 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_LE(j["recalibrate_raised_s"].get<double>(), 3600.0);
   EXPECT_TRUE(j["unknown_inputs"].contains("air"));
   EXPECT_FALSE(j["unknown_inputs"].contains("offset:T11"));
+  // Without offset states T11 also reads away from the declared model's run, and is named.
+  EXPECT_EQ(j["consistency"]["model_residual_sigmas"], 3.0);
+  ASSERT_FALSE(j["model_departures"].empty());
+  EXPECT_EQ(j["model_departures"][0]["sensor"], "T11");
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", out));
   // With the default offset states the offset is found as T11's, and explained: no alarm, but
   // the sensor is reported (status sensor_fault, below).
@@ -121,6 +125,8 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_NEAR(jo["sensor_faults"][0]["offset_K"].get<double>(), 0.6, 0.1);
   EXPECT_LE(jo["sensor_faults"][0]["since_s"].get<double>(), 900.0);
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", with_offsets));
+  // T11's offset is its own: it is left out of the declared run's test, and nothing else departs.
+  EXPECT_TRUE(jo["model_departures"].empty()) << jo["model_departures"].dump();
   EXPECT_TRUE(j["sensor_faults"].empty());  // without offset states no offset test
   // Each material's expansion error widens the drift's sigma and leaves the prediction.
   const fs::path expansion = dir / "expansion";
@@ -317,7 +323,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
     for (const char* flag :
          {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
           "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale",
-          "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma"})
+          "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma",
+          "--model-residual-sigmas"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
@@ -329,6 +336,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
        "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
       {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},
       {{"--sensor-fault-sigmas", "-1"}, "--sensor-fault-sigmas: -1: expected a finite number >= 0"},
+      {{"--model-residual-sigmas", "nan"},
+       "--model-residual-sigmas: nan: expected a finite number >= 0"},
       {{"--expansion-relative-sigma", "-0.1"},
        "--expansion-relative-sigma: -0.1: expected a finite number >= 0"},
       {{"--widen-on-inconsistency=maybe"}, "--widen-on-inconsistency"}};
