@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/dense_product.hpp"
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 
@@ -24,10 +25,10 @@ std::string shape(const Eigen::MatrixXd& m) {
 /// The covariance at the next reading before its update: F P F^T + Q, kept symmetric.
 Eigen::MatrixXd predicted(const Eigen::MatrixXd& p, const Eigen::MatrixXd& f,
                           const Eigen::MatrixXd& q) {
-  // Coefficient-wise products, as the observer's: matrices of ~100 rows do not pay for Eigen's
-  // OpenMP-parallel GEMM, whose threads wait on each other when the cores are shared.
-  const Eigen::MatrixXd fp = f.lazyProduct(p);
-  const Eigen::MatrixXd fpf = fp.lazyProduct(f.transpose());
+  // core::dense_product, as the observer's: coefficient-wise for ~100 rows, blocked for several
+  // hundred.
+  const Eigen::MatrixXd fp = core::dense_product(f, p);
+  const Eigen::MatrixXd fpf = core::dense_product(fp, f.transpose());
   return 0.5 * (fpf + fpf.transpose()) + q;
 }
 

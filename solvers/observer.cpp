@@ -6,6 +6,7 @@
 #include <iterator>
 #include <string>
 
+#include "core/dense_product.hpp"
 #include "core/directions.hpp"
 #include "core/errors.hpp"
 #include "core/units.hpp"
@@ -305,12 +306,13 @@ Eigen::MatrixXd propagated(const Eigen::MatrixXd& p, const Eigen::MatrixXd& phi,
   const Eigen::Index r = phi.rows(), nb = gamma.cols();
   const auto pzz = p.topLeftCorner(r, r), pzb = p.topRightCorner(r, nb),
              pbb = p.bottomRightCorner(nb, nb);
-  // Coefficient-wise products: matrices of ~100 rows do not pay for Eigen's OpenMP-parallel GEMM,
-  // whose threads wait on each other every step when the cores are shared (as in the stepper).
-  const Eigen::MatrixXd left = phi.lazyProduct(pzz) + gamma.lazyProduct(pzb.transpose());  // r x r
-  const Eigen::MatrixXd cross = phi.lazyProduct(pzb) + gamma.lazyProduct(pbb);             // r x nb
+  // core::dense_product: coefficient-wise for ~100 rows (Eigen's OpenMP-parallel GEMM's threads
+  // wait on each other every step when the cores are shared), blocked for several hundred.
+  const Eigen::MatrixXd left =
+      core::dense_product(phi, pzz) + gamma.lazyProduct(pzb.transpose());       // r x r
+  const Eigen::MatrixXd cross = phi.lazyProduct(pzb) + gamma.lazyProduct(pbb);  // r x nb
   const Eigen::MatrixXd zz =
-      left.lazyProduct(phi.transpose()) + cross.lazyProduct(gamma.transpose());
+      core::dense_product(left, phi.transpose()) + cross.lazyProduct(gamma.transpose());
   Eigen::MatrixXd out(p.rows(), p.cols());
   out.topLeftCorner(r, r) = 0.5 * (zz + zz.transpose());
   out.topRightCorner(r, nb) = cross;
@@ -347,7 +349,7 @@ void KalmanObserver::step(double t1) {
   add_process_noise(p_, dt);
   if (map_) {
     Eigen::MatrixXd& f = map_->transition;
-    f.topRows(r_) = (phi.lazyProduct(f.topRows(r_)) + gamma.lazyProduct(f.bottomRows(nb_))).eval();
+    f.topRows(r_) = core::dense_product(phi, f.topRows(r_)) + gamma.lazyProduct(f.bottomRows(nb_));
     map_->process = propagated(map_->process, phi, gamma);
     add_process_noise(map_->process, dt);
   }

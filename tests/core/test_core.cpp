@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/dense_product.hpp"
 #include "core/enum_names.hpp"
 #include "core/errors.hpp"
 #include "core/parallel.hpp"
@@ -77,4 +78,23 @@ TEST(Rng, DerivedSeedsDifferPerStreamAndRepeat) {
   EXPECT_NE(derived_seed(1, 0), derived_seed(1, 1));
   EXPECT_NE(derived_seed(1, 0), derived_seed(2, 0));
   EXPECT_EQ(generator(7, 3)(), generator(7, 3)());
+}
+
+TEST(DenseProduct, EitherMethodIsTheProduct) {
+  // Below the work bound the coefficient-wise product, from it the blocked one (rectangular and
+  // transposed operands, as the observer's covariance takes them): both are a b to rounding.
+  for (const Eigen::Index n : {Eigen::Index{40}, Eigen::Index{200}}) {
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Random(n, n + 3);
+    const Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, n + 3);
+    const Eigen::MatrixXd got = dense_product(a, b.transpose());
+    ASSERT_EQ(got.rows(), n);
+    ASSERT_EQ(got.cols(), n);
+    Eigen::MatrixXd want = Eigen::MatrixXd::Zero(n, n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (Eigen::Index j = 0; j < n; ++j)
+        for (Eigen::Index k = 0; k < a.cols(); ++k) want(i, j) += a(i, k) * b(j, k);
+    EXPECT_LT((got - want).cwiseAbs().maxCoeff(), 1e-12 * static_cast<double>(n)) << n << " rows";
+  }
+  EXPECT_LT(40.0 * 43 * 40, kBlockedProductWork);
+  EXPECT_GE(200.0 * 203 * 200, kBlockedProductWork);
 }
