@@ -35,10 +35,13 @@ int fit_command(const FitArgs& args) {
                  "observer on the reduced model (order "
               << (campaign.twin ? campaign.twin->model.states() : 0)
               << ") over the fitting runs first\n";
+  const auto progress = [&](const std::string& line) {
+    if (!args.quiet) std::cerr << "thermotwin: fit: " << line << "\n";
+  };
   const studies::CampaignFitReport report =
       studies::fit_on_campaign(spec, campaign.results,
                                {args.quick, args.network, args.required_sm_um * 1e-6,
-                                campaign.twin ? &*campaign.twin : nullptr, &runs});
+                                campaign.twin ? &*campaign.twin : nullptr, &runs, progress});
   io::write_campaign_fit(out.path(), spec, runs, report, campaign.model);
   out.commit();
   std::cerr << "thermotwin: fit: " << io::campaign_fit_summary(report).dump() << "\n";

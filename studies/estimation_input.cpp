@@ -46,21 +46,23 @@ Eigen::RowVectorXd candidate_row(const solvers::Twin& twin, const std::string& n
 
 }  // namespace
 
-placement::EstimationProblem observer_estimation_problem(const solvers::Twin& twin,
-                                                         const std::vector<core::CaseSpec>& runs,
-                                                         const EstimationCandidates& candidates,
-                                                         const std::vector<std::string>& targets,
-                                                         const solvers::ObserverNoise& noise,
-                                                         double sample_s) {
+placement::EstimationProblem observer_estimation_problem(
+    const solvers::Twin& twin, const std::vector<core::CaseSpec>& runs,
+    const EstimationCandidates& candidates, const std::vector<std::string>& targets,
+    const solvers::ObserverNoise& noise, double sample_s, const Progress& progress) {
   if (runs.empty()) throw core::SolverError("estimation placement: no run to place on");
   solvers::ObserverNoise without_sensors = noise;
   without_sensors.sensor_sigma_k.resize(0);
   const solvers::ObserverSetup setup =
       solvers::twin_observer_setup(twin, runs.front(), {}, without_sensors);
   placement::EstimationProblem p;
-  for (const auto& run : runs)
+  for (const auto& run : runs) {
     p.tracks.push_back(
         observer_covariance_track(twin.model.system, run, setup, reading_times(run, sample_s)));
+    if (progress)
+      progress("placement for estimation: the covariance stepped along duty cycle " +
+               std::to_string(p.tracks.size()) + " of " + std::to_string(runs.size()));
+  }
   // The filter's state is [z; unknown inputs]: the rows read z only.
   const Eigen::Index r = twin.model.states(), n = p.tracks.front().initial.rows();
   const auto count = static_cast<Eigen::Index>(candidates.names.size());

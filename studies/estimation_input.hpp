@@ -11,6 +11,7 @@
 #include "placement/estimation.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
+#include "studies/progress.hpp"
 
 namespace tt::studies {
 
@@ -38,13 +39,12 @@ struct EstimationCandidates {
 /// `sample_s`): the covariance tracks, the candidates' rows and sigmas, and the rows of the
 /// targets `targets` (names of the observer's targets: "dx", "dy", "dz", "<axis point>_dy", ...),
 /// each scaled by noise.drift_sigma_scale when that is set (one factor per observer target).
-/// Throws SolverError for a candidate that is neither a named point nor a node of the twin's
-/// basis, an unknown target, or no run.
-placement::EstimationProblem observer_estimation_problem(const solvers::Twin& twin,
-                                                         const std::vector<core::CaseSpec>& runs,
-                                                         const EstimationCandidates& candidates,
-                                                         const std::vector<std::string>& targets,
-                                                         const solvers::ObserverNoise& noise,
-                                                         double sample_s);
+/// `progress`, when given, gets a line as each run's track is done (the long part: the
+/// covariance stepped along the run). Throws SolverError for a candidate that is neither a named
+/// point nor a node of the twin's basis, an unknown target, or no run.
+placement::EstimationProblem observer_estimation_problem(
+    const solvers::Twin& twin, const std::vector<core::CaseSpec>& runs,
+    const EstimationCandidates& candidates, const std::vector<std::string>& targets,
+    const solvers::ObserverNoise& noise, double sample_s, const Progress& progress = {});
 
 }  // namespace tt::studies

@@ -57,7 +57,7 @@ placement::EstimationProblem fitting_estimation(const core::CaseSpec& spec, cons
   noise.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(h.names.size()),
                                                    candidates.sensor_sigma_k);
   return observer_estimation_problem(*o.twin, cycles, candidates, h.target_names, noise,
-                                     std::max(spec.thermal.output_interval, 300.0));
+                                     std::max(spec.thermal.output_interval, 300.0), o.progress);
 }
 
 /// Sensor sets per placement method and m for one target, as fitting takes them.

@@ -22,6 +22,7 @@
 #include "solvers/twin.hpp"
 #include "studies/axis_fit.hpp"
 #include "studies/network_candidate.hpp"
+#include "studies/progress.hpp"
 
 namespace tt::studies {
 
@@ -37,6 +38,8 @@ struct CampaignFitOptions {
   /// variance over the fitting runs' duty cycles) is one more placement method; nullptr: not.
   const solvers::Twin* twin = nullptr;
   const std::vector<solvers::CampaignRun>* runs = nullptr;
+  /// a line per stage of the long work (placement for estimation's duty cycles); empty: none
+  Progress progress;
 };
 
 /// One TCP target's choice, tested.
