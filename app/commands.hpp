@@ -103,8 +103,8 @@ struct ObserverOptions {
   std::vector<double> drift_sigma_scale;
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
   double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
-  double model_residual_sigmas =
-      3;  /// a reading this many sigmas from the declared run: recalibrate
+  /// a reading held this many sigmas from the declared model's run: recalibrate (0: off)
+  double model_residual_sigmas = 3;
 };
 
 /// compensate --model FIT.json | --rom DIR: live compensation (app/compensate_command.cpp).

@@ -449,10 +449,8 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
 void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
                                      ObserverEstimate& e) {
   const Eigen::Index m = setup_.sensor_rows.rows();
-  const auto earliest = [this](const std::vector<HeldSensor>& raised, std::size_t from) {
-    for (std::size_t k = from; k < raised.size(); ++k)
-      if (std::isnan(departure_s_) || raised[k].since_s < departure_s_)
-        departure_s_ = raised[k].since_s;
+  const auto earliest = [this](double since_s) {
+    if (std::isnan(departure_s_) || since_s < departure_s_) departure_s_ = since_s;
   };
   Eigen::VectorXd offset = Eigen::VectorXd::Zero(m), offset_sigma = offset;
   if (offsets_ >= 0) {
@@ -466,7 +464,8 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
     // followed by its offset state and leaves the innovations consistent); the filter cannot
     // tell, so it also says recalibrate, dated from the offset's crossing.
     for (std::size_t k = before; k < faults_.raised().size(); ++k)
-      if (faults_.raised()[k].since_s > setup_.consistency.window_s) earliest(faults_.raised(), k);
+      if (faults_.raised()[k].since_s > setup_.consistency.window_s)
+        earliest(faults_.raised()[k].since_s);
   }
   if (setup_.consistency.model_residual_sigmas > 0) {
     // Each reading against the declared model's own run, less the sensor's estimated offset; a
@@ -478,7 +477,8 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
         residual(k) = std::numeric_limits<double>::quiet_NaN();
     const std::size_t before = departures_.raised().size();
     departures_.add(t, residual, setup_.noise.sensor_sigma_k);
-    earliest(departures_.raised(), before);
+    for (std::size_t k = before; k < departures_.raised().size(); ++k)
+      earliest(departures_.raised()[k].since_s);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =

@@ -726,6 +726,13 @@ TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
   EXPECT_NEAR(loud.since_s(), 1800.0, 60.0);  // the change point, not the window's end
 }
 
+/// One raised sensor: which, since when and when raised [s].
+void expect_held(const solvers::HeldSensor& h, int sensor, double since_s, double raised_s) {
+  EXPECT_EQ(h.sensor, sensor);
+  EXPECT_DOUBLE_EQ(h.since_s, since_s);
+  EXPECT_DOUBLE_EQ(h.raised_s, raised_s);
+}
+
 TEST(ObserverPieces, HeldBeyondMonitor) {
   // Sensor 1 goes beyond 4 sigma at t = 600 s and stays: raised once at 600 + 300 s. Sensor 0
   // crosses for less than the sustain time, alone (180 s): not raised; then from 1200 s, beside
@@ -738,9 +745,7 @@ TEST(ObserverPieces, HeldBeyondMonitor) {
           Eigen::Vector3d(0.1, 0.1, 0.1));
   }
   ASSERT_EQ(m.raised().size(), 2u);
-  EXPECT_EQ(m.raised()[0].sensor, 1);
-  EXPECT_DOUBLE_EQ(m.raised()[0].since_s, 600.0);
-  EXPECT_DOUBLE_EQ(m.raised()[0].raised_s, 900.0);
+  expect_held(m.raised()[0], 1, 600.0, 900.0);
   EXPECT_EQ(m.raised()[1].sensor, 0);
   EXPECT_DOUBLE_EQ(m.raised()[1].raised_s, 1500.0);
   // Two sensors beyond together, neither faulty yet: heat or air, not two faults. One of them
@@ -750,9 +755,7 @@ TEST(ObserverPieces, HeldBeyondMonitor) {
     pair.add(60.0 * k, Eigen::Vector3d(0.5, k < 20 ? 0.5 : 0.0, 0.0),
              Eigen::Vector3d::Constant(0.1));
   ASSERT_EQ(pair.raised().size(), 1u);
-  EXPECT_EQ(pair.raised()[0].sensor, 0);
-  EXPECT_DOUBLE_EQ(pair.raised()[0].since_s, 1200.0);
-  EXPECT_DOUBLE_EQ(pair.raised()[0].raised_s, 1500.0);
+  expect_held(pair.raised()[0], 0, 1200.0, 1500.0);
   // A bound of 0: no test.
   solvers::HeldBeyondMonitor off(0, 300);
   for (int k = 0; k <= 30; ++k)
@@ -767,12 +770,8 @@ TEST(ObserverPieces, HeldBeyondMonitor) {
     both.add(60.0 * k, Eigen::Vector3d(0.5, k == 12 ? nan : (k >= 8 ? -0.5 : 0.0), 0.29),
              Eigen::Vector3d::Constant(0.1));
   ASSERT_EQ(both.raised().size(), 2u);
-  EXPECT_EQ(both.raised()[0].sensor, 0);
-  EXPECT_DOUBLE_EQ(both.raised()[0].since_s, 0.0);
-  EXPECT_DOUBLE_EQ(both.raised()[0].raised_s, 300.0);
-  EXPECT_EQ(both.raised()[1].sensor, 1);
-  EXPECT_DOUBLE_EQ(both.raised()[1].since_s, 780.0);
-  EXPECT_DOUBLE_EQ(both.raised()[1].raised_s, 1080.0);
+  expect_held(both.raised()[0], 0, 0.0, 300.0);
+  expect_held(both.raised()[1], 1, 780.0, 1080.0);
 }
 
 }  // namespace
