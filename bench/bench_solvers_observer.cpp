@@ -78,6 +78,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/twin.hpp"
+#include "studies/axis_fit.hpp"
 #include "studies/estimation_input.hpp"
 #include "studies/placement_input.hpp"
 
@@ -214,6 +215,31 @@ void add_alarm(Alarms& a, const solvers::ObserverRun& run, double hours) {
     a.delays_s.push_back(run.recalibrate_at_s);
   }
 }
+
+/// Per direction (x, y, z), over the axis points, runs and times but t = 0: squared errors,
+/// samples, and samples inside ±2σ (reported, and times the calibrated scale per target).
+struct AxisScore {
+  Eigen::Array3d ss = Eigen::Array3d::Zero(), truth_ss = Eigen::Array3d::Zero(),
+                 inside = Eigen::Array3d::Zero(), inside_calibrated = Eigen::Array3d::Zero(),
+                 n = Eigen::Array3d::Zero();
+  /// `truth`, `predicted`, `sigma`: #samples x 3 #points [m]; `scale`: per column (empty: none).
+  void add(const Eigen::MatrixXd& predicted, const Eigen::MatrixXd& sigma,
+           const Eigen::MatrixXd& truth, const Eigen::VectorXd& scale) {
+    for (Eigen::Index c = 0; c < truth.cols(); ++c)
+      for (Eigen::Index i = 1; i < truth.rows(); ++i) {
+        const Eigen::Index d = c % 3;
+        const double e = predicted(i, c) - truth(i, c);
+        ss(d) += e * e;
+        truth_ss(d) += truth(i, c) * truth(i, c);
+        n(d) += 1;
+        if (sigma.size() == 0) continue;
+        inside(d) += std::abs(e) <= 2 * sigma(i, c);
+        if (scale.size() != 0) inside_calibrated(d) += std::abs(e) <= 2 * scale(c) * sigma(i, c);
+      }
+  }
+  Eigen::Array3d rms_um() const { return (ss / n).sqrt() * 1e6; }
+  Eigen::Array3d truth_rms_um() const { return (truth_ss / n).sqrt() * 1e6; }
+};
 
 std::string fmt(double v, int digits = 3) {
   std::ostringstream o;
@@ -419,10 +445,17 @@ int main(int argc, char** argv) {
       std::cout << " -> walk " << chosen_walk << " K/sqrt(h)\n";
     }
     const std::vector<solvers::ObserverRun> training = observe_training(campaign_noise, {});
+    // A campaign run's truth as the observer's targets: dy, dz, and the axis points' (dx, dy, dz)
+    // where the case has them.
+    const Eigen::Index axis_columns =
+        3 * static_cast<Eigen::Index>(spec.mechanical.axis_points.size());
+    const auto campaign_truth = [&](int i) {
+      Eigen::MatrixXd t = as_targets(clean[static_cast<std::size_t>(i)].error, 3 + axis_columns);
+      t.rightCols(axis_columns) = results[static_cast<std::size_t>(i)].axis.values;
+      return t;
+    };
     std::vector<Eigen::MatrixXd> training_truth;
-    for (int i : fitted)
-      training_truth.push_back(
-          as_targets(clean[static_cast<std::size_t>(i)].error, training.front().drift.cols()));
+    for (int i : fitted) training_truth.push_back(campaign_truth(i));
     const Eigen::VectorXd training_nees =
         solvers::mean_normalised_squared_error(training, training_truth);
     const Eigen::VectorXd campaign_scale =
@@ -512,6 +545,7 @@ int main(int argc, char** argv) {
     };
     std::vector<Replay> replays;
     int held_fault_runs = 0;
+    std::vector<solvers::ObserverRun> held_runs;  // in split.test's order
     for (int i : split.test) {
       const auto& r = runs[static_cast<std::size_t>(i)];
       const auto& g = noisy_s[static_cast<std::size_t>(i)];
@@ -541,6 +575,78 @@ int main(int argc, char** argv) {
       add_alarm(clean_fast, fast_alarm(r.spec, campaign_noise, g.time, g.temperature),
                 r.spec.duty_cycle.end / 3600);
       line(r.name, "campaign, held out", o, rr, run);
+      held_runs.push_back(run);
+    }
+
+    // 4b. The feed-axis points on the held-out runs (the generator's runs record the TCP only):
+    //     the observer's estimate of every point's error (its targets after the TCP's), and the
+    //     regression on the same sensors per point (studies::axis_fit: each point's model chosen
+    //     on validation among the same candidates, with the probes' noise on its training
+    //     readings), against the true error; and what the axis polynomial a CNC receives from
+    //     each leaves at the points.
+    if (axis_columns > 0) {
+      const auto t_axis = Clock::now();
+      const std::vector<std::string> axis_names = studies::axis_target_names(spec);
+      const std::vector<std::string> observed =
+          solvers::twin_observer_setup(twin, spec, sensors, campaign_noise).target_names;
+      if (!std::equal(axis_names.begin(), axis_names.end(), observed.end() - axis_columns))
+        throw std::runtime_error("the observer's targets are not the axis points' columns");
+      std::vector<fitting::Group> axis_groups;
+      for (std::size_t i = 0; i < clean.size(); ++i) {
+        fitting::Group g = clean[i];
+        g.error.conservativeResize(Eigen::NoChange, 2 + axis_columns);
+        g.error.rightCols(axis_columns) = results[i].axis.values;
+        g.target_names.insert(g.target_names.end(), axis_names.begin(), axis_names.end());
+        // The same draws as `noisy` for the temperatures and dy, dz (temperatures first).
+        axis_groups.push_back(columns(fitting::noisy_group(g, fitting::SensorNoise{}, spec.seed, i),
+                                      chosen, sensors));
+      }
+      const studies::AxisFit axis = studies::axis_fit(
+          spec, axis_groups, split, 2, sets, fitting::default_model_candidates(), std::nullopt, {});
+      AxisScore observer_axis, regression_axis;
+      std::vector<Eigen::MatrixXd> truths, zeros, by_observer, by_regression;
+      for (std::size_t k = 0; k < split.test.size(); ++k) {
+        const auto i = static_cast<std::size_t>(split.test[k]);
+        const Eigen::MatrixXd& truth = results[i].axis.values;
+        const solvers::ObserverRun& run = held_runs[k];
+        const Eigen::MatrixXd p = run.drift.rightCols(axis_columns);
+        observer_axis.add(p, run.drift_sigma.rightCols(axis_columns), truth,
+                          campaign_scale.tail(axis_columns));
+        Eigen::MatrixXd pr(truth.rows(), axis_columns);
+        for (Eigen::Index c = 0; c < axis_columns; ++c)
+          pr.col(c) = fitting::predicted_error(axis.linear[static_cast<std::size_t>(c)].model,
+                                               axis_groups[i]);
+        regression_axis.add(pr, {}, truth, {});
+        truths.push_back(truth);
+        zeros.push_back(Eigen::MatrixXd::Zero(truth.rows(), axis_columns));
+        by_observer.push_back(p);
+        by_regression.push_back(pr);
+      }
+      const auto xyz = [](const Eigen::Array3d& v, const std::string& unit) {
+        return fmt(v(0)) + ", " + fmt(v(1)) + ", " + fmt(v(2)) + unit;
+      };
+      std::cout << "\naxis points (" << spec.mechanical.axis_points.size()
+                << ") on the held-out runs, dx, dy, dz over points and times ("
+                << fmt(seconds_since(t_axis)) << " s):\n"
+                << "  true error RMS: " << xyz(observer_axis.truth_rms_um(), " um") << "\n"
+                << "  observer RMS error: " << xyz(observer_axis.rms_um(), " um") << "\n"
+                << "  regression RMS error: " << xyz(regression_axis.rms_um(), " um") << "\n"
+                << "  observer 2σ coverage: "
+                << xyz(100 * observer_axis.inside / observer_axis.n, " %")
+                << "; calibrated on the training runs: "
+                << xyz(100 * observer_axis.inside_calibrated / observer_axis.n, " %") << "\n";
+      std::cout << "  left at the points by the axis polynomial (degree " << axis.degree
+                << ") a CNC receives, RMS (max) dx, dy, dz [um]:\n";
+      for (const studies::AxisCompensation& c :
+           {studies::axis_compensation("uncompensated", axis, truths, zeros),
+            studies::axis_compensation("true error (the polynomial's floor)", axis, truths, truths),
+            studies::axis_compensation("observer", axis, truths, by_observer),
+            studies::axis_compensation("regression", axis, truths, by_regression)}) {
+        std::cout << "    " << c.source << ":";
+        for (std::size_t d = 0; d < 3; ++d)
+          std::cout << " " << fmt(c.rms_m[d] * 1e6) << " (" << fmt(c.max_m[d] * 1e6) << ")";
+        std::cout << "\n";
+      }
     }
 
     // 5. The generator's runs (GEN_HOURS = 0: none).

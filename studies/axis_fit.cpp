@@ -11,12 +11,6 @@ namespace tt::studies {
 
 namespace {
 
-/// The axis points' error on one group, as the CNC's polynomial sees it: columns of `values`
-/// (#samples x 3 #points [m]).
-solvers::AxisError axis_values(const AxisFit& fit, Eigen::MatrixXd values) {
-  return solvers::AxisError{fit.points, fit.positions, std::move(values)};
-}
-
 /// Sums of squares, counts and largest |residual| per direction, over groups.
 struct Tally {
   std::array<double, 3> squares{}, count{}, max{};
@@ -55,6 +49,29 @@ double uncompensated_std(const std::vector<fitting::Group>& groups, const std::v
     sum += fitting::residual_std((e.array() - e.mean()).matrix());
   }
   return sum / static_cast<double>(which.size());
+}
+
+AxisCompensation axis_compensation(const std::string& source, const AxisFit& fit,
+                                   const std::vector<Eigen::MatrixXd>& truths,
+                                   const std::vector<Eigen::MatrixXd>& estimates) {
+  if (truths.size() != estimates.size())
+    throw core::SolverError("axis compensation '" + source +
+                            "': " + std::to_string(estimates.size()) + " estimates for " +
+                            std::to_string(truths.size()) + " truths");
+  Tally tally;
+  for (std::size_t k = 0; k < truths.size(); ++k) {
+    if (estimates[k].rows() != truths[k].rows() || estimates[k].cols() != truths[k].cols())
+      throw core::SolverError("axis compensation '" + source + "': an estimate of " +
+                              std::to_string(estimates[k].rows()) + " x " +
+                              std::to_string(estimates[k].cols()) + " against a truth of " +
+                              std::to_string(truths[k].rows()) + " x " +
+                              std::to_string(truths[k].cols()));
+    const solvers::AxisError truth{fit.points, fit.positions, truths[k]};
+    const auto poly = solvers::axis_polynomial(
+        solvers::AxisError{fit.points, fit.positions, estimates[k]}, fit.degree);
+    tally.add(solvers::axis_polynomial_residual(poly, truth));
+  }
+  return tally.result(source);
 }
 
 AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& groups,
@@ -106,27 +123,24 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
   fit.positions = first.positions;
   fit.feed_axis = spec.feed_axis.name;
   fit.direction = spec.feed_axis.direction;
-  Tally none, measured, linear, net;
+  std::vector<Eigen::MatrixXd> truths, zeros, linear, net;
   for (const fitting::Group& g : test) {
-    const solvers::AxisError truth = axis_values(fit, g.error.rightCols(3 * n));
-    none.add(truth.values);
-    const auto residual_of = [&](Eigen::MatrixXd estimate) {
-      const auto poly = solvers::axis_polynomial(axis_values(fit, std::move(estimate)), fit.degree);
-      return solvers::axis_polynomial_residual(poly, truth);
-    };
-    measured.add(residual_of(truth.values));
+    truths.push_back(g.error.rightCols(3 * n));
+    zeros.push_back(Eigen::MatrixXd::Zero(g.time.size(), 3 * n));
     Eigen::MatrixXd p(g.time.size(), 3 * n);
     for (int k = 0; k < 3 * n; ++k) p.col(k) = fitting::predicted_error(fit.linear[k].model, g);
-    linear.add(residual_of(p));
+    linear.push_back(p);
     if (!fit.network.empty()) {
       for (int k = 0; k < 3 * n; ++k)
         p.col(k) = fitting::predicted_error(fit.network[first_target + k], g);
-      net.add(residual_of(p));
+      net.push_back(p);
     }
   }
-  fit.compensation = {none.result("uncompensated"), measured.result("measured"),
-                      linear.result("linear")};
-  if (!fit.network.empty()) fit.compensation.push_back(net.result("network"));
+  fit.compensation = {axis_compensation("uncompensated", fit, truths, zeros),
+                      axis_compensation("measured", fit, truths, truths),
+                      axis_compensation("linear", fit, truths, linear)};
+  if (!fit.network.empty())
+    fit.compensation.push_back(axis_compensation("network", fit, truths, net));
   return fit;
 }
 

@@ -52,6 +52,15 @@ struct AxisFit {
   std::vector<AxisCompensation> compensation;
 };
 
+/// What the axis polynomial fitted at every time to each estimate (#samples x 3 #points of
+/// `fit.points`, as AxisError::values) leaves at the points of the matching truth, over all of
+/// them, as `source`. An estimate of zeros leaves the truth itself (uncompensated). Throws
+/// SolverError when the counts of truths and estimates differ or an estimate's shape is not its
+/// truth's.
+AxisCompensation axis_compensation(const std::string& source, const AxisFit& fit,
+                                   const std::vector<Eigen::MatrixXd>& truths,
+                                   const std::vector<Eigen::MatrixXd>& estimates);
+
 /// The axis points' error columns are groups' target columns [first_target, first_target + 3 n).
 /// Each is chosen among `specs` on split.validation with the standard's correlation sets (m <= 4,
 /// ranked on the fitting groups) and `extra_sets` (e.g. the TCP's chosen sets), and tested on

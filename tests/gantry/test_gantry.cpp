@@ -8,9 +8,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/rng.hpp"
 #include "fitting/cnc_export.hpp"
 #include "io/axis_fit_out.hpp"
 #include "io/case_reader.hpp"
@@ -21,9 +23,11 @@
 #include "solvers/campaign.hpp"
 #include "solvers/feed_axis.hpp"
 #include "solvers/loads.hpp"
+#include "solvers/observer.hpp"
 #include "solvers/thermal.hpp"
 #include "solvers/thermal_error.hpp"
 #include "solvers/thermal_stepper.hpp"
+#include "solvers/twin.hpp"
 #include "solvers/virtual_machine.hpp"
 #include "studies/axis_fit.hpp"
 #include "studies/histories.hpp"
@@ -322,6 +326,89 @@ TEST_F(Gm1Coarse, CampaignRecordsTheAxisPointsAsADirectElasticSolveDoes) {
   ASSERT_TRUE(direct.error);
   EXPECT_LE((campaign[0].error - direct.error->values).cwiseAbs().maxCoeff(),
             1e-6 * direct.error->values.cwiseAbs().maxCoeff());
+}
+
+TEST_F(Gm1Coarse, TheObserverEstimatesTheAxisPointsOfAFullOrderRun) {
+  // The physics observer on the coarse GM-1's twin, reading four sensors of a full-order campaign
+  // run (held out in the observer bench) with 0.05 K of noise, given the run's duty cycle: its
+  // estimate of every axis point's error (the targets after the TCP's) against the full-order
+  // error at the points, its reported sigma, and what the axis polynomial a CNC would receive
+  // from it leaves at the points.
+  auto runs = solvers::campaign_runs(*spec_, 3.0, spec_->seed);
+  const auto run = std::find_if(runs.begin(), runs.end(), [](const solvers::CampaignRun& r) {
+    return r.name == "irregular_b";
+  });
+  ASSERT_NE(run, runs.end());
+  const auto full = solvers::simulate_campaign(*mesh_, *spec_, {*run});
+  const solvers::AxisError& truth = full[0].axis;
+  const Eigen::Index columns = truth.values.cols();
+  ASSERT_EQ(columns, 33);
+  const solvers::Twin twin = solvers::case_twin(*mesh_, *spec_);
+  const std::vector<std::string> sensors{"R08", "R02", "R05",
+                                         "R04"};  // the bench's, by correlation
+  solvers::ObserverNoise noise;
+  noise.sensor_sigma_k = Eigen::VectorXd::Constant(4, 0.05);
+  const solvers::ObserverSetup setup =
+      solvers::twin_observer_setup(twin, run->spec, sensors, noise);
+  const auto names = studies::axis_target_names(*spec_);
+  ASSERT_EQ(setup.target_names.size(), 3 + names.size());
+  EXPECT_TRUE(std::equal(names.begin(), names.end(), setup.target_names.begin() + 3));
+  const Eigen::Map<const Eigen::VectorXd> times(full[0].times.data(),
+                                                static_cast<Eigen::Index>(full[0].times.size()));
+  Eigen::MatrixXd readings(times.size(), 4);
+  std::mt19937_64 rng = core::generator(5, 0);
+  std::normal_distribution<double> normal(0.0, 0.05);
+  for (int k = 0; k < 4; ++k) {
+    const auto& points = mesh_->points;
+    const auto at = std::find_if(points.begin(), points.end(),
+                                 [&](const mesh::NamedNode& p) { return p.id == sensors[k]; });
+    ASSERT_NE(at, points.end()) << sensors[k];
+    for (Eigen::Index i = 0; i < times.size(); ++i)
+      readings(i, k) = full[0].point_temperature(i, at - points.begin()) + normal(rng);
+  }
+  const solvers::ObserverRun observed =
+      solvers::observe(twin.model.system, run->spec, setup, times, readings);
+  const Eigen::MatrixXd estimate = observed.drift.rightCols(columns);
+  const Eigen::MatrixXd sigma = observed.drift_sigma.rightCols(columns);
+  ASSERT_EQ(estimate.rows(), truth.values.rows());
+  std::array<double, 3> error_ss{}, truth_ss{}, inside{}, count{};
+  for (Eigen::Index c = 0; c < columns; ++c)
+    for (Eigen::Index i = 1; i < times.size(); ++i) {
+      const auto d = static_cast<std::size_t>(c % 3);
+      const double e = estimate(i, c) - truth.values(i, c);
+      error_ss[d] += e * e;
+      truth_ss[d] += truth.values(i, c) * truth.values(i, c);
+      inside[d] += std::abs(e) <= 2 * sigma(i, c);
+      count[d] += 1;
+    }
+  studies::AxisFit axis;  // the polynomial's points, positions and degree
+  axis.points = truth.points;
+  axis.positions = truth.positions;
+  axis.degree = spec_->mechanical.axis_polynomial_degree;
+  const auto left = [&](const std::string& source, const Eigen::MatrixXd& e) {
+    return studies::axis_compensation(source, axis, {truth.values}, {e});
+  };
+  const studies::AxisCompensation none =
+      left("uncompensated", Eigen::MatrixXd::Zero(truth.values.rows(), columns));
+  const studies::AxisCompensation by_observer = left("observer", estimate);
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double rms = std::sqrt(error_ss[d] / count[d]), size = std::sqrt(truth_ss[d] / count[d]);
+    std::printf(
+        "[gantry] observer at the axis points, direction %zu: true RMS %.3f um, error RMS %.3f um, "
+        "2 sigma covers %.1f %%; the polynomial leaves %.3f um (uncompensated %.3f um)\n",
+        d, size * 1e6, rms * 1e6, 100 * inside[d] / count[d], by_observer.rms_m[d] * 1e6,
+        none.rms_m[d] * 1e6);
+    EXPECT_GT(size, 0.5e-6) << d;  // a micron or more along the axis in 3 h: a real signal
+    EXPECT_GE(inside[d] / count[d], 0.95) << d;
+    // dx (56 um) and dy (9.5 um) within 2.2 and 0.9 % here. dz (0.77 um) is another matter: the
+    // unknown inputs, moved by the readings' noise, tilt it along the axis by up to 1 um at the
+    // end (error 0.40 um RMS; the twin alone is exact on this clean run). Still less than half of
+    // what is left uncompensated.
+    const double part = d < 2 ? 0.05 : 0.7;
+    EXPECT_LT(rms, part * size) << d;
+    EXPECT_LT(by_observer.rms_m[d], part * none.rms_m[d]) << d;
+  }
+  EXPECT_THROW(left("observer", estimate.leftCols(30)), core::SolverError);
 }
 
 /// Groups as `fit` builds them on GM-1 (its 37 candidate sensors, the TCP's dy and dz, then the
