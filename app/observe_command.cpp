@@ -63,7 +63,7 @@ int observe_command(const ObserveArgs& args) {
     std::cerr << "thermotwin: observe: sensor "
               << report.sensors[static_cast<std::size_t>(d.sensor)]
               << " read away from the declared model's run since t = " << d.since_s
-              << " s (observer.json model_departures)\n";
+              << " s, beginning near t = " << d.onset_s << " s (observer.json model_departures)\n";
   return 0;
 }
 

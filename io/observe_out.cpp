@@ -70,15 +70,16 @@ nlohmann::json sensor_faults_json(const solvers::ObserverRun& r,
   return faults;
 }
 
-/// Each sensor whose readings stayed away from the declared model's run: its id, since when and
-/// when it was raised [s].
+/// Each sensor whose readings stayed away from the declared model's run: its id, since when, when
+/// it was raised and where that began [s].
 nlohmann::json departures_json(const solvers::ObserverRun& r,
                                const std::vector<std::string>& sensors) {
   nlohmann::json out = nlohmann::json::array();
   for (const solvers::HeldSensor& d : r.model_departures)
     out.push_back({{"sensor", sensors[static_cast<std::size_t>(d.sensor)]},
                    {"since_s", d.since_s},
-                   {"raised_s", d.raised_s}});
+                   {"raised_s", d.raised_s},
+                   {"onset_s", d.onset_s}});
   return out;
 }
 
@@ -105,7 +106,8 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
         {"sustain_s", setup.consistency.sustain_s},
         {"probability", setup.consistency.probability},
         {"sensor_fault_sigmas", setup.consistency.sensor_fault_sigmas},
-        {"model_residual_sigmas", setup.consistency.model_residual_sigmas}}},
+        {"model_residual_sigmas", setup.consistency.model_residual_sigmas},
+        {"departure_onset_sigmas", setup.consistency.departure_onset_sigmas}}},
       {"status", final_status(r)},
       {"unknown_inputs", unknown_inputs_json(r)},
       {"sensor_faults", sensor_faults_json(r, report.sensors)},

@@ -187,11 +187,16 @@ void HeldBeyondMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& v
   if (!(sigmas_ > 0)) return;
   const auto n = static_cast<std::size_t>(value.size());
   beyond_since_.resize(n, std::numeric_limits<double>::quiet_NaN());
+  within_onset_.resize(n, t);
   raised_.resize(n, false);
   const auto beyond = [&](std::size_t k) {
     const auto i = static_cast<Eigen::Index>(k);
     return std::abs(value(i)) > sigmas_ * sigma(i);
   };
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<Eigen::Index>(k);
+    if (!raised_[k] && std::abs(value(i)) <= onset_sigmas_ * sigma(i)) within_onset_[k] = t;
+  }
   // Exclusive: several sensors not yet raised beyond the bound together are heat or air read as
   // offsets, more likely than several sensors failing at once; none of them is counted.
   std::size_t together = 0;
@@ -204,10 +209,66 @@ void HeldBeyondMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& v
     if (std::isnan(beyond_since_[k])) beyond_since_[k] = t;
     if (!raised_[k] && t - beyond_since_[k] >= sustain_s_) {
       raised_[k] = true;
-      held_.push_back({static_cast<int>(k), beyond_since_[k], t});
+      const double onset =
+          onset_sigmas_ > 0 ? std::min(within_onset_[k], beyond_since_[k]) : beyond_since_[k];
+      held_.push_back({static_cast<int>(k), beyond_since_[k], t, onset});
     }
   }
 }
+
+namespace {
+
+/// Throws SolverError naming what of `setup` does not fit `system` and `spec`, or is not a
+/// finite noise, bound or scale.
+void check_setup(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                 const ObserverSetup& setup) {
+  const Eigen::Index r = system.states();
+  const auto fail = [](const std::string& what) { throw core::SolverError("observer: " + what); };
+  if (setup.sensor_rows.cols() != r || setup.target_rows.cols() != r)
+    fail("the sensor and target rows have " + std::to_string(setup.sensor_rows.cols()) + " and " +
+         std::to_string(setup.target_rows.cols()) + " columns, the reduced model " +
+         std::to_string(r) + " states: rows of another model");
+  if (static_cast<std::size_t>(setup.target_rows.rows()) != setup.target_names.size())
+    fail(std::to_string(setup.target_rows.rows()) + " target rows for " +
+         std::to_string(setup.target_names.size()) + " names");
+  const auto& sigma = setup.noise.sensor_sigma_k;
+  if (sigma.size() != setup.sensor_rows.rows() || !(sigma.array() > 0).all() || !sigma.allFinite())
+    fail("sensor noise: " + std::to_string(sigma.size()) + " values for " +
+         std::to_string(setup.sensor_rows.rows()) +
+         " sensors; expected one finite sigma > 0 K each");
+  const ObserverNoise& n = setup.noise;
+  for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
+                   n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k,
+                   n.correction_relative_sigma})
+    if (!(v >= 0) || !std::isfinite(v))
+      fail("process noise " + number(v) + ": expected a finite value >= 0");
+  for (double bound :
+       {setup.consistency.sensor_fault_sigmas, setup.consistency.model_residual_sigmas,
+        setup.consistency.departure_onset_sigmas})
+    if (!(bound >= 0) || !std::isfinite(bound))
+      fail("sensor fault, model residual or departure onset bound " + number(bound) +
+           " sigma: expected a finite value >= 0");
+  if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup);
+  const Eigen::VectorXd& scale = n.drift_sigma_scale;
+  if (scale.size() != 0 && (scale.size() != setup.target_rows.rows() ||
+                            !(scale.array() > 0).all() || !scale.allFinite()))
+    fail("drift sigma scale: " + std::to_string(scale.size()) + " values for " +
+         std::to_string(setup.target_rows.rows()) +
+         " targets; expected none or one finite factor > 0 per target");
+  const auto& conv = spec.thermal.convection;
+  for (int c : setup.air_entries)
+    if (c < 0 || c >= static_cast<int>(conv.size()) ||
+        static_cast<std::size_t>(c) >= system.film_area.size())
+      fail("air entry " + std::to_string(c) + " is not a convection entry (the case has " +
+           std::to_string(conv.size()) + ")");
+
+  const Eigen::Index m = setup.sensor_rows.rows();
+  if (!setup.sensor_names.empty() && setup.sensor_names.size() != static_cast<std::size_t>(m))
+    fail(std::to_string(setup.sensor_names.size()) + " sensor names for " + std::to_string(m) +
+         " sensor rows");
+}
+
+}  // namespace
 
 KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                                const ObserverSetup& setup)
@@ -217,50 +278,12 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       stepper_(system, spec),
       monitor_(setup.consistency),
       faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s),
-      departures_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false) {
+      departures_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false,
+                  setup.consistency.departure_onset_sigmas) {
   r_ = system.states();
-  const auto fail = [](const std::string& what) { throw core::SolverError("observer: " + what); };
-  if (setup_.sensor_rows.cols() != r_ || setup_.target_rows.cols() != r_)
-    fail("the sensor and target rows have " + std::to_string(setup_.sensor_rows.cols()) + " and " +
-         std::to_string(setup_.target_rows.cols()) + " columns, the reduced model " +
-         std::to_string(r_) + " states: rows of another model");
-  if (static_cast<std::size_t>(setup_.target_rows.rows()) != setup_.target_names.size())
-    fail(std::to_string(setup_.target_rows.rows()) + " target rows for " +
-         std::to_string(setup_.target_names.size()) + " names");
-  const auto& sigma = setup_.noise.sensor_sigma_k;
-  if (sigma.size() != setup_.sensor_rows.rows() || !(sigma.array() > 0).all() || !sigma.allFinite())
-    fail("sensor noise: " + std::to_string(sigma.size()) + " values for " +
-         std::to_string(setup_.sensor_rows.rows()) +
-         " sensors; expected one finite sigma > 0 K each");
+  check_setup(system, spec, setup_);
   const ObserverNoise& n = setup_.noise;
-  for (double v : {n.heat_walk_w, n.heat_initial_w, n.air_walk_k, n.air_initial_k, n.state_walk_k,
-                   n.drift_relative_sigma, n.sensor_offset_initial_k, n.sensor_offset_walk_k,
-                   n.correction_relative_sigma})
-    if (!(v >= 0) || !std::isfinite(v))
-      fail("process noise " + number(v) + ": expected a finite value >= 0");
-  for (double bound :
-       {setup_.consistency.sensor_fault_sigmas, setup_.consistency.model_residual_sigmas})
-    if (!(bound >= 0) || !std::isfinite(bound))
-      fail("sensor fault or model residual bound " + number(bound) +
-           " sigma: expected a finite value >= 0");
-  if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup_);
-  const Eigen::VectorXd& scale = n.drift_sigma_scale;
-  if (scale.size() != 0 && (scale.size() != setup_.target_rows.rows() ||
-                            !(scale.array() > 0).all() || !scale.allFinite()))
-    fail("drift sigma scale: " + std::to_string(scale.size()) + " values for " +
-         std::to_string(setup_.target_rows.rows()) +
-         " targets; expected none or one finite factor > 0 per target");
-  const auto& conv = spec.thermal.convection;
-  for (int c : setup_.air_entries)
-    if (c < 0 || c >= static_cast<int>(conv.size()) ||
-        static_cast<std::size_t>(c) >= system.film_area.size())
-      fail("air entry " + std::to_string(c) + " is not a convection entry (the case has " +
-           std::to_string(conv.size()) + ")");
-
   const Eigen::Index m = setup_.sensor_rows.rows();
-  if (!setup_.sensor_names.empty() && setup_.sensor_names.size() != static_cast<std::size_t>(m))
-    fail(std::to_string(setup_.sensor_names.size()) + " sensor names for " + std::to_string(m) +
-         " sensor rows");
 
   heat_columns_ = unknown_heat_columns(system, spec, bias_names_);
   const bool air = !setup_.air_entries.empty();
@@ -478,7 +501,7 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
     const std::size_t before = departures_.raised().size();
     departures_.add(t, residual, setup_.noise.sensor_sigma_k);
     for (std::size_t k = before; k < departures_.raised().size(); ++k)
-      earliest(departures_.raised()[k].since_s);
+      earliest(departures_.raised()[k].onset_s);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =

@@ -106,6 +106,11 @@ struct ConsistencyOptions {
   /// reading, and a sensor whose offset is beyond its fault bound is left out (its own fault,
   /// not the machine's). 0: no such test.
   double model_residual_sigmas = 3;
+  /// That test's alarm is dated from each departing sensor's onset (HeldSensor::onset_s): the
+  /// last time before it crossed that its reading was within this many sigmas of the declared
+  /// run. A change that grows from its start crosses 3 sigma hours after it began; the readings
+  /// of a clean run are within 1 sigma 68 % of the time. 0: dated from the crossing.
+  double departure_onset_sigmas = 1;
 };
 
 /// The observer's set-up on a reduced system.
@@ -174,17 +179,25 @@ struct HeldSensor {
   int sensor = 0;                                              /// index into the setup's sensors
   double since_s = std::numeric_limits<double>::quiet_NaN();   /// first beyond the bound
   double raised_s = std::numeric_limits<double>::quiet_NaN();  /// held for sustain_s: raised
+  /// The last time at or before since_s that the value was within the monitor's onset bound
+  /// (where a change that grows from there began, as near as the values tell); its first time
+  /// when it never was; since_s when the monitor has no onset bound.
+  double onset_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A per-sensor value held beyond a bound, fed one assimilation at a time: sensor k is raised
 /// once |value_k| > sigmas * sigma_k has held for sustain_s (a NaN value is not beyond); a raised
 /// sensor stays raised. `exclusive` (the offsets' fault test): only as the only sensor not yet
 /// raised beyond the bound (several together are heat or air read as offsets, likelier than
-/// several sensors failing at once: their clocks restart).
+/// several sensors failing at once: their clocks restart). `onset_sigmas` > 0: each raised
+/// sensor's onset_s walks back from since_s to the last time |value_k| <= onset_sigmas * sigma_k.
 class HeldBeyondMonitor {
  public:
-  HeldBeyondMonitor(double sigmas, double sustain_s, bool exclusive = true)
-      : sigmas_(sigmas), sustain_s_(sustain_s), exclusive_(exclusive) {}
+  HeldBeyondMonitor(double sigmas, double sustain_s, bool exclusive = true, double onset_sigmas = 0)
+      : sigmas_(sigmas),
+        sustain_s_(sustain_s),
+        onset_sigmas_(onset_sigmas),
+        exclusive_(exclusive) {}
   /// The values and their standard deviations at time t, one per sensor.
   void add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
            const Eigen::Ref<const Eigen::VectorXd>& sigma);
@@ -192,9 +205,11 @@ class HeldBeyondMonitor {
   const std::vector<HeldSensor>& raised() const { return held_; }
 
  private:
-  double sigmas_, sustain_s_;
+  double sigmas_, sustain_s_, onset_sigmas_;
   bool exclusive_;
   std::vector<double> beyond_since_;  /// per sensor: NaN while within the bound
+  /// per sensor: the last time within the onset bound (the first time seen until it is)
+  std::vector<double> within_onset_;
   std::vector<bool> raised_;
   std::vector<HeldSensor> held_;
 };

@@ -291,6 +291,15 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
       alarm["recalibrate_since_s"].dump().c_str());
   ASSERT_EQ(alarm["status"], "recalibrate");
   EXPECT_LT(alarm["recalibrate_raised_s"].get<double>(), 4 * 3600.0);
+  // The heat is there from t = 0. Each departing sensor's onset walks back from its crossing of
+  // 3 sigma to its last reading within 1 sigma of the declared run, and the alarm is dated from
+  // the earliest (180 s here; 540 s from the crossing).
+  ASSERT_FALSE(alarm["model_departures"].empty());
+  EXPECT_EQ(alarm["consistency"]["departure_onset_sigmas"], 1.0);
+  for (const auto& d : alarm["model_departures"]) {
+    EXPECT_LE(d["onset_s"].get<double>(), d["since_s"].get<double>()) << d.dump();
+    EXPECT_LE(alarm["recalibrate_since_s"].get<double>(), d["onset_s"].get<double>()) << d.dump();
+  }
   const fs::path out = dir / "calibrated";
   ASSERT_EQ(rt::run({"calibrate", "--case", rt::kCoarseCase.string(), "--train", runs[0], runs[1],
                      "--test", runs[2], "--out", out.string()},

@@ -426,6 +426,9 @@ TEST_F(Observer, ASensorOffsetIsEstimatedAsAnOffsetNotAsHeat) {
   no_bound.consistency.sensor_fault_sigmas = 4;
   no_bound.consistency.model_residual_sigmas = -1;
   EXPECT_THROW(solvers::KalmanObserver(sys, c, no_bound), core::SolverError);
+  no_bound.consistency.model_residual_sigmas = 3;
+  no_bound.consistency.departure_onset_sigmas = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(solvers::KalmanObserver(sys, c, no_bound), core::SolverError);
   solvers::ObserverSetup bad = setup(with);
   bad.noise.sensor_offset_walk_k = -0.1;
   EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
@@ -772,6 +775,25 @@ TEST(ObserverPieces, HeldBeyondMonitor) {
   ASSERT_EQ(both.raised().size(), 2u);
   expect_held(both.raised()[0], 0, 0.0, 300.0);
   expect_held(both.raised()[1], 1, 780.0, 1080.0);
+  EXPECT_DOUBLE_EQ(both.raised()[1].onset_s, 780.0);  // no onset bound: the crossing
+  // An onset bound of 1 sigma. Sensor 0 grows by 0.1 sigma a sample from 600 s: within 1 sigma
+  // last at 1140 s, beyond 3 sigma from 2400 s, raised at 2700 s with its onset at 1140 s.
+  // Sensor 1 is beyond 1 sigma from the first sample and beyond 3 from 300 s: its onset is the
+  // first sample. Sensor 2 jumps beyond 3 sigma at 600 s and comes back after it was raised:
+  // its onset stays the last sample before the jump.
+  solvers::HeldBeyondMonitor onset(3, 300, false, 1);
+  for (int k = 0; k <= 60; ++k)
+    onset.add(60.0 * k,
+              Eigen::Vector3d(k >= 10 ? 0.1 * (k - 10) + 0.05 : 0.0, k >= 5 ? 4.0 : 2.0,
+                              k >= 10 && k <= 30 ? 5.0 : 0.0),
+              Eigen::Vector3d::Ones());
+  ASSERT_EQ(onset.raised().size(), 3u);
+  expect_held(onset.raised()[0], 1, 300.0, 600.0);
+  EXPECT_DOUBLE_EQ(onset.raised()[0].onset_s, 0.0);
+  expect_held(onset.raised()[1], 2, 600.0, 900.0);
+  EXPECT_DOUBLE_EQ(onset.raised()[1].onset_s, 540.0);
+  expect_held(onset.raised()[2], 0, 2400.0, 2700.0);
+  EXPECT_DOUBLE_EQ(onset.raised()[2].onset_s, 1140.0);
 }
 
 }  // namespace
