@@ -35,6 +35,9 @@
 //                     scores, issue 20 item 4)
 //     estimation_exact the same criterion, each candidate scored by its set's criterion afresh
 //                     (the filter re-run per candidate): what the rank-one scores stand in for
+//     correlation+detection the correlation's sensors and COUNT (0: 2) more placed for detection
+//                     (placement::detection_greedy: the observer's unknown heat inputs at 5 W and
+//                     its air at 1 K, each to move some sensor's reading 3 sigma for 900 s)
 // 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
 // 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
 //    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
@@ -268,10 +271,11 @@ int main(int argc, char** argv) {
     if (argc > 13) campaign_noise.sensor_offset_walk_k = std::stod(argv[13]);
     const bool changed_training = argc > 14 && std::stoi(argv[14]) != 0;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
-        sensor_choice != "estimation" && sensor_choice != "estimation_exact")
+        sensor_choice != "estimation" && sensor_choice != "estimation_exact" &&
+        sensor_choice != "correlation+detection")
       throw std::runtime_error("SENSORS '" + sensor_choice +
-                               "': expected correlation, mutual_info, estimation or "
-                               "estimation_exact");
+                               "': expected correlation, mutual_info, estimation, "
+                               "estimation_exact or correlation+detection");
     const auto t_all = Clock::now();
 
     // 1. Case, mesh, twin.
@@ -333,6 +337,33 @@ int main(int argc, char** argv) {
           if (s.method == placement::Method::kGaussianGreedy && s.m == 4)
             for (int c : s.columns)
               if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
+    } else if (sensor_choice == "correlation+detection") {
+      // The correlation's sensors, then COUNT (default 2) placed for detection beside them.
+      std::vector<core::CaseSpec> fitting_runs;
+      for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);
+      const double sample_s = 300;
+      const placement::EstimationProblem problem = studies::observer_estimation_problem(
+          twin, fitting_runs, {cand, {}, fitting::SensorNoise{}.temperature_sigma}, {"dy", "dz"},
+          campaign_noise, sample_s);
+      const solvers::ConsistencyOptions alarm;
+      const placement::DetectionProblem detection = studies::observer_detection_problem(
+          twin, problem, fitting_runs.front(), campaign_noise, {}, alarm.sustain_s, sample_s);
+      std::vector<int> pool(cand.size());
+      for (std::size_t k = 0; k < pool.size(); ++k) pool[k] = static_cast<int>(k);
+      const placement::GreedyPath placed = placement::detection_greedy(
+          detection, chosen, pool, count > 0 ? count : 2, alarm.model_residual_sigmas);
+      const auto unseen = [&](const std::vector<int>& columns) {
+        std::string out;
+        for (int e : placement::unseen_effects(detection, columns, alarm.model_residual_sigmas))
+          out += " " + detection.effects[static_cast<std::size_t>(e)];
+        return out.empty() ? std::string(" none") : out;
+      };
+      std::cout << "detection placement (" << fmt(seconds_since(t_place)) << " s, "
+                << detection.effects.size() << " effects: heat 5 W, air 1 K, held "
+                << alarm.sustain_s << " s beyond " << alarm.model_residual_sigmas
+                << " sigma): unseen by the correlation's sensors:" << unseen(chosen);
+      chosen.insert(chosen.end(), placed.order.begin(), placed.order.end());
+      std::cout << "; after adding " << placed.order.size() << ":" << unseen(chosen) << "\n";
     } else if (sensor_choice.starts_with("estimation")) {
       std::vector<core::CaseSpec> fitting_runs;
       for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);

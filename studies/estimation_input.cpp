@@ -1,6 +1,7 @@
 #include "studies/estimation_input.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.hpp"
 
@@ -85,6 +86,39 @@ placement::EstimationProblem observer_estimation_problem(
     p.target_rows.row(static_cast<Eigen::Index>(t)).head(r) = scale * setup.target_rows.row(row);
   }
   return p;
+}
+
+placement::DetectionProblem observer_detection_problem(const solvers::Twin& twin,
+                                                       const placement::EstimationProblem& problem,
+                                                       const core::CaseSpec& run,
+                                                       const solvers::ObserverNoise& noise,
+                                                       const DetectionSizes& sizes,
+                                                       double sustain_s, double sample_s) {
+  if (!(sample_s > 0) || !(sustain_s > 0))
+    throw core::SolverError("detection placement: readings every " + std::to_string(sample_s) +
+                            " s held for " + std::to_string(sustain_s) + " s: expected both > 0");
+  solvers::ObserverNoise without_sensors = noise;
+  without_sensors.sensor_sigma_k.resize(0);
+  const solvers::KalmanObserver observer(
+      twin.model.system, run, solvers::twin_observer_setup(twin, run, {}, without_sensors));
+  const std::vector<std::string>& names = observer.unknown_inputs();
+  const std::vector<solvers::UnknownInputKind> kinds = observer.unknown_input_kinds();
+  std::vector<std::string> effects;
+  std::vector<Eigen::Index> states;
+  std::vector<double> size;
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    if (kinds[j] == solvers::UnknownInputKind::sensor_offset) continue;
+    effects.push_back(names[j]);
+    states.push_back(twin.model.states() + static_cast<Eigen::Index>(j));
+    size.push_back(kinds[j] == solvers::UnknownInputKind::heat ? sizes.heat_w : sizes.air_k);
+  }
+  // Beyond the bound at every reading over the sustain time: the first and the last sustain_s
+  // apart (solvers::HeldBeyondMonitor raises at t - since >= sustain_s).
+  const int readings = static_cast<int>(std::ceil(sustain_s / sample_s - 1e-9)) + 1;
+  return placement::detection_problem(
+      problem, effects, states,
+      Eigen::Map<const Eigen::VectorXd>(size.data(), static_cast<Eigen::Index>(size.size())),
+      readings);
 }
 
 }  // namespace tt::studies

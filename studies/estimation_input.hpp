@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/case_spec.hpp"
+#include "placement/detection.hpp"
 #include "placement/estimation.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
@@ -46,5 +47,25 @@ placement::EstimationProblem observer_estimation_problem(
     const solvers::Twin& twin, const std::vector<core::CaseSpec>& runs,
     const EstimationCandidates& candidates, const std::vector<std::string>& targets,
     const solvers::ObserverNoise& noise, double sample_s, const Progress& progress = {});
+
+/// The sizes at which placement for detection asks to see the observer's unknown inputs: a
+/// heat input at a source or film [W], the air's offset [K].
+struct DetectionSizes {
+  double heat_w = 5;
+  double air_k = 1;
+};
+
+/// Placement for detection on `problem` (observer_estimation_problem's, its runs read every
+/// `sample_s`): each of the observer's unknown heat inputs and its air (not the sensors'
+/// offsets) held at `sizes` from t = 0, and how far it moves each candidate's reading from the
+/// declared run for `sustain_s` (solvers::ConsistencyOptions::sustain_s), in sigmas. `run` and
+/// `noise` as the problem was built with. Throws SolverError when sample_s or sustain_s is not
+/// > 0, DataError as placement::detection_problem does.
+placement::DetectionProblem observer_detection_problem(const solvers::Twin& twin,
+                                                       const placement::EstimationProblem& problem,
+                                                       const core::CaseSpec& run,
+                                                       const solvers::ObserverNoise& noise,
+                                                       const DetectionSizes& sizes,
+                                                       double sustain_s, double sample_s);
 
 }  // namespace tt::studies

@@ -67,10 +67,13 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   for (const auto& c : res.selection.claimed)
     std::printf("[calibration]   claimed: %s score %.1f floor %.1f p0 %.4g\n", c.name.c_str(),
                 c.score, c.floor, c.parameters.empty() ? 0.0 : c.parameters[0]);
-  for (const auto& p : res.selection.pairs)
-    std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f%s\n",
+  for (const auto& p : res.selection.pairs) {
+    std::string gains;
+    for (double g : p.fold_gains) gains += " " + std::to_string(g);
+    std::printf("[calibration]   pair %s + %s: score %.1f adds %.1f / %.1f%s; per run%s\n",
                 p.first.name.c_str(), p.second.name.c_str(), p.score, p.adds_first, p.adds_second,
-                p.admissible ? " admissible" : "");
+                p.admissible ? " admissible" : "", gains.c_str());
+  }
   if (res.selection.by_pair) std::printf("[calibration]   claimed by the best pair\n");
   for (const auto& [was, now] : res.selection.backfit_replaced)
     std::printf("[calibration]   backfit: %s replaced by %s\n", was.c_str(), now.c_str());

@@ -710,6 +710,47 @@ TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) 
                core::SolverError);
 }
 
+TEST_F(Observer, DetectionPlacementReadsTheChangeAnUndeclaredAirMakes) {
+  // Placement for detection (studies::observer_detection_problem): the change the observer's
+  // air input makes at each candidate, carried by the filter's maps, against the twin run twice,
+  // with the declared air and with every air sink 1 K warmer; held over 900 s of readings every
+  // 300 s (four readings), in the candidates' sigmas.
+  core::CaseSpec c = run_spec();
+  c.duty_cycle.end = 3 * 3600;
+  c.thermal.output_interval = 300;
+  const std::vector<std::string> candidates{"T02", "T11", "T25", "T44"};
+  const placement::EstimationProblem problem = studies::observer_estimation_problem(
+      s_->twin, {c}, {candidates, {}, 0.04}, {"dy", "dz"}, default_noise(), 300);
+  const placement::DetectionProblem d =
+      studies::observer_detection_problem(s_->twin, problem, c, default_noise(), {5, 1}, 900, 300);
+  const auto air = std::find(d.effects.begin(), d.effects.end(), "air");
+  ASSERT_NE(air, d.effects.end());
+  for (const auto& e : d.effects) EXPECT_EQ(e.rfind("offset:", 0), std::string::npos) << e;
+  EXPECT_EQ(static_cast<std::size_t>(d.held_sigmas.rows()), d.effects.size());
+  core::CaseSpec warmer = c;
+  for (int k : solvers::air_entries(c))
+    for (double& v : warmer.thermal.convection[static_cast<std::size_t>(k)].sink.value) v += 1;
+  const solvers::TwinRun declared = solvers::twin_run(s_->twin, c);
+  const solvers::TwinRun changed = solvers::twin_run(s_->twin, warmer);
+  ASSERT_EQ(declared.times.size(), 37u);  // t = 0, then every 300 s for 3 h
+  const auto& names = s_->twin.outputs.names;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const auto col = std::find(names.begin(), names.end(), candidates[k]) - names.begin();
+    const Eigen::VectorXd change =
+        (changed.outputs.col(col) - declared.outputs.col(col)).tail(36).cwiseAbs() / 0.04;
+    double held = 0;
+    for (Eigen::Index i = 0; i + 4 <= change.size(); ++i)
+      held = std::max(held, change.segment(i, 4).minCoeff());
+    EXPECT_NEAR(d.held_sigmas(air - d.effects.begin(), static_cast<Eigen::Index>(k)), held,
+                1e-6 * held)
+        << candidates[k];
+    EXPECT_GT(held, 3.0) << candidates[k];  // 1 K of air shows at every sensor of SB-1
+  }
+  EXPECT_THROW(
+      studies::observer_detection_problem(s_->twin, problem, c, default_noise(), {5, 1}, 0, 300),
+      core::SolverError);
+}
+
 TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
   // Tabulated quantiles: chi2(0.999; 10) = 29.59, chi2(0.999; 100) = 149.45, chi2(0.95; 30)
   // = 43.77.

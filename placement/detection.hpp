@@ -1,0 +1,55 @@
+// Placement for detection: sensors where the machine's undeclared changes would show. The
+// observer raises `recalibrate` when a reading stays more than a bound (in its sensor's sigmas)
+// from the declared model's own run for a sustain time (solvers::ConsistencyOptions). An effect
+// that moves no chosen sensor's reading that far for that long is never seen, however good the
+// sensors are for estimating the drift at the tool.
+//
+// Plain matrices only (placement sees core): the filter's map from one reading to the next along
+// each run (EstimationProblem's tracks, whose states are [reduced states; unknown inputs]) carries
+// a constant unknown input (a heat input at a source or film, the air's offset) into the reduced
+// states; the candidates' rows read the change it makes. The criterion counts the effects some
+// chosen sensor would see, each at a stated size.
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "placement/estimation.hpp"
+#include "placement/gaussian.hpp"
+
+namespace tt::placement {
+
+/// How far each effect moves each candidate's reading, held: #effects x #candidates, the largest
+/// over the runs and times of the smallest |change| over `sustain_readings` consecutive readings,
+/// in the candidate's sigmas, for each effect at its stated size.
+struct DetectionProblem {
+  std::vector<std::string> effects;  ///< #effects names
+  Eigen::MatrixXd held_sigmas;       ///< #effects x #candidates
+};
+
+/// The held changes of `problem`'s candidates under each unknown input `effect_states` (indices
+/// into the tracks' states, after the reduced ones) held constant at `sizes` (one per effect, in
+/// the input's unit: W, K) from t = 0, carried along every track's transitions. Throws
+/// core::DataError for a state index out of range, sizes that do not match, a size that is not
+/// finite and > 0, or sustain_readings < 1.
+DetectionProblem detection_problem(const EstimationProblem& problem,
+                                   const std::vector<std::string>& effects,
+                                   std::span<const Eigen::Index> effect_states,
+                                   const Eigen::VectorXd& sizes, int sustain_readings);
+
+/// Greedy forward selection over `pool` added to the sensors `chosen` (already installed): at
+/// each step the candidate that makes the most effects seen (held_sigmas >= bound at some chosen
+/// sensor), ties broken by the most progress towards the unseen ones (the sum over them of
+/// min(held, bound)), exact ties to the lower column; up to m_max sensors, or until no candidate
+/// adds to either. `scores` is the number of effects seen after each step. Throws
+/// core::DataError for a bound that is not finite and > 0 or a column out of range.
+GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int> chosen,
+                            std::span<const int> pool, int m_max, double bound);
+
+/// The effects no sensor of `columns` sees at `bound` (their indices, in order).
+std::vector<int> unseen_effects(const DetectionProblem& problem, std::span<const int> columns,
+                                double bound);
+
+}  // namespace tt::placement
