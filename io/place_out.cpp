@@ -33,6 +33,41 @@ nlohmann::json estimation_json(const studies::EstimationSettings& e,
           {"air_walk_K_per_sqrt_h", e.noise.air_walk_k}};
 }
 
+/// Placement for detection: the settings, each effect's best candidate, the greedy from no
+/// sensor and what it and each target's observer_variance set leave unseen.
+nlohmann::json detection_json(const studies::DetectionReport& d, const studies::Histories& h) {
+  const auto& held = d.problem.held_sigmas;
+  const auto names = [&](const std::vector<int>& effects) {
+    nlohmann::json out = nlohmann::json::array();
+    for (int e : effects) out.push_back(d.problem.effects[static_cast<std::size_t>(e)]);
+    return out;
+  };
+  nlohmann::json effects = nlohmann::json::array();
+  for (Eigen::Index e = 0; e < held.rows(); ++e) {
+    Eigen::Index best = 0;
+    const double most = held.cols() > 0 ? held.row(e).maxCoeff(&best) : 0.0;
+    effects.push_back({{"name", d.problem.effects[static_cast<std::size_t>(e)]},
+                       {"best_candidate",
+                        held.cols() > 0 ? h.names[static_cast<std::size_t>(best)] : std::string()},
+                       {"best_held_sigmas", most}});
+  }
+  nlohmann::json greedy = nlohmann::json::array();
+  for (std::size_t k = 0; k < d.greedy.order.size(); ++k)
+    greedy.push_back({{"candidate", h.names[static_cast<std::size_t>(d.greedy.order[k])]},
+                      {"id", d.greedy.order[k] + 1},
+                      {"effects_seen", static_cast<int>(d.greedy.scores[k])}});
+  nlohmann::json by_target = nlohmann::json::object();
+  for (const auto& [target, unseen] : d.unseen_by_estimation) by_target[target] = names(unseen);
+  return {{"bound_sigmas", d.bound_sigmas},
+          {"sustain_s", d.sustain_s},
+          {"heat_W", d.sizes.heat_w},
+          {"air_K", d.sizes.air_k},
+          {"effects", effects},
+          {"greedy", greedy},
+          {"unseen", names(placement::unseen_effects(d.problem, d.greedy.order, d.bound_sigmas))},
+          {"unseen_by_observer_variance", by_target}};
+}
+
 /// Each target's single-sensor MI and rank per candidate, for the point cloud.
 std::vector<NamedField> mi_fields(const placement::PlacementResult& result) {
   std::vector<NamedField> fields;
@@ -74,6 +109,7 @@ void write_place(const std::filesystem::path& dir, const studies::PlaceReport& r
   doc["sensor_noise"] = source.sensor_noise;
   doc["model"] = source.model;
   if (report.estimation) doc["observer_variance"] = estimation_json(*report.estimation, source.rom);
+  if (report.detection) doc["observer_detection"] = detection_json(*report.detection, h);
   doc["candidates"] = candidates_json(h);
   write_json(dir / "placement.json", doc);
   write_mi_ranking_csv(dir / "mi_ranking.csv", report.result);

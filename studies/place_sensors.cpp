@@ -49,6 +49,32 @@ placement::PlacementOptions placement_options(const PlaceInput& input) {
   return options;
 }
 
+/// Placement for detection on the estimation problem: the greedy from no sensor, and what each
+/// target's observer_variance set of the largest m leaves unseen.
+DetectionReport detection_report(const PlaceInput& input, const placement::EstimationProblem& p,
+                                 const EstimationSettings& settings,
+                                 const placement::PlacementResult& result) {
+  DetectionReport d;
+  const solvers::ConsistencyOptions alarm;
+  d.bound_sigmas = alarm.model_residual_sigmas;
+  d.sustain_s = alarm.sustain_s;
+  d.problem = observer_detection_problem(*input.twin, p, *input.spec, settings.noise, d.sizes,
+                                         d.sustain_s, settings.reading_interval_s);
+  std::vector<int> pool(static_cast<std::size_t>(d.problem.held_sigmas.cols()));
+  for (std::size_t c = 0; c < pool.size(); ++c) pool[c] = static_cast<int>(c);
+  d.greedy = placement::detection_greedy(d.problem, {}, pool, input.m_max, d.bound_sigmas);
+  for (const auto& t : result.targets) {
+    const placement::Selection* largest = nullptr;
+    for (const auto& s : t.selections)
+      if (s.method == placement::Method::kObserverVariance && (!largest || s.m > largest->m))
+        largest = &s;
+    if (largest)
+      d.unseen_by_estimation.emplace_back(
+          t.target, placement::unseen_effects(d.problem, largest->columns, d.bound_sigmas));
+  }
+  return d;
+}
+
 }  // namespace
 
 placement::PlacementInput placement_input(const Histories& h) {
@@ -75,6 +101,8 @@ PlaceReport place_sensors(const PlaceInput& input) {
   }
   const auto t = std::chrono::steady_clock::now();
   report.result = placement::place_all(in, placement_options(input));
+  if (in.estimation)
+    report.detection = detection_report(input, *in.estimation, *report.estimation, report.result);
   report.place_s = core::seconds_since(t);
   return report;
 }

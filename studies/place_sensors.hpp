@@ -11,6 +11,7 @@
 #include "placement/place.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
+#include "studies/estimation_input.hpp"
 #include "studies/histories.hpp"
 
 namespace tt::studies {
@@ -37,10 +38,23 @@ struct EstimationSettings {
   solvers::ObserverNoise noise;  /// its default process noise
 };
 
+/// Placement for detection beside observer_variance: where the observer's unknown inputs would
+/// show (studies::observer_detection_problem on the same covariance model).
+struct DetectionReport {
+  DetectionSizes sizes;
+  double bound_sigmas = 0;  /// the declared-run test's bound (ConsistencyOptions defaults)
+  double sustain_s = 0;
+  placement::DetectionProblem problem;
+  placement::GreedyPath greedy;  /// from no sensor, up to m_max: effects seen after each step
+  /// per target: the effects its observer_variance set of the largest m leaves unseen
+  std::vector<std::pair<std::string, std::vector<int>>> unseen_by_estimation;
+};
+
 struct PlaceReport {
   Histories histories;  /// as placed on: with the sensor noise when it was asked for
   placement::PlacementResult result;
   std::optional<EstimationSettings> estimation;  /// with observer_variance
+  std::optional<DetectionReport> detection;      /// with observer_variance
   double place_s = 0;                            /// wall time of the placement [s]
 };
 

@@ -142,6 +142,30 @@ TEST(PlaceCli, SurfaceVerticesOfTheHousingOnCoarseSb1) {
       if (k > 0) EXPECT_LT(sets[k]["score"].get<double>(), sets[k - 1]["score"].get<double>());
     }
   }
+  // Placement for detection on the same model: the observer's unknown heat inputs and its air,
+  // no sensor offset; each greedy step makes more effects seen (or, once none can be, progress),
+  // and an effect is unseen after it only when no candidate holds it beyond the bound.
+  const auto& detection = observer["observer_detection"];
+  EXPECT_EQ(detection["bound_sigmas"], 3.0);
+  EXPECT_EQ(detection["sustain_s"], 900.0);
+  ASSERT_GE(detection["effects"].size(), 2u);
+  bool air = false;
+  for (const auto& e : detection["effects"]) {
+    air = air || e["name"] == "air";
+    EXPECT_EQ(e["name"].get<std::string>().rfind("offset:", 0), std::string::npos) << e;
+  }
+  EXPECT_TRUE(air);
+  ASSERT_FALSE(detection["greedy"].empty());
+  EXPECT_LE(detection["greedy"].size(), 3u);  // --m-max
+  EXPECT_GE(detection["greedy"][0]["effects_seen"].get<int>(), 1);
+  for (size_t k = 1; k < detection["greedy"].size(); ++k)
+    EXPECT_GE(detection["greedy"][k]["effects_seen"].get<int>(),
+              detection["greedy"][k - 1]["effects_seen"].get<int>());
+  for (const auto& name : detection["unseen"])
+    for (const auto& e : detection["effects"])
+      if (e["name"] == name && detection["greedy"].size() < 3u)
+        EXPECT_LT(e["best_held_sigmas"].get<double>(), 3.0) << name;
+  EXPECT_TRUE(detection["unseen_by_observer_variance"].contains("dy"));
   EXPECT_NE(thermotwin({"place", "--from", (dir / "run").string(), "--out",
                         (dir / "place_bad").string(), "--methods", "observer_varianse", "--quiet"},
                        dir / "place.log"),
