@@ -615,6 +615,7 @@ int main(int argc, char** argv) {
     //     on validation among the same candidates, with the probes' noise on its training
     //     readings), against the true error; and what the axis polynomial a CNC receives from
     //     each leaves at the points.
+    std::optional<studies::AxisFit> axis_models;  // the regressions at the axis points
     if (axis_columns > 0) {
       const auto t_axis = Clock::now();
       const std::vector<std::string> axis_names = studies::axis_target_names(spec);
@@ -632,8 +633,9 @@ int main(int argc, char** argv) {
         axis_groups.push_back(columns(fitting::noisy_group(g, fitting::SensorNoise{}, spec.seed, i),
                                       chosen, sensors));
       }
-      const studies::AxisFit axis = studies::axis_fit(
-          spec, axis_groups, split, 2, sets, fitting::default_model_candidates(), std::nullopt, {});
+      axis_models = studies::axis_fit(spec, axis_groups, split, 2, sets,
+                                      fitting::default_model_candidates(), std::nullopt, {});
+      const studies::AxisFit& axis = *axis_models;
       AxisScore observer_axis, regression_axis;
       std::vector<Eigen::MatrixXd> truths, zeros, by_observer, by_regression;
       for (std::size_t k = 0; k < split.test.size(); ++k) {
@@ -682,6 +684,12 @@ int main(int argc, char** argv) {
 
     // 5. The generator's runs (GEN_HOURS = 0: none).
     Method gclean, geffect;
+    // The axis points on the generator's runs (clean, effect), where the case has them.
+    struct AxisRuns {
+      AxisScore observer, regression;
+      std::vector<Eigen::MatrixXd> truths, by_observer, by_regression;
+    };
+    std::array<AxisRuns, 2> gen_axis;
     // The generator's effect runs also with the sigma calibrated on its clean runs (the machine's
     // own runs before it changed), beside the campaign's calibration.
     Score geffect_own;
@@ -703,6 +711,7 @@ int main(int argc, char** argv) {
       const mesh::TetMesh gmesh = mesh::mesh_case(gen);
       calibration::Instrumentation inst;
       inst.sensor_points = sensors;
+      inst.axis_probes = axis_columns > 0;
       std::mt19937_64 rng = core::generator(seed, 0);
       solvers::ObserverNoise gen_noise = campaign_noise;
       // The generator's sensors: 0.03 K white, 0.01 K drifting (600 s), 0.01 K steps.
@@ -743,7 +752,12 @@ int main(int argc, char** argv) {
         const std::string name = "gen_" + std::to_string(k);
         const io::MeasuredRun truth =
             calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
-        const io::MeasuredRun measured = calibration::with_noise(truth, gopt, rng);
+        // The noise on the sensors and the TCP's probes only: the same draws as without the axis
+        // points' probes (their truth is scored, not read).
+        io::MeasuredRun tcp_only = truth;
+        tcp_only.displacement.conservativeResize(Eigen::NoChange, 3);
+        tcp_only.displacements.resize(3);
+        const io::MeasuredRun measured = calibration::with_noise(tcp_only, gopt, rng);
         const core::CaseSpec declared = calibration::case_for_run(spec, measured);
         if (k >= scored_runs) {  // a changed-machine training run: observed, not scored
           solvers::ObserverNoise widened = gen_noise;
@@ -821,6 +835,24 @@ int main(int argc, char** argv) {
         if (effect.present)
           what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
         line(name, "generator, " + what, o, rr, run);
+        if (axis_models && truth.displacement.cols() == 3 + axis_columns) {
+          // The axis points against the generator's own (finer mesh) truth.
+          const Eigen::MatrixXd axis_truth = truth.displacement.rightCols(axis_columns);
+          const Eigen::MatrixXd p = run.drift.rightCols(axis_columns);
+          Eigen::MatrixXd pr(axis_truth.rows(), axis_columns);
+          fitting::Group ga = g;
+          ga.error = axis_truth;
+          for (Eigen::Index c = 0; c < axis_columns; ++c)
+            pr.col(c) = fitting::predicted_error(
+                axis_models->linear[static_cast<std::size_t>(c)].model, ga);
+          const int set = effect.present ? 1 : 0;
+          gen_axis[set].observer.add(p, run.drift_sigma.rightCols(axis_columns), axis_truth,
+                                     campaign_scale.tail(axis_columns));
+          gen_axis[set].regression.add(pr, {}, axis_truth, {});
+          gen_axis[set].truths.push_back(axis_truth);
+          gen_axis[set].by_observer.push_back(p);
+          gen_axis[set].by_regression.push_back(pr);
+        }
         if (campaign_noise.sensor_offset_initial_k > 0 || campaign_noise.sensor_offset_walk_k > 0) {
           // The sensor offsets' estimates at the run's end (sigma) [K].
           const Eigen::Index last = run.times.size() - 1;
@@ -873,6 +905,28 @@ int main(int argc, char** argv) {
       }
       std::cout << "generator: " << plan.size() << " runs of " << gen_hours << " h ("
                 << fmt(seconds_since(t_gen)) << " s)\n\n";
+      for (int set = 0; set < 2 && axis_models; ++set) {
+        const AxisRuns& a = gen_axis[static_cast<std::size_t>(set)];
+        if (a.truths.empty()) continue;
+        const auto xyz = [](const Eigen::Array3d& v) {
+          return fmt(v(0)) + ", " + fmt(v(1)) + ", " + fmt(v(2));
+        };
+        const studies::AxisCompensation by_observer =
+            studies::axis_compensation("observer", *axis_models, a.truths, a.by_observer);
+        const studies::AxisCompensation by_regression =
+            studies::axis_compensation("regression", *axis_models, a.truths, a.by_regression);
+        std::cout << "axis points on the generator's " << (set ? "effect" : "clean")
+                  << " runs, dx, dy, dz [um]: true RMS " << xyz(a.observer.truth_rms_um())
+                  << "; observer RMS error " << xyz(a.observer.rms_um()) << ", regression "
+                  << xyz(a.regression.rms_um())
+                  << "; observer coverage, calibrated on the campaign "
+                  << xyz(100 * a.observer.inside_calibrated / a.observer.n)
+                  << " %; the polynomial leaves: observer " << fmt(by_observer.rms_m[0] * 1e6)
+                  << ", " << fmt(by_observer.rms_m[1] * 1e6) << ", "
+                  << fmt(by_observer.rms_m[2] * 1e6) << ", regression "
+                  << fmt(by_regression.rms_m[0] * 1e6) << ", " << fmt(by_regression.rms_m[1] * 1e6)
+                  << ", " << fmt(by_regression.rms_m[2] * 1e6) << "\n";
+      }
       effect_runs = scored_runs - static_cast<std::size_t>(clean_runs);
     }
 

@@ -444,21 +444,26 @@ void add_tcp_probes(io::MeasuredRun& run, const mesh::TetMesh& m, const core::Ca
                     const Instrumentation& inst, const solvers::ThermalHistory& th,
                     const std::vector<Eigen::Index>& at) {
   const Eigen::Index ns = run.time.size();
-  if (inst.tcp_probes && truth.mechanical.enabled && !truth.mechanical.tcp_point.empty()) {
-    const int tcp = point_node(m, truth.mechanical.tcp_point);
-    const solvers::ElasticModel model(m, truth);
-    const char* ids[] = {"dx", "dy", "dz"};
-    run.displacement.resize(ns, 3);
-    const Eigen::Vector3d tcp_pos = m.nodes.row(tcp).transpose();
-    for (int d = 0; d < 3; ++d) {
-      const Eigen::VectorXd a = model.influence(tcp, d);
-      run.displacements.push_back({ids[d], tcp_pos, Eigen::Vector3d::Unit(d)});
+  run.displacement.resize(ns, 0);
+  if (!inst.tcp_probes || !truth.mechanical.enabled || truth.mechanical.tcp_point.empty()) return;
+  // The TCP's, then (axis_probes) each axis point's: the point's displacement in x, y, z.
+  std::vector<std::pair<std::string, std::string>> points{{truth.mechanical.tcp_point, ""}};
+  if (inst.axis_probes)
+    for (const auto& id : truth.mechanical.axis_points) points.emplace_back(id, id + "_");
+  const solvers::ElasticModel model(m, truth);
+  const char* directions[] = {"dx", "dy", "dz"};
+  run.displacement.resize(ns, 3 * static_cast<Eigen::Index>(points.size()));
+  Eigen::Index column = 0;
+  for (const auto& [id, prefix] : points) {
+    const int node = point_node(m, id);
+    const Eigen::Vector3d position = m.nodes.row(node).transpose();
+    for (int d = 0; d < 3; ++d, ++column) {
+      const Eigen::VectorXd a = model.influence(node, d);
+      run.displacements.push_back({prefix + directions[d], position, Eigen::Vector3d::Unit(d)});
       const double u0 = a.dot(th.temperature.col(0));
       for (Eigen::Index i = 0; i < ns; ++i)
-        run.displacement(i, d) = a.dot(th.temperature.col(at[i])) - u0;
+        run.displacement(i, column) = a.dot(th.temperature.col(at[i])) - u0;
     }
-  } else {
-    run.displacement.resize(ns, 0);
   }
 }
 

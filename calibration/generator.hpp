@@ -102,6 +102,9 @@ core::CaseSpec truth_case(const core::CaseSpec& gen_case, const InjectedEffects&
 struct Instrumentation {
   std::vector<std::string> sensor_points;  /// ids of named points
   bool tcp_probes = true;
+  /// Probes at each of the case's feed-axis points in x, y, z ("<point>_dx", ...), after the
+  /// TCP's: the truth of the error along the axis (mechanical.axis_points).
+  bool axis_probes = false;
   /// An air sensor `AIR` (no position; meta.json `ambient_sensor`) reading the truth's air: the
   /// sink of its first convection entry that is not mechanically fixed, with the sensors' noise.
   bool ambient_sensor = false;
