@@ -58,6 +58,10 @@
 //    with no effect and one per effect kind, random duty cycles of GEN_HOURS; the observer is
 //    given the declared case and the run's duty cycle only. The effect runs' coverage also with
 //    the sigma calibrated on the generator's clean runs (the machine's own runs before it changed).
+// 4b./5. On a case with feed-axis points (GM-1): the observer's estimate of each point's error
+//    against the truth (the campaign's held-out runs, and the generator's runs through its axis
+//    probes), beside per-point regressions on the same sensors (studies::axis_fit), and what the
+//    axis polynomial a CNC receives from each leaves at the points.
 // Prints one line per run and the totals.
 #include <array>
 #include <chrono>
