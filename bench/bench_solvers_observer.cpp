@@ -649,10 +649,7 @@ int main(int argc, char** argv) {
         const Eigen::MatrixXd p = run.drift.rightCols(axis_columns);
         observer_axis.add(p, run.drift_sigma.rightCols(axis_columns), truth,
                           campaign_scale.tail(axis_columns));
-        Eigen::MatrixXd pr(truth.rows(), axis_columns);
-        for (Eigen::Index c = 0; c < axis_columns; ++c)
-          pr.col(c) = fitting::predicted_error(axis.linear[static_cast<std::size_t>(c)].model,
-                                               axis_groups[i]);
+        const Eigen::MatrixXd pr = studies::linear_axis_predictions(axis, axis_groups[i]);
         regression_axis.add(pr, {}, truth, {});
         truths.push_back(truth);
         zeros.push_back(Eigen::MatrixXd::Zero(truth.rows(), axis_columns));
@@ -843,12 +840,7 @@ int main(int argc, char** argv) {
           // The axis points against the generator's own (finer mesh) truth.
           const Eigen::MatrixXd axis_truth = truth.displacement.rightCols(axis_columns);
           const Eigen::MatrixXd p = run.drift.rightCols(axis_columns);
-          Eigen::MatrixXd pr(axis_truth.rows(), axis_columns);
-          fitting::Group ga = g;
-          ga.error = axis_truth;
-          for (Eigen::Index c = 0; c < axis_columns; ++c)
-            pr.col(c) = fitting::predicted_error(
-                axis_models->linear[static_cast<std::size_t>(c)].model, ga);
+          const Eigen::MatrixXd pr = studies::linear_axis_predictions(*axis_models, g);
           const int set = effect.present ? 1 : 0;
           gen_axis[set].observer.add(p, run.drift_sigma.rightCols(axis_columns), axis_truth,
                                      campaign_scale.tail(axis_columns));

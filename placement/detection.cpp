@@ -103,22 +103,23 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
         fail("candidate column " + std::to_string(c) + " of " + std::to_string(nc));
   const auto start = std::chrono::steady_clock::now();
   std::vector<int> columns(chosen.begin(), chosen.end());
+  std::vector<int> unseen = unseen_effects(problem, columns, bound);
   GreedyPath path;
   for (int step = 0; step < m_max; ++step) {
-    const std::vector<int> unseen = unseen_effects(problem, columns, bound);
-    // Per candidate: the effects it would add, then the progress towards the rest.
+    // Per unseen effect, how far the chosen sensors already get towards the bound.
+    std::vector<double> already(unseen.size(), 0.0);
+    for (std::size_t u = 0; u < unseen.size(); ++u)
+      for (int s : columns) already[u] = std::max(already[u], problem.held_sigmas(unseen[u], s));
+    // Per candidate: the effects it would add, then the progress beyond that towards the rest.
     int best = -1;
     std::pair<int, double> best_gain{0, 0.0};
     for (int c : pool) {
       if (std::find(columns.begin(), columns.end(), c) != columns.end()) continue;
       std::pair<int, double> gain{0, 0.0};
-      for (int e : unseen) {
-        const double held = problem.held_sigmas(e, c);
+      for (std::size_t u = 0; u < unseen.size(); ++u) {
+        const double held = problem.held_sigmas(unseen[u], c);
         gain.first += held >= bound;
-        // Progress beyond what the chosen sensors already make towards the bound.
-        double already = 0;
-        for (int s : columns) already = std::max(already, problem.held_sigmas(e, s));
-        gain.second += std::max(0.0, std::min(held, bound) - already);
+        gain.second += std::max(0.0, std::min(held, bound) - already[u]);
       }
       const bool adds = gain.first > 0 || gain.second > 0;
       if (adds && (gain > best_gain || (gain == best_gain && c < best))) {
@@ -128,9 +129,10 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
     }
     if (best < 0) break;  // no candidate adds anything
     columns.push_back(best);
+    unseen = unseen_effects(problem, columns, bound);
     path.order.push_back(best);
     path.scores.push_back(static_cast<double>(problem.held_sigmas.rows()) -
-                          static_cast<double>(unseen_effects(problem, columns, bound).size()));
+                          static_cast<double>(unseen.size()));
     path.seconds.push_back(core::seconds_since(start));
   }
   return path;

@@ -99,7 +99,7 @@ struct ConsistencyOptions {
   /// The declared model's own run (the case's inputs stepped with no unknown input and no
   /// reading) against the readings: a sensor whose reading stays more than this many of its
   /// sigmas (ObserverNoise::sensor_sigma_k) from it for `sustain_s` says the machine is no longer
-  /// the declared one, and raises recalibrate dated from when it began to stay there. The
+  /// the declared one, and raises recalibrate (dated as departure_onset_sigmas says). The
   /// unknown inputs follow heat, air and films that the case does not declare, so their
   /// innovations stay consistent and the NIS test alone sees none of them; the declared model's
   /// run does not follow them. With offset states the sensor's estimated offset is taken off its

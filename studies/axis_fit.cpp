@@ -51,6 +51,13 @@ double uncompensated_std(const std::vector<fitting::Group>& groups, const std::v
   return sum / static_cast<double>(which.size());
 }
 
+Eigen::MatrixXd linear_axis_predictions(const AxisFit& fit, const fitting::Group& group) {
+  Eigen::MatrixXd p(group.time.size(), static_cast<Eigen::Index>(fit.linear.size()));
+  for (std::size_t k = 0; k < fit.linear.size(); ++k)
+    p.col(static_cast<Eigen::Index>(k)) = fitting::predicted_error(fit.linear[k].model, group);
+  return p;
+}
+
 AxisCompensation axis_compensation(const std::string& source, const AxisFit& fit,
                                    const std::vector<Eigen::MatrixXd>& truths,
                                    const std::vector<Eigen::MatrixXd>& estimates) {
@@ -127,10 +134,9 @@ AxisFit axis_fit(const core::CaseSpec& spec, const std::vector<fitting::Group>& 
   for (const fitting::Group& g : test) {
     truths.push_back(g.error.rightCols(3 * n));
     zeros.push_back(Eigen::MatrixXd::Zero(g.time.size(), 3 * n));
-    Eigen::MatrixXd p(g.time.size(), 3 * n);
-    for (int k = 0; k < 3 * n; ++k) p.col(k) = fitting::predicted_error(fit.linear[k].model, g);
-    linear.push_back(p);
+    linear.push_back(linear_axis_predictions(fit, g));
     if (!fit.network.empty()) {
+      Eigen::MatrixXd p(g.time.size(), 3 * n);
       for (int k = 0; k < 3 * n; ++k)
         p.col(k) = fitting::predicted_error(fit.network[first_target + k], g);
       net.push_back(p);

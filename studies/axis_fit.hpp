@@ -52,6 +52,10 @@ struct AxisFit {
   std::vector<AxisCompensation> compensation;
 };
 
+/// Each axis target's chosen linear model (fit.linear) on `group`: #samples x 3 #points [m], as
+/// AxisError::values.
+Eigen::MatrixXd linear_axis_predictions(const AxisFit& fit, const fitting::Group& group);
+
 /// What the axis polynomial fitted at every time to each estimate (#samples x 3 #points of
 /// `fit.points`, as AxisError::values) leaves at the points of the matching truth, over all of
 /// them, as `source`. An estimate of zeros leaves the truth itself (uncompensated). Throws

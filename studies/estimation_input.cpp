@@ -45,6 +45,15 @@ Eigen::RowVectorXd candidate_row(const solvers::Twin& twin, const std::string& n
                           std::to_string(twin.model.basis.rows()) + " nodes)");
 }
 
+/// The observer's set-up on `twin` for `run` with no sensor: what the covariance model and the
+/// unknown inputs need (`noise` without its sensors' sigmas).
+solvers::ObserverSetup sensorless_setup(const solvers::Twin& twin, const core::CaseSpec& run,
+                                        const solvers::ObserverNoise& noise) {
+  solvers::ObserverNoise without_sensors = noise;
+  without_sensors.sensor_sigma_k.resize(0);
+  return solvers::twin_observer_setup(twin, run, {}, without_sensors);
+}
+
 }  // namespace
 
 placement::EstimationProblem observer_estimation_problem(
@@ -52,10 +61,7 @@ placement::EstimationProblem observer_estimation_problem(
     const EstimationCandidates& candidates, const std::vector<std::string>& targets,
     const solvers::ObserverNoise& noise, double sample_s, const Progress& progress) {
   if (runs.empty()) throw core::SolverError("estimation placement: no run to place on");
-  solvers::ObserverNoise without_sensors = noise;
-  without_sensors.sensor_sigma_k.resize(0);
-  const solvers::ObserverSetup setup =
-      solvers::twin_observer_setup(twin, runs.front(), {}, without_sensors);
+  const solvers::ObserverSetup setup = sensorless_setup(twin, runs.front(), noise);
   placement::EstimationProblem p;
   for (const auto& run : runs) {
     p.tracks.push_back(
@@ -97,10 +103,8 @@ placement::DetectionProblem observer_detection_problem(const solvers::Twin& twin
   if (!(sample_s > 0) || !(sustain_s > 0))
     throw core::SolverError("detection placement: readings every " + std::to_string(sample_s) +
                             " s held for " + std::to_string(sustain_s) + " s: expected both > 0");
-  solvers::ObserverNoise without_sensors = noise;
-  without_sensors.sensor_sigma_k.resize(0);
-  const solvers::KalmanObserver observer(
-      twin.model.system, run, solvers::twin_observer_setup(twin, run, {}, without_sensors));
+  const solvers::KalmanObserver observer(twin.model.system, run,
+                                         sensorless_setup(twin, run, noise));
   const std::vector<std::string>& names = observer.unknown_inputs();
   const std::vector<solvers::UnknownInputKind> kinds = observer.unknown_input_kinds();
   std::vector<std::string> effects;
