@@ -664,26 +664,21 @@ struct MarchedCandidates {
 };
 
 /// The speed a speed law is referred to [rpm]: the sources' own, else the runs' fastest, else 1.
-double reference_speed(const core::CaseSpec& declared, const std::vector<io::MeasuredRun>& runs) {
+double reference_speed(const core::CaseSpec& declared, const std::vector<core::CaseSpec>& runs) {
   double ref_speed = 0;
   for (const auto& s : declared.thermal.sources) ref_speed = std::max(ref_speed, s.ref_speed_rpm);
-  if (ref_speed <= 0) {
-    for (const auto& run : runs) {
-      const core::CaseSpec s = case_for_run(declared, run);
+  if (ref_speed <= 0)
+    for (const auto& s : runs)
       for (const auto& seg : s.duty_cycle.segments) ref_speed = std::max(ref_speed, seg.speed_rpm);
-    }
-  }
   if (ref_speed <= 0) ref_speed = 1;
   return ref_speed;
 }
 
 /// Air temperature: hat functions on the sinks of (a) every convection entry, (b) every entry
 /// whose group is not mechanically fixed (a bed that keeps its own temperature).
-void add_air_candidates(MarchedCandidates& mc, const core::CaseSpec& declared,
-                        const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& o) {
+void add_air_candidates(MarchedCandidates& mc, const core::CaseSpec& declared, double end_max,
+                        const CalibrationOptions& o) {
   const auto& conv = declared.thermal.convection;
-  double end_max = 0;
-  for (const auto& run : runs) end_max = std::max(end_max, run.time(run.time.size() - 1));
   std::vector<double> knots;
   const int intervals = std::max(1, static_cast<int>(std::ceil(end_max / o.ambient_knot_interval)));
   for (int k = 0; k <= intervals; ++k) knots.push_back(end_max * k / intervals);
@@ -724,7 +719,7 @@ void add_air_candidates(MarchedCandidates& mc, const core::CaseSpec& declared,
 void add_heat_candidates(MarchedCandidates& mc, const mesh::TetMesh& m, const CalibrationOptions& o,
                          double ref_speed) {
   for (const Patch& p : surface_patches(m, o.patch_spacing, o.patch_half_size)) {
-    for (const HeatLaw law : {HeatLaw::speed, HeatLaw::constant}) {
+    for (const HeatLaw law : o.heat_laws) {
       Candidate c = heat_candidate(p, law, ref_speed);
       mc.sources.push_back({ColumnSource::separable, {static_cast<int>(mc.sep.size())}});
       mc.sep.push_back(heat_column(m, p, c));
@@ -829,30 +824,39 @@ void add_material_candidates(MarchedCandidates& mc, const MarchModel& model,
   }
 }
 
-/// One march per run with every column of `mc`: the runs (base histories, measured channels) into
-/// `cat.runs`, their responses returned in run order.
-std::vector<Responses> marched_runs(Catalogue& cat, const MarchModel& model,
-                                    const core::CaseSpec& declared, const Readout& r,
-                                    const std::vector<io::MeasuredRun>& runs,
+/// One march per run with every column of `mc`, each read at its `times`; `progress` gets the
+/// simulated time over the runs' total.
+std::vector<Responses> marched_runs(const MarchModel& model, const Readout& r,
+                                    const std::vector<core::CaseSpec>& specs,
+                                    const std::vector<Eigen::VectorXd>& times,
                                     const MarchedCandidates& mc,
                                     const solvers::Progress& progress) {
   std::vector<Responses> resp;
   double simulated = 0, total = 0;
-  for (const auto& run : runs) total += run.time(run.time.size() - 1);
-  for (const auto& run : runs) {
-    RunModel rm;
-    rm.name = run.run;
-    rm.spec = case_for_run(declared, run);
-    rm.times = run.time;
-    rm.measured = measured_channels(run, r);
-    Responses rs = march(model, rm.spec, r, run.time, mc.sep, mc.loads, mc.extra);
-    simulated += run.time(run.time.size() - 1);
+  for (const auto& t : times) total += t(t.size() - 1);
+  for (size_t k = 0; k < specs.size(); ++k) {
+    resp.push_back(march(model, specs[k], r, times[k], mc.sep, mc.loads, mc.extra));
+    simulated += times[k](times[k].size() - 1);
     if (progress) progress(simulated, total);
-    rm.base = rs.base;
-    cat.runs.push_back(std::move(rm));
-    resp.push_back(std::move(rs));
   }
   return resp;
+}
+
+/// The candidates' identities and unit loads (no columns yet): the air, and unless `ambient_only`
+/// the heat inputs, films, sources' growth and materials.
+MarchedCandidates candidate_loads(const MarchModel& model, const core::CaseSpec& declared,
+                                  const Readout& r, const std::vector<core::CaseSpec>& specs,
+                                  double end_max, const CalibrationOptions& o, bool ambient_only) {
+  const double ref_speed = reference_speed(declared, specs);
+  MarchedCandidates mc;
+  add_air_candidates(mc, declared, end_max, o);
+  if (!ambient_only) {
+    add_heat_candidates(mc, model.mesh(), o, ref_speed);
+    add_film_candidates(mc, declared, ref_speed);
+    add_source_growth_candidates(mc, declared);
+    add_material_candidates(mc, model, declared, r);
+  }
+  return mc;
 }
 
 /// Each candidate's columns per run, gathered from the runs' responses `resp` by its source.
@@ -905,25 +909,55 @@ Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, con
                     bool ambient_only, const solvers::Progress& progress) {
   Catalogue cat;
   cat.readout = r;
-  const double ref_speed = reference_speed(declared, runs);
-  // 1. The candidates' identities and their unit loads.
-  MarchedCandidates mc;
-  add_air_candidates(mc, declared, runs, o);
-  if (!ambient_only) {
-    add_heat_candidates(mc, model.mesh(), o, ref_speed);
-    add_film_candidates(mc, declared, ref_speed);
-    add_source_growth_candidates(mc, declared);
-    add_material_candidates(mc, model, declared, r);
+  std::vector<core::CaseSpec> specs;
+  std::vector<Eigen::VectorXd> times;
+  double end_max = 0;
+  for (const auto& run : runs) {
+    specs.push_back(case_for_run(declared, run));
+    times.push_back(run.time);
+    end_max = std::max(end_max, run.time(run.time.size() - 1));
   }
+  // 1. The candidates' identities and their unit loads.
+  MarchedCandidates mc = candidate_loads(model, declared, r, specs, end_max, o, ambient_only);
   // 2. One march per run with every column; sensors' own effects from the base histories.
-  fill_columns(mc, marched_runs(cat, model, declared, r, runs, mc, progress));
+  const std::vector<Responses> resp = marched_runs(model, r, specs, times, mc, progress);
+  for (size_t k = 0; k < runs.size(); ++k) {
+    RunModel rm;
+    rm.name = runs[k].run;
+    rm.spec = specs[k];
+    rm.times = runs[k].time;
+    rm.measured = measured_channels(runs[k], r);
+    rm.base = resp[k].base;
+    // The air the run's ambient sensor reads (the readout leaves it out of the channels).
+    rm.air = ambient_reading(runs[k]);
+    cat.runs.push_back(std::move(rm));
+  }
+  fill_columns(mc, resp);
   std::vector<Candidate> cands = std::move(mc.cands);
-  if (!ambient_only) cands = with_several_places(std::move(cands), declared, ref_speed);
+  if (!ambient_only)
+    cands = with_several_places(std::move(cands), declared, reference_speed(declared, specs));
   if (!ambient_only) add_sensor_candidates(cands, cat.runs, r, o);
-  // The air the runs' ambient sensors read (the readout leaves them out of the channels).
-  for (size_t k = 0; k < runs.size(); ++k) cat.runs[k].air = ambient_reading(runs[k]);
   cat.candidates = std::move(cands);
   return cat;
+}
+
+std::vector<Candidate> heat_flow_candidates(const MarchModel& model, const core::CaseSpec& declared,
+                                            const Readout& r,
+                                            const std::vector<core::CaseSpec>& runs,
+                                            const std::vector<Eigen::VectorXd>& times,
+                                            const CalibrationOptions& o,
+                                            const solvers::Progress& progress) {
+  if (runs.empty() || runs.size() != times.size())
+    throw core::DataError("heat-flow candidates: " + std::to_string(runs.size()) + " runs and " +
+                          std::to_string(times.size()) + " time vectors: expected one per run");
+  double end_max = 0;
+  for (const auto& t : times) {
+    if (t.size() == 0) throw core::DataError("heat-flow candidates: a run read at no time");
+    end_max = std::max(end_max, t(t.size() - 1));
+  }
+  MarchedCandidates mc = candidate_loads(model, declared, r, runs, end_max, o, false);
+  fill_columns(mc, marched_runs(model, r, runs, times, mc, progress));
+  return with_several_places(std::move(mc.cands), declared, reference_speed(declared, runs));
 }
 
 std::vector<double> fit_run_parameters(const Candidate& c, int run, const RunModel& model,

@@ -45,9 +45,22 @@ static_assert(core::one_to_one(kEffectKindNames));
 /// The kind's name in kEffectKindNames.
 std::string kind_name(EffectKind kind);
 
+/// How a heat input's flux follows the spindle: in proportion to speed, or constant.
+enum class HeatLaw { speed, constant };
+/// The laws' names in calibration.json and candidate names.
+inline constexpr std::array<core::Named<HeatLaw>, 2> kHeatLawNames{{
+    {HeatLaw::speed, "speed"},
+    {HeatLaw::constant, "constant"},
+}};
+static_assert(core::one_to_one(kHeatLawNames));
+/// The law's name in kHeatLawNames.
+std::string law_name(HeatLaw law);
+
 struct CalibrationOptions {
   double patch_spacing = 0.10;     /// grid of candidate heat-input patch centres [m]
   double patch_half_size = 0.065;  /// half edge of a patch's box [m]
+  /// The laws a heat input on a patch is tried under (one candidate per patch and law).
+  std::vector<HeatLaw> heat_laws{HeatLaw::speed, HeatLaw::constant};
   /// Place of a heat input refined after the grid: `heat_refine_levels` grids, each a third of
   /// the previous spacing, of boxes `heat_refine_half_scale` x patch_half_size around the best
   /// `heat_refine_parents` places found so far.
@@ -116,17 +129,6 @@ struct RunModel {
   Eigen::MatrixXd measured;  /// #samples x #channels [K | m], NaN missing
   Eigen::VectorXd air;       /// #samples: the run's ambient sensor [K], NaN missing; empty: none
 };
-
-/// How a heat input's flux follows the spindle: in proportion to speed, or constant.
-enum class HeatLaw { speed, constant };
-/// The laws' names in calibration.json and candidate names.
-inline constexpr std::array<core::Named<HeatLaw>, 2> kHeatLawNames{{
-    {HeatLaw::speed, "speed"},
-    {HeatLaw::constant, "constant"},
-}};
-static_assert(core::one_to_one(kHeatLawNames));
-/// The law's name in kHeatLawNames.
-std::string law_name(HeatLaw law);
 
 /// The material value a material_parameter candidate changes.
 enum class MaterialField { conductivity, heat_capacity, expansion };
@@ -272,6 +274,19 @@ Eigen::VectorXd face_load(const mesh::TetMesh& mesh, const std::vector<int>& fac
 Catalogue catalogue(const MarchModel& model, const core::CaseSpec& declared, const Readout& r,
                     const std::vector<io::MeasuredRun>& runs, const CalibrationOptions& options,
                     bool ambient_only = false, const solvers::Progress& progress = {});
+
+/// The catalogue's candidates that change the heat flow (the air on every sink and on the
+/// unfixed groups' sinks, heat inputs on patches, films, sources' growth with temperature,
+/// conductivity and capacity, in several places where the catalogue has them; not the sensors'
+/// own effects nor expansion), their columns the responses at `r`'s temperature channels along
+/// each of `runs` (cases with `declared`'s operators under their own duty cycles) read at
+/// `times` (one vector per run). What placement for detection asks to see.
+std::vector<Candidate> heat_flow_candidates(const MarchModel& model, const core::CaseSpec& declared,
+                                            const Readout& r,
+                                            const std::vector<core::CaseSpec>& runs,
+                                            const std::vector<Eigen::VectorXd>& times,
+                                            const CalibrationOptions& options,
+                                            const solvers::Progress& progress = {});
 
 /// `cat` with lag candidates of `sensor` at `lag_refine_steps` time constants spaced
 /// geometrically between the grid values either side of `tau` [s]: the grid's step (up to 1.7x)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <type_traits>
 #include <variant>
 
@@ -94,31 +95,49 @@ std::vector<std::pair<int, double>> point_weights(const mesh::TetMesh& m,
   return w;
 }
 
+Readout temperature_readout(const mesh::TetMesh& m, const core::CaseSpec& spec,
+                            const std::vector<std::string>& ids,
+                            const std::vector<Eigen::Vector3d>& points) {
+  if (ids.size() != points.size())
+    throw core::DataError("readout: " + std::to_string(ids.size()) + " sensor ids and " +
+                          std::to_string(points.size()) + " points: expected one point per id");
+  Readout r;
+  std::vector<Eigen::Triplet<double>> trip;
+  for (size_t s = 0; s < ids.size(); ++s)
+    for (const auto& [node, w] : point_weights(m, points[s]))
+      trip.emplace_back(static_cast<int>(s), node, w);
+  r.ids = ids;
+  r.sensors = static_cast<int>(ids.size());
+  r.run_column.resize(ids.size());
+  std::iota(r.run_column.begin(), r.run_column.end(), 0);
+  r.temperature.resize(r.sensors, m.nodes.rows());
+  r.temperature.setFromTriplets(trip.begin(), trip.end());
+  r.reference_k = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
+  r.displacement.resize(0, m.nodes.rows());
+  return r;
+}
+
 namespace {
 
 /// The located channels of `run`: sensors with their weights, probes with their geometry; no
 /// displacement rows yet.
 Readout located(const mesh::TetMesh& m, const core::CaseSpec& spec, const io::MeasuredRun& run) {
-  Readout r;
-  const Eigen::Index n = m.nodes.rows();
-  std::vector<Eigen::Triplet<double>> trip;
+  std::vector<std::string> ids;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> columns;
   for (size_t s = 0; s < run.sensors.size(); ++s) {
     // The ambient sensor reads the air, not the machine: it gives the air (ambient_reading).
     if (!run.sensors[s].position || run.sensors[s].id == run.ambient_sensor) continue;
-    for (const auto& [node, w] : point_weights(m, *run.sensors[s].position))
-      trip.emplace_back(r.sensors, node, w);
-    r.ids.push_back(run.sensors[s].id);
-    r.run_column.push_back(static_cast<int>(s));
-    r.sensors += 1;
+    ids.push_back(run.sensors[s].id);
+    points.push_back(*run.sensors[s].position);
+    columns.push_back(static_cast<int>(s));
   }
-  r.temperature.resize(r.sensors, n);
-  r.temperature.setFromTriplets(trip.begin(), trip.end());
+  Readout r = temperature_readout(m, spec, ids, points);
+  r.run_column = columns;
   std::vector<int> probes;
   for (size_t p = 0; p < run.displacements.size(); ++p)
     if (run.displacements[p].point && run.displacements[p].direction)
       probes.push_back(static_cast<int>(p));
-  r.reference_k = spec.mechanical.reference_temperature_c + core::kCelsiusOffset;
-  r.displacement.resize(0, n);
   if (!probes.empty() && spec.mechanical.enabled) {
     for (int p : probes) {
       r.ids.push_back(run.displacements[p].id);

@@ -43,6 +43,12 @@ struct Readout {
 std::vector<std::pair<int, double>> point_weights(const mesh::TetMesh& mesh,
                                                   const Eigen::Vector3d& p);
 
+/// Temperature channels only: sensor `ids[k]` at `points[k]` (interpolated on `mesh`), no probes.
+/// Throws DataError for ids and points that do not pair up or a point outside the mesh.
+Readout temperature_readout(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
+                            const std::vector<std::string>& ids,
+                            const std::vector<Eigen::Vector3d>& points);
+
 /// Readout of `run`'s channels on `mesh`. Sensors without a position and probes without a point or
 /// direction are left out. Throws DataError when nothing can be located.
 Readout readout(const mesh::TetMesh& mesh, const core::CaseSpec& spec, const io::MeasuredRun& run);
