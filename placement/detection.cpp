@@ -81,6 +81,44 @@ DetectionProblem detection_problem(const EstimationProblem& problem,
   return out;
 }
 
+DetectionProblem detection_problem(const std::vector<std::string>& effects,
+                                   const std::vector<std::vector<Eigen::MatrixXd>>& changes,
+                                   const Eigen::VectorXd& sigma, int sustain_readings) {
+  if (effects.size() != changes.size())
+    fail(std::to_string(effects.size()) + " effect names and " + std::to_string(changes.size()) +
+         " effects' changes: expected one of each per effect");
+  if (sustain_readings < 1)
+    fail("held over " + std::to_string(sustain_readings) + " readings: expected at least 1");
+  if (!(sigma.array() > 0).all() || !sigma.allFinite())
+    fail("a candidate's sigma that is not finite and > 0");
+  const auto ne = static_cast<Eigen::Index>(effects.size());
+  DetectionProblem out;
+  out.effects = effects;
+  out.held_sigmas = Eigen::MatrixXd::Zero(ne, sigma.size());
+  for (Eigen::Index e = 0; e < ne; ++e) {
+    const auto& runs = changes[static_cast<std::size_t>(e)];
+    if (runs.empty()) fail("effect '" + effects[static_cast<std::size_t>(e)] + "' on no run");
+    for (const Eigen::MatrixXd& change : runs) {
+      if (change.cols() != sigma.size())
+        fail("effect '" + effects[static_cast<std::size_t>(e)] + "' changes " +
+             std::to_string(change.cols()) + " candidates' readings; " +
+             std::to_string(sigma.size()) + " have a sigma");
+      const Eigen::MatrixXd in_sigmas = (change * sigma.cwiseInverse().asDiagonal()).transpose();
+      out.held_sigmas.row(e) =
+          out.held_sigmas.row(e).cwiseMax(held_largest(in_sigmas, sustain_readings).transpose());
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXd weights_per_kind(const std::vector<std::string>& kinds) {
+  Eigen::VectorXd w(static_cast<Eigen::Index>(kinds.size()));
+  for (std::size_t e = 0; e < kinds.size(); ++e)
+    w(static_cast<Eigen::Index>(e)) =
+        1.0 / static_cast<double>(std::count(kinds.begin(), kinds.end(), kinds[e]));
+  return w;
+}
+
 std::vector<int> unseen_effects(const DetectionProblem& problem, std::span<const int> columns,
                                 double bound) {
   std::vector<int> out;
@@ -96,14 +134,24 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
                             std::span<const int> pool, int m_max, double bound) {
   if (!(bound > 0) || !std::isfinite(bound))
     fail("a bound of " + std::to_string(bound) + " sigma: expected a finite bound > 0");
-  const Eigen::Index nc = problem.held_sigmas.cols();
+  const Eigen::Index nc = problem.held_sigmas.cols(), ne = problem.held_sigmas.rows();
   for (std::span<const int> set : {chosen, pool})
     for (int c : set)
       if (c < 0 || c >= nc)
         fail("candidate column " + std::to_string(c) + " of " + std::to_string(nc));
+  const Eigen::VectorXd weight =
+      problem.weights.size() == 0 ? Eigen::VectorXd::Ones(ne) : problem.weights;
+  if (weight.size() != ne || !weight.allFinite() || (weight.array() < 0).any())
+    fail(std::to_string(problem.weights.size()) + " weights for " + std::to_string(ne) +
+         " effects: expected one finite weight >= 0 per effect");
   const auto start = std::chrono::steady_clock::now();
   std::vector<int> columns(chosen.begin(), chosen.end());
   std::vector<int> unseen = unseen_effects(problem, columns, bound);
+  const auto seen_weight = [&] {
+    double unseen_weight = 0;
+    for (int e : unseen) unseen_weight += weight(e);
+    return weight.sum() - unseen_weight;
+  };
   GreedyPath path;
   for (int step = 0; step < m_max; ++step) {
     // Per unseen effect, how far the chosen sensors already get towards the bound.
@@ -112,14 +160,14 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
       for (int s : columns) already[u] = std::max(already[u], problem.held_sigmas(unseen[u], s));
     // Per candidate: the effects it would add, then the progress beyond that towards the rest.
     int best = -1;
-    std::pair<int, double> best_gain{0, 0.0};
+    std::pair<double, double> best_gain{0.0, 0.0};
     for (int c : pool) {
       if (std::find(columns.begin(), columns.end(), c) != columns.end()) continue;
-      std::pair<int, double> gain{0, 0.0};
+      std::pair<double, double> gain{0.0, 0.0};
       for (std::size_t u = 0; u < unseen.size(); ++u) {
-        const double held = problem.held_sigmas(unseen[u], c);
-        gain.first += held >= bound;
-        gain.second += std::max(0.0, std::min(held, bound) - already[u]);
+        const double held = problem.held_sigmas(unseen[u], c), w = weight(unseen[u]);
+        gain.first += held >= bound ? w : 0.0;
+        gain.second += w * std::max(0.0, std::min(held, bound) - already[u]);
       }
       const bool adds = gain.first > 0 || gain.second > 0;
       if (adds && (gain > best_gain || (gain == best_gain && c < best))) {
@@ -131,8 +179,7 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
     columns.push_back(best);
     unseen = unseen_effects(problem, columns, bound);
     path.order.push_back(best);
-    path.scores.push_back(static_cast<double>(problem.held_sigmas.rows()) -
-                          static_cast<double>(unseen.size()));
+    path.scores.push_back(seen_weight());
     path.seconds.push_back(core::seconds_since(start));
   }
   return path;

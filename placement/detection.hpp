@@ -27,7 +27,14 @@ namespace tt::placement {
 struct DetectionProblem {
   std::vector<std::string> effects;  ///< #effects names
   Eigen::MatrixXd held_sigmas;       ///< #effects x #candidates
+  /// #effects: what seeing each effect is worth to the greedy (empty: 1 each). One kind's places
+  /// weighted 1 / #places together count as one kind whose place is drawn at random.
+  Eigen::VectorXd weights;
+  std::vector<std::string> kinds;  ///< #effects: each effect's kind, for reports (may be empty)
 };
+
+/// Weights that make each kind of `kinds` count once: 1 / (the number of effects of its kind).
+Eigen::VectorXd weights_per_kind(const std::vector<std::string>& kinds);
 
 /// The held changes of `problem`'s candidates under each unknown input `effect_states` (indices
 /// into the tracks' states, after the reduced ones) held constant at `sizes` (one per effect, in
@@ -39,12 +46,23 @@ DetectionProblem detection_problem(const EstimationProblem& problem,
                                    std::span<const Eigen::Index> effect_states,
                                    const Eigen::VectorXd& sizes, int sustain_readings);
 
+/// The same from the effects' own responses: `changes[e][k]` is effect e's change of every
+/// candidate's reading along run k at its stated size (#readings x #candidates, in the readings'
+/// unit), `sigma` each candidate's noise (#candidates, same unit); held over `sustain_readings`
+/// as above. Throws core::DataError for names and changes that do not pair up, an effect with no
+/// run, a change of another number of candidates than `sigma` has, a sigma that is not finite
+/// and > 0, or sustain_readings < 1.
+DetectionProblem detection_problem(const std::vector<std::string>& effects,
+                                   const std::vector<std::vector<Eigen::MatrixXd>>& changes,
+                                   const Eigen::VectorXd& sigma, int sustain_readings);
+
 /// Greedy forward selection over `pool` added to the sensors `chosen` (already installed): at
 /// each step the candidate that makes the most effects seen (held_sigmas >= bound at some chosen
-/// sensor), ties broken by the most progress towards the unseen ones (the sum over them of
-/// min(held, bound)), exact ties to the lower column; up to m_max sensors, or until no candidate
-/// adds to either. `scores` is the number of effects seen after each step. Throws
-/// core::DataError for a bound that is not finite and > 0 or a column out of range.
+/// sensor; each counted at its weight), ties broken by the most progress towards the unseen ones
+/// (the sum over them of weight x min(held, bound)), exact ties to the lower column; up to m_max
+/// sensors, or until no candidate adds to either. `scores` is the (weighted) number of effects
+/// seen after each step. Throws core::DataError for a bound that is not finite and > 0, a column
+/// out of range, or weights that are not one per effect, finite and >= 0.
 GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int> chosen,
                             std::span<const int> pool, int m_max, double bound);
 

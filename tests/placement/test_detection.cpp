@@ -98,5 +98,58 @@ TEST(Detection, GreedyMakesTheMostEffectsSeenThenTheMostProgress) {
   EXPECT_THROW(detection_greedy(d, installed, std::vector<int>{4}, 1, 3.0), core::DataError);
 }
 
+TEST(Detection, WeightsPerKindCountEachKindOnce) {
+  // Three patches of one kind and one film: with weights per kind, the candidate that sees the
+  // film (one kind) is worth more than the one that sees two of the three patches (2/3 of a
+  // kind); unweighted, the two patches win. The scores are the kinds seen.
+  DetectionProblem d;
+  d.effects = {"patch a", "patch b", "patch c", "film"};
+  d.kinds = {"heat_input", "heat_input", "heat_input", "boundary_conductance"};
+  d.held_sigmas = Eigen::MatrixXd(4, 2);
+  d.held_sigmas << 4, 0,  //
+      4, 0,               //
+      0, 0,               //
+      0, 4;
+  const std::vector<int> none, pool{0, 1};
+  EXPECT_EQ(detection_greedy(d, none, pool, 1, 3.0).order, (std::vector<int>{0}));
+  d.weights = weights_per_kind(d.kinds);
+  ASSERT_EQ(d.weights.size(), 4);
+  EXPECT_DOUBLE_EQ(d.weights(0), 1.0 / 3);
+  EXPECT_DOUBLE_EQ(d.weights(3), 1.0);
+  const GreedyPath path = detection_greedy(d, none, pool, 2, 3.0);
+  EXPECT_EQ(path.order, (std::vector<int>{1, 0}));
+  ASSERT_EQ(path.scores.size(), 2u);
+  EXPECT_DOUBLE_EQ(path.scores[0], 1.0);
+  EXPECT_DOUBLE_EQ(path.scores[1], 1.0 + 2.0 / 3);
+  d.weights = Eigen::VectorXd::Ones(3);
+  EXPECT_THROW(detection_greedy(d, none, pool, 1, 3.0), core::DataError);
+  d.weights = -Eigen::VectorXd::Ones(4);
+  EXPECT_THROW(detection_greedy(d, none, pool, 1, 3.0), core::DataError);
+}
+
+TEST(Detection, ProblemFromResponsesHoldsEachRunsChange) {
+  // One effect on two runs, two candidates of sigma 0.1 and 0.5 K: the held change is the largest
+  // over both runs and times of the smallest |change| over 2 consecutive readings, in sigmas.
+  Eigen::MatrixXd run1(4, 2), run2(3, 2);
+  run1 << 0.1, 1.0,  //
+      0.3, -2.0,     //
+      0.2, 0.5,      //
+      0.0, 0.0;
+  run2 << -0.4, 0.1,  //
+      -0.35, 0.2,     //
+      0.0, 0.3;
+  const Eigen::Vector2d sigma(0.1, 0.5);
+  const DetectionProblem d = detection_problem({"heat"}, {{run1, run2}}, sigma, 2);
+  ASSERT_EQ(d.held_sigmas.rows(), 1);
+  EXPECT_NEAR(d.held_sigmas(0, 0), 0.35 / 0.1, 1e-12);  // run 2's first two readings
+  EXPECT_NEAR(d.held_sigmas(0, 1), 1.0 / 0.5, 1e-12);   // run 1's first two readings
+  EXPECT_NEAR(detection_problem({"heat"}, {{run1}}, sigma, 1).held_sigmas(0, 1), 4.0, 1e-12);
+  EXPECT_THROW(detection_problem({"heat", "air"}, {{run1}}, sigma, 2), core::DataError);
+  EXPECT_THROW(detection_problem({"heat"}, {{}}, sigma, 2), core::DataError);
+  EXPECT_THROW(detection_problem({"heat"}, {{run1}}, Eigen::Vector3d::Ones(), 2), core::DataError);
+  EXPECT_THROW(detection_problem({"heat"}, {{run1}}, Eigen::Vector2d(0.1, 0), 2), core::DataError);
+  EXPECT_THROW(detection_problem({"heat"}, {{run1}}, sigma, 0), core::DataError);
+}
+
 }  // namespace
 }  // namespace tt::placement
