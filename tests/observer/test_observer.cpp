@@ -22,6 +22,7 @@
 #include "solvers/observer.hpp"
 #include "solvers/observer_live.hpp"
 #include "solvers/twin.hpp"
+#include "studies/catalogue_detection.hpp"
 #include "studies/estimation_input.hpp"
 
 namespace tt::observer_test {
@@ -749,6 +750,87 @@ TEST_F(Observer, DetectionPlacementReadsTheChangeAnUndeclaredAirMakes) {
   EXPECT_THROW(
       studies::observer_detection_problem(s_->twin, problem, c, default_noise(), {5, 1}, 0, 300),
       core::SolverError);
+}
+
+TEST_F(Observer, CatalogueDetectionReadsEachEffectAsTheFullModelAndTheTwinDo) {
+  // Placement for detection on the calibration catalogue's effects
+  // (studies::catalogue_detection_problem), marched on the reduced model on the candidates' rows:
+  // every effect's held change as the full-order march gives it, and the air's 1 K on every sink
+  // as the twin run twice gives it (with the declared air; with every sink 1 K warmer); held over
+  // 900 s of readings every 300 s (four readings), in the candidates' sigmas.
+  core::CaseSpec c = run_spec();
+  c.duty_cycle.end = 2 * 3600;
+  c.thermal.output_interval = 300;
+  studies::CatalogueDetectionInput in;
+  in.names = {"T02", "T11", "T25", "T44"};
+  for (const auto& name : in.names)
+    for (const auto& p : s_->mesh.points)
+      if (p.id == name) in.points.push_back(p.position);
+  ASSERT_EQ(in.points.size(), in.names.size());
+  in.sensor_sigma_k = 0.04;
+  in.catalogue.patch_spacing = 0.15;
+  in.catalogue.patch_half_size = 0.1;
+  in.catalogue.heat_laws = {calibration::HeatLaw::constant};
+  const placement::DetectionProblem d =
+      studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in);
+  in.full_order = true;
+  const placement::DetectionProblem full =
+      studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in);
+  ASSERT_EQ(d.effects, full.effects);
+  ASSERT_EQ(d.held_sigmas.rows(), static_cast<Eigen::Index>(d.effects.size()));
+  ASSERT_EQ(d.held_sigmas.cols(), 4);
+  int patches = 0;
+  for (const auto& e : d.effects) patches += e.find("heat input") != std::string::npos;
+  EXPECT_GT(patches, 10);
+  for (const std::string kind :
+       {"conductance of", "growing with speed", "growing with its temperature", "conductivity of",
+        "heat_capacity of", "air temperature on every convective sink"})
+    EXPECT_TRUE(std::any_of(d.effects.begin(), d.effects.end(), [&](const std::string& e) {
+      return e.find(kind) != std::string::npos;
+    })) << kind;
+  for (Eigen::Index e = 0; e < d.held_sigmas.rows(); ++e)
+    for (Eigen::Index k = 0; k < 4; ++k)
+      EXPECT_NEAR(d.held_sigmas(e, k), full.held_sigmas(e, k),
+                  1e-4 * full.held_sigmas.row(e).maxCoeff())
+          << d.effects[static_cast<std::size_t>(e)] << " at "
+          << in.names[static_cast<std::size_t>(k)];
+  double worst = 0;  // the largest difference, relative to the effect's largest held change
+  for (Eigen::Index e = 0; e < d.held_sigmas.rows(); ++e)
+    worst = std::max(worst, (d.held_sigmas.row(e) - full.held_sigmas.row(e)).cwiseAbs().maxCoeff() /
+                                full.held_sigmas.row(e).maxCoeff());
+  std::printf(
+      "[observer] catalogue detection: %zu effects (%d patches), reduced against full "
+      "order: largest difference %.2g of the effect's largest held change; held [sigma] "
+      "range %.3g .. %.3g\n",
+      d.effects.size(), patches, worst, d.held_sigmas.minCoeff(), d.held_sigmas.maxCoeff());
+  // Some patch is seen (3 sigma) by some candidate and not by another: the criterion has a choice.
+  const double bound = 3;
+  EXPECT_TRUE(((d.held_sigmas.array() >= bound).rowwise().any() &&
+               (d.held_sigmas.array() < bound).rowwise().any())
+                  .any());
+  const auto air =
+      std::find(d.effects.begin(), d.effects.end(), "air temperature on every convective sink");
+  ASSERT_NE(air, d.effects.end());
+  core::CaseSpec warmer = c;
+  for (auto& entry : warmer.thermal.convection)
+    for (double& v : entry.sink.value) v += 1;
+  const solvers::TwinRun declared = solvers::twin_run(s_->twin, c);
+  const solvers::TwinRun changed = solvers::twin_run(s_->twin, warmer);
+  ASSERT_EQ(declared.times.size(), 25u);  // t = 0, then every 300 s for 2 h
+  const auto& names = s_->twin.outputs.names;
+  for (std::size_t k = 0; k < in.names.size(); ++k) {
+    const auto col = std::find(names.begin(), names.end(), in.names[k]) - names.begin();
+    const Eigen::VectorXd change =
+        (changed.outputs.col(col) - declared.outputs.col(col)).tail(24).cwiseAbs() / 0.04;
+    double held = 0;
+    for (Eigen::Index i = 0; i + 4 <= change.size(); ++i)
+      held = std::max(held, change.segment(i, 4).minCoeff());
+    EXPECT_NEAR(d.held_sigmas(air - d.effects.begin(), static_cast<Eigen::Index>(k)), held,
+                0.01 * held)
+        << in.names[k];
+  }
+  in.sustain_s = 0;
+  EXPECT_THROW(studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in), core::DataError);
 }
 
 TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
