@@ -40,6 +40,9 @@ struct PlaceArgs {
   bool sensor_noise = false;  /// place on readings with the campaign's sensor noise
   bool quiet = false;
   std::vector<std::string> methods;  /// placement methods by name; empty: all but observer_variance
+  /// also place for detection of the calibration catalogue's effects (placement.json
+  /// catalogue_detection)
+  bool catalogue_detection = false;
 };
 
 struct FitArgs {

@@ -182,6 +182,11 @@ Command place_line(CLI::App& cli) {
                   "place on readings as real sensors give them: the campaign's noise (0.05 K, "
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
+  place->add_flag("--catalogue-detection", place_args.catalogue_detection,
+                  "also place for detection of the calibration catalogue's effects (a heat input "
+                  "on any patch of the surface, films, sources, materials, the air): where each "
+                  "would move a reading 3 sigma for 900 s (placement.json catalogue_detection, "
+                  "docs/placement.md)");
   place
       ->add_option("--methods", place_args.methods,
                    "placement methods, comma-separated (default: all but observer_variance, the "

@@ -60,8 +60,8 @@ std::vector<placement::Method> methods_named(const std::vector<std::string>& nam
 
 /// The reduced model of observer_variance: read from `rom` and checked against the case, or built
 /// on the fly.
-solvers::Twin estimation_twin(const core::CaseSpec& spec, const std::filesystem::path& rom) {
-  const mesh::TetMesh mesh = mesh::mesh_case(spec);
+solvers::Twin estimation_twin(const core::CaseSpec& spec, const mesh::TetMesh& mesh,
+                              const std::filesystem::path& rom) {
   if (rom.empty()) return solvers::case_twin(mesh, spec);
   io::ReducedModelFile file = io::read_reduced_model(rom);
   io::check_reduced_model_fits(file, io::reduced_model_key(spec, mesh), rom);
@@ -99,14 +99,19 @@ int place_command(const PlaceArgs& args) {
   const std::vector<placement::Method> methods = methods_named(args.methods);
   std::optional<io::OutputDir> out;
   const Candidates c = candidates_of(args, out);
+  const bool estimation = std::find(methods.begin(), methods.end(),
+                                    placement::Method::kObserverVariance) != methods.end();
+  std::optional<mesh::TetMesh> mesh;
+  if (estimation || args.catalogue_detection) mesh = mesh::mesh_case(c.spec);
   std::optional<solvers::Twin> twin;
-  if (std::find(methods.begin(), methods.end(), placement::Method::kObserverVariance) !=
-      methods.end())
-    twin = estimation_twin(c.spec, args.rom);
+  if (estimation) twin = estimation_twin(c.spec, *mesh, args.rom);
   // 2. Every placement method, for each target and m = 1..m_max.
-  const studies::PlaceReport report =
-      studies::place_sensors({&c.spec, c.histories, methods, args.samples, args.bins, args.m_max,
-                              args.sensor_noise, twin ? &*twin : nullptr});
+  const studies::PlaceReport report = studies::place_sensors(
+      {&c.spec, c.histories, methods, args.samples, args.bins, args.m_max, args.sensor_noise,
+       twin ? &*twin : nullptr, args.catalogue_detection ? &*mesh : nullptr,
+       args.quiet ? solvers::Progress{} : [](double done, double total) {
+         report_progress("place: the catalogue's effects for detection", done, total);
+       }});
   // 3. Outputs, all or nothing.
   io::write_place(out->path(), report, {args.sensor_noise, c.model, args.rom});
   out->commit();

@@ -1,5 +1,6 @@
 #include "io/place_out.hpp"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,60 @@ nlohmann::json detection_json(const studies::DetectionReport& d, const studies::
           {"unseen_by_observer_variance", by_target}};
 }
 
+/// Placement for detection of the calibration catalogue's effects: the settings, each kind's
+/// effects, each effect's best candidate, the greedy from no sensor (kinds seen) and the kinds
+/// each method's largest set sees.
+nlohmann::json catalogue_detection_json(const studies::CatalogueDetectionReport& d,
+                                        const studies::Histories& h) {
+  const auto& held = d.problem.held_sigmas;
+  const auto& in = d.settings;
+  nlohmann::json effects = nlohmann::json::array();
+  std::map<std::string, int> per_kind;
+  for (Eigen::Index e = 0; e < held.rows(); ++e) {
+    const auto k = static_cast<std::size_t>(e);
+    Eigen::Index best = 0;
+    const double most = held.cols() > 0 ? held.row(e).maxCoeff(&best) : 0.0;
+    effects.push_back({{"name", d.problem.effects[k]},
+                       {"kind", d.problem.kinds[k]},
+                       {"best_candidate",
+                        held.cols() > 0 ? h.names[static_cast<std::size_t>(best)] : std::string()},
+                       {"best_held_sigmas", most}});
+    ++per_kind[d.problem.kinds[k]];
+  }
+  nlohmann::json greedy = nlohmann::json::array();
+  for (std::size_t k = 0; k < d.greedy.order.size(); ++k) {
+    const std::vector<int> so_far(d.greedy.order.begin(),
+                                  d.greedy.order.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+    greedy.push_back(
+        {{"candidate", h.names[static_cast<std::size_t>(d.greedy.order[k])]},
+         {"id", d.greedy.order[k] + 1},
+         {"kinds_seen", d.greedy.scores[k]},
+         {"effects_seen",
+          held.rows() - static_cast<Eigen::Index>(
+                            placement::unseen_effects(d.problem, so_far, d.bound_sigmas).size())}});
+  }
+  nlohmann::json by_target = nlohmann::json::object();
+  for (const auto& [target, methods] : d.kinds_seen)
+    for (const auto& [method, seen] : methods) by_target[target][method] = seen;
+  return {{"bound_sigmas", d.bound_sigmas},
+          {"sustain_s", in.sustain_s},
+          {"reading_interval_s", in.sample_s},
+          {"sensor_sigma_K", in.sensor_sigma_k},
+          {"model", in.full_order ? "full order" : "reduced on the candidates' rows"},
+          {"sizes",
+           {{"heat_W", in.sizes.heat_w},
+            {"film_share", in.sizes.film_share},
+            {"source_coefficient_per_K", in.sizes.source_coefficient_per_k},
+            {"material_change", in.sizes.material_change},
+            {"air_K", in.sizes.air_k}}},
+          {"patch_spacing_m", in.catalogue.patch_spacing},
+          {"patch_half_size_m", in.catalogue.patch_half_size},
+          {"effects_per_kind", per_kind},
+          {"effects", effects},
+          {"greedy", greedy},
+          {"kinds_seen_by_method", by_target}};
+}
+
 /// Each target's single-sensor MI and rank per candidate, for the point cloud.
 std::vector<NamedField> mi_fields(const placement::PlacementResult& result) {
   std::vector<NamedField> fields;
@@ -110,6 +165,8 @@ void write_place(const std::filesystem::path& dir, const studies::PlaceReport& r
   doc["model"] = source.model;
   if (report.estimation) doc["observer_variance"] = estimation_json(*report.estimation, source.rom);
   if (report.detection) doc["observer_detection"] = detection_json(*report.detection, h);
+  if (report.catalogue_detection)
+    doc["catalogue_detection"] = catalogue_detection_json(*report.catalogue_detection, h);
   doc["candidates"] = candidates_json(h);
   write_json(dir / "placement.json", doc);
   write_mi_ranking_csv(dir / "mi_ranking.csv", report.result);

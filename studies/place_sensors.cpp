@@ -1,6 +1,7 @@
 #include "studies/place_sensors.hpp"
 
 #include <chrono>
+#include <map>
 
 #include "core/timing.hpp"
 #include "fitting/noise.hpp"
@@ -75,6 +76,53 @@ DetectionReport detection_report(const PlaceInput& input, const placement::Estim
   return d;
 }
 
+/// The weighted number of effects of `d` that `columns` see at `bound` (the kinds seen, when the
+/// weights count each kind once).
+double seen_weight(const placement::DetectionProblem& d, const std::vector<int>& columns,
+                   double bound) {
+  const Eigen::VectorXd w =
+      d.weights.size() ? d.weights : Eigen::VectorXd::Ones(d.held_sigmas.rows());
+  double seen = w.sum();
+  for (int e : placement::unseen_effects(d, columns, bound)) seen -= w(e);
+  return seen;
+}
+
+/// Placement for detection of the catalogue's effects on the case's duty cycle: the greedy from
+/// no sensor, and the kinds each method's set of the largest m sees.
+CatalogueDetectionReport catalogue_detection_report(const PlaceInput& input, const Histories& h,
+                                                    const placement::PlacementResult& result) {
+  CatalogueDetectionReport d;
+  const solvers::ConsistencyOptions alarm;
+  d.bound_sigmas = alarm.model_residual_sigmas;
+  d.settings.sustain_s = alarm.sustain_s;
+  d.settings.sample_s = input.spec->thermal.output_interval;
+  d.settings.sensor_sigma_k = fitting::SensorNoise{}.temperature_sigma;
+  // Many candidates (a surface's vertices) make the reduced basis on their rows larger than the
+  // mesh is worth: the full model then.
+  d.settings.full_order = h.names.size() > kCatalogueReducedCandidates;
+  CatalogueDetectionInput in = d.settings;
+  in.names = h.names;
+  for (Eigen::Index c = 0; c < h.positions.rows(); ++c)
+    in.points.push_back(h.positions.row(c).transpose());
+  d.problem = catalogue_detection_problem(*input.catalogue_mesh, *input.spec, {*input.spec}, in,
+                                          input.catalogue_progress);
+  std::vector<int> pool(h.names.size());
+  for (std::size_t c = 0; c < pool.size(); ++c) pool[c] = static_cast<int>(c);
+  d.greedy = placement::detection_greedy(d.problem, {}, pool, input.m_max, d.bound_sigmas);
+  for (const auto& t : result.targets) {
+    std::map<std::string, const placement::Selection*> largest;
+    for (const auto& s : t.selections) {
+      const std::string method(placement::method_name(s.method));
+      if (!largest[method] || s.m > largest[method]->m) largest[method] = &s;
+    }
+    auto& by_method =
+        d.kinds_seen.emplace_back(t.target, std::vector<std::pair<std::string, double>>{}).second;
+    for (const auto& [method, s] : largest)
+      by_method.emplace_back(method, seen_weight(d.problem, s->columns, d.bound_sigmas));
+  }
+  return d;
+}
+
 }  // namespace
 
 placement::PlacementInput placement_input(const Histories& h) {
@@ -103,6 +151,8 @@ PlaceReport place_sensors(const PlaceInput& input) {
   report.result = placement::place_all(in, placement_options(input));
   if (in.estimation)
     report.detection = detection_report(input, *in.estimation, *report.estimation, report.result);
+  if (input.catalogue_mesh)
+    report.catalogue_detection = catalogue_detection_report(input, report.histories, report.result);
   report.place_s = core::seconds_since(t);
   return report;
 }

@@ -8,9 +8,11 @@
 #include <vector>
 
 #include "core/case_spec.hpp"
+#include "mesh/tet_mesh.hpp"
 #include "placement/place.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
+#include "studies/catalogue_detection.hpp"
 #include "studies/estimation_input.hpp"
 #include "studies/histories.hpp"
 
@@ -28,6 +30,11 @@ struct PlaceInput {
   /// the reduced model whose observer observer_variance places for (give it when that method is
   /// asked for); nullptr: no estimation problem
   const solvers::Twin* twin = nullptr;
+  /// the case's mesh, for placement for detection of the calibration catalogue's effects (the
+  /// candidates are read at their positions on it); nullptr: not asked for
+  const mesh::TetMesh* catalogue_mesh = nullptr;
+  /// gets the simulated time over the total as the catalogue's effects are marched
+  solvers::Progress catalogue_progress;
 };
 
 /// The observer's settings for placement for estimation.
@@ -50,12 +57,29 @@ struct DetectionReport {
   std::vector<std::pair<std::string, std::vector<int>>> unseen_by_estimation;
 };
 
+/// Placement for detection of the calibration catalogue's heat-flow effects (studies::
+/// catalogue_detection_problem on the case's duty cycle, read at its output interval), each kind
+/// counted once.
+/// Up to this many candidates the catalogue's effects are marched on the reduced model on their
+/// rows; beyond, in full order (each candidate's row adds Krylov vectors to the basis).
+inline constexpr std::size_t kCatalogueReducedCandidates = 64;
+
+struct CatalogueDetectionReport {
+  CatalogueDetectionInput settings;  /// sizes, patches, sigma, readings (names and points left out)
+  double bound_sigmas = 0;           /// the declared-run test's bound (ConsistencyOptions defaults)
+  placement::DetectionProblem problem;
+  placement::GreedyPath greedy;  /// from no sensor, up to m_max: kinds seen after each step
+  /// per target and method: the kinds its set of the largest m sees
+  std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> kinds_seen;
+};
+
 struct PlaceReport {
   Histories histories;  /// as placed on: with the sensor noise when it was asked for
   placement::PlacementResult result;
-  std::optional<EstimationSettings> estimation;  /// with observer_variance
-  std::optional<DetectionReport> detection;      /// with observer_variance
-  double place_s = 0;                            /// wall time of the placement [s]
+  std::optional<EstimationSettings> estimation;                 /// with observer_variance
+  std::optional<DetectionReport> detection;                     /// with observer_variance
+  std::optional<CatalogueDetectionReport> catalogue_detection;  /// with catalogue_mesh
+  double place_s = 0;                                           /// wall time of the placement [s]
 };
 
 /// The histories as one placement input: candidates numbered 1.. in their order.

@@ -218,4 +218,63 @@ TEST(FitCli, PlacesForEstimationWhenAsked) {
   if (!HasFailure()) fs::remove_all(dir);
 }
 
+TEST(PlaceCli, PlacesForDetectionOfTheCataloguesEffectsWhenAsked) {
+  // `place --catalogue-detection` on the coarse SB-1's named points (54, marched on the reduced
+  // model on their rows): every kind of the catalogue's heat-flow effects at its size, each
+  // effect's best candidate, a greedy whose kinds seen grow with each sensor and never exceed the
+  // kinds, and the kinds each method's largest set sees. It says how far the march is; without the
+  // flag there is no catalogue_detection.
+  const fs::path dir = fs::temp_directory_path() / "tt_place_catalogue";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_EQ(thermotwin({"place", kCoarse.string(), "--out", (dir / "place").string(), "--methods",
+                        "correlation", "--m-max", "3", "--catalogue-detection"},
+                       dir / "place.log"),
+            0)
+      << text_of(dir / "place.log");
+  EXPECT_NE(text_of(dir / "place.log")
+                .find("thermotwin: place: the catalogue's effects for detection 100 %"),
+            std::string::npos)
+      << text_of(dir / "place.log");
+  EXPECT_TRUE(tt::test::matches_output_schemas("place", dir / "place"));
+  const auto doc = nlohmann::json::parse(text_of(dir / "place" / "placement.json"));
+  ASSERT_TRUE(doc.contains("catalogue_detection"));
+  const auto& d = doc["catalogue_detection"];
+  EXPECT_EQ(d["model"], "reduced on the candidates' rows");
+  EXPECT_EQ(d["bound_sigmas"], 3.0);
+  const std::vector<std::string> kinds{"ambient_temperature",        "heat_input",
+                                       "speed_dependent_convection", "temperature_dependent_heat",
+                                       "boundary_conductance",       "material_parameter"};
+  std::size_t effects = 0;
+  for (const auto& kind : kinds) {
+    ASSERT_TRUE(d["effects_per_kind"].contains(kind)) << kind;
+    effects += d["effects_per_kind"][kind].get<std::size_t>();
+  }
+  EXPECT_EQ(d["effects_per_kind"].size(), kinds.size());
+  ASSERT_EQ(d["effects"].size(), effects);
+  EXPECT_GT(d["effects_per_kind"]["heat_input"].get<int>(), 100);  // patches under two laws
+  int beyond = 0;                                                  // effects some candidate sees
+  for (const auto& e : d["effects"]) beyond += e["best_held_sigmas"].get<double>() >= 3.0;
+  ASSERT_EQ(d["greedy"].size(), 3u);
+  double before = 0;
+  for (const auto& step : d["greedy"]) {
+    EXPECT_GT(step["kinds_seen"].get<double>(), before) << step;
+    before = step["kinds_seen"].get<double>();
+    EXPECT_LE(step["effects_seen"].get<int>(), beyond);
+  }
+  EXPECT_LE(before, static_cast<double>(kinds.size()));
+  for (const std::string target : {"dy", "dz"}) {
+    const double seen = d["kinds_seen_by_method"][target]["correlation"].get<double>();
+    EXPECT_GT(seen, 0.0) << target;
+    EXPECT_LE(seen, static_cast<double>(kinds.size())) << target;
+  }
+  ASSERT_EQ(thermotwin({"place", kCoarse.string(), "--out", (dir / "without").string(), "--methods",
+                        "correlation", "--m-max", "2", "--quiet"},
+                       dir / "place.log"),
+            0);
+  EXPECT_FALSE(nlohmann::json::parse(text_of(dir / "without" / "placement.json"))
+                   .contains("catalogue_detection"));
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
 }  // namespace
