@@ -6,7 +6,7 @@
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
 //                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT=0]
 //                               [GEN_ONLY=-1] [SENSOR_OFFSET_K=0] [SENSOR_OFFSET_WALK_K=0]
-//                               [CHANGED_TRAINING=0]
+//                               [CHANGED_TRAINING=0] [CATALOGUE_SPACING=0.25]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
 //   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
 //   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
@@ -38,6 +38,10 @@
 //     correlation+detection the correlation's sensors and COUNT (0: 2) more placed for detection
 //                     (placement::detection_greedy: the observer's unknown heat inputs at 5 W and
 //                     its air at 1 K, each to move some sensor's reading 3 sigma for 900 s)
+//     correlation+catalogue the same on the calibration catalogue's heat-flow effects
+//                     (studies::catalogue_detection: 5 W on each patch of a grid every
+//                     CATALOGUE_SPACING m under the constant law, films changed by 25 % of their
+//                     h, sources' heat growing 0.02/K, conductivity and capacity 10 %, air 1 K)
 // 1. The case, its mesh, full system and twin (reduced model with the TCP rows).
 // 2. The virtual campaign in full order with the fit's noise (fitting::SensorNoise) on every
 //    reading; the fit's split (fitting: p1_extended, staircase_up, irregular_a, warm_start;
@@ -68,8 +72,11 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <optional>
 #include <random>
 #include <set>
+#include <variant>
 
 #include "calibration/generator.hpp"
 #include "calibration/model.hpp"
@@ -86,6 +93,7 @@
 #include "solvers/thermal_error.hpp"
 #include "solvers/twin.hpp"
 #include "studies/axis_fit.hpp"
+#include "studies/catalogue_detection.hpp"
 #include "studies/estimation_input.hpp"
 #include "studies/placement_input.hpp"
 
@@ -254,6 +262,79 @@ std::string fmt(double v, int digits = 3) {
   return o.str();
 }
 
+/// The catalogue's effect that stands for the generator's `effect` (the nearest patch, the same
+/// film, source or material field, the air on the unfixed sinks) and the factor from the size it
+/// was held at to the effect's; {-1, 0} when none does (a sensor's own fault, expansion).
+std::pair<int, double> catalogue_match(const studies::CatalogueDetection& d,
+                                       const calibration::InjectedEffect& e,
+                                       const core::CaseSpec& spec) {
+  using namespace calibration;
+  const auto group = [&](const std::vector<int>& entries) {
+    return entries.size() == 1
+               ? spec.groups[spec.thermal.convection[static_cast<std::size_t>(entries[0])].group]
+                     .name
+               : std::string();
+  };
+  std::pair<int, double> best{-1, 0.0};
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < d.effects.size(); ++k) {
+    const Effect& c = d.effects[k];
+    const double size = d.sizes(static_cast<Eigen::Index>(k));
+    const int at = static_cast<int>(k);
+    if (const auto* h = std::get_if<HeatInput>(&c); h && e.kind == EffectKind::heat_input) {
+      if ((h->centre - e.centre).norm() < nearest) {
+        nearest = (h->centre - e.centre).norm();
+        best = {at, e.magnitude / size / h->area};  // the effect's W over the patch's flux
+      }
+    } else if (const auto* f = std::get_if<SpeedDependentConvection>(&c);
+               f && e.kind == EffectKind::speed_dependent_convection &&
+               group(f->entries) == e.target) {
+      best = {at, e.magnitude / size};  // gains [W/(m2 K)]
+    } else if (const auto* b = std::get_if<BoundaryConductance>(&c);
+               b && e.kind == EffectKind::boundary_conductance && group(b->entries) == e.target) {
+      const auto entry = static_cast<std::size_t>(b->entries[0]);
+      best = {at, e.magnitude * spec.thermal.convection[entry].h / size};  // h x (1 + magnitude)
+    } else if (const auto* t = std::get_if<TemperatureDependentHeat>(&c);
+               t && e.kind == EffectKind::temperature_dependent_heat && t->sources.size() == 1 &&
+               spec.thermal.sources[static_cast<std::size_t>(t->sources[0])].name == e.target) {
+      best = {at, e.magnitude / size};
+    } else if (const auto* m = std::get_if<MaterialParameter>(&c);
+               m && e.kind == EffectKind::material_parameter &&
+               spec.materials[static_cast<std::size_t>(m->material)].name + "." +
+                       field_name(m->field) ==
+                   e.target) {
+      best = {at, e.magnitude / size};
+    } else if (std::holds_alternative<AmbientTemperature>(c) &&
+               e.kind == EffectKind::ambient_temperature) {
+      best = {at, e.magnitude / size};  // every sink's, then the unfixed sinks' (the generator's)
+    }
+  }
+  return best;
+}
+
+/// What placement for detection on the catalogue says of the generator's `effect` at its size:
+/// the held change at the best of the chosen sensors, against the alarm's 3 sigma.
+std::string criterion_says(const studies::CatalogueDetection& d,
+                           const calibration::InjectedEffect& effect, const core::CaseSpec& spec,
+                           const std::vector<int>& chosen,
+                           const std::vector<std::string>& sensors) {
+  const auto [e, factor] = catalogue_match(d, effect, spec);
+  if (e < 0) return "the catalogue criterion has no such effect (not a heat flow: unseen by it)";
+  double most = 0;
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const double held = d.problem.held_sigmas(e, chosen[k]) * std::abs(factor);
+    if (held > most) {
+      most = held;
+      at = k;
+    }
+  }
+  const solvers::ConsistencyOptions alarm;
+  return "the catalogue criterion at the effect's size (" +
+         d.problem.effects[static_cast<std::size_t>(e)] + " x " + fmt(factor) + "): " + fmt(most) +
+         " sigma held at " + sensors[at] + ", " +
+         (most >= alarm.model_residual_sigmas ? "seen" : "unseen");
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -274,12 +355,14 @@ int main(int argc, char** argv) {
     if (argc > 12) campaign_noise.sensor_offset_initial_k = std::stod(argv[12]);
     if (argc > 13) campaign_noise.sensor_offset_walk_k = std::stod(argv[13]);
     const bool changed_training = argc > 14 && std::stoi(argv[14]) != 0;
+    const double catalogue_spacing = argc > 15 ? std::stod(argv[15]) : 0.25;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
         sensor_choice != "estimation" && sensor_choice != "estimation_exact" &&
-        sensor_choice != "correlation+detection")
+        sensor_choice != "correlation+detection" && sensor_choice != "correlation+catalogue")
       throw std::runtime_error("SENSORS '" + sensor_choice +
                                "': expected correlation, mutual_info, estimation, "
-                               "estimation_exact or correlation+detection");
+                               "estimation_exact, correlation+detection or "
+                               "correlation+catalogue");
     const auto t_all = Clock::now();
 
     // 1. Case, mesh, twin.
@@ -320,6 +403,7 @@ int main(int argc, char** argv) {
 
     // 3. Sensors and regression.
     std::vector<int> chosen;
+    std::optional<studies::CatalogueDetection> catalogue;  // correlation+catalogue
     for (int d = 0; d < 2; ++d)
       for (int c :
            fitting::sensors_by_correlation(fitting::group_subset(noisy, split.fitting), d, 4))
@@ -341,29 +425,65 @@ int main(int argc, char** argv) {
           if (s.method == placement::Method::kGaussianGreedy && s.m == 4)
             for (int c : s.columns)
               if (std::find(chosen.begin(), chosen.end(), c) == chosen.end()) chosen.push_back(c);
-    } else if (sensor_choice == "correlation+detection") {
-      // The correlation's sensors, then COUNT (default 2) placed for detection beside them.
+    } else if (sensor_choice.starts_with("correlation+")) {
+      // The correlation's sensors, then COUNT (default 2) placed for detection beside them: of
+      // the observer's unknown inputs, or of the calibration catalogue's heat-flow effects.
       std::vector<core::CaseSpec> fitting_runs;
       for (int i : split.fitting) fitting_runs.push_back(runs[static_cast<std::size_t>(i)].spec);
       const double sample_s = 300;
-      const placement::EstimationProblem problem = studies::observer_estimation_problem(
-          twin, fitting_runs, {cand, {}, fitting::SensorNoise{}.temperature_sigma}, {"dy", "dz"},
-          campaign_noise, sample_s);
       const solvers::ConsistencyOptions alarm;
-      const placement::DetectionProblem detection = studies::observer_detection_problem(
-          twin, problem, fitting_runs.front(), campaign_noise, {}, alarm.sustain_s, sample_s);
+      placement::DetectionProblem detection;
+      std::string what;
+      if (sensor_choice == "correlation+detection") {
+        const placement::EstimationProblem problem = studies::observer_estimation_problem(
+            twin, fitting_runs, {cand, {}, fitting::SensorNoise{}.temperature_sigma}, {"dy", "dz"},
+            campaign_noise, sample_s);
+        detection = studies::observer_detection_problem(
+            twin, problem, fitting_runs.front(), campaign_noise, {}, alarm.sustain_s, sample_s);
+        what = "the observer's unknown inputs: heat 5 W, air 1 K";
+      } else {
+        studies::CatalogueDetectionInput input;
+        input.names = cand;
+        for (const auto& name : cand)
+          input.points.push_back(
+              mesh.points[static_cast<std::size_t>(point_column(mesh, name))].position);
+        input.sensor_sigma_k = fitting::SensorNoise{}.temperature_sigma;
+        input.sample_s = sample_s;
+        input.sustain_s = alarm.sustain_s;
+        input.catalogue.patch_spacing = catalogue_spacing;
+        input.catalogue.patch_half_size = 0.65 * catalogue_spacing;
+        input.catalogue.heat_laws = {calibration::HeatLaw::constant};
+        catalogue = studies::catalogue_detection(mesh, spec, fitting_runs, input);
+        detection = catalogue->problem;
+        what = "the catalogue's heat-flow effects (patches every " + fmt(catalogue_spacing) +
+               " m, constant law): heat 5 W, films 25 %, sources 0.02/K, materials 10 %, air 1 K";
+      }
       std::vector<int> pool(cand.size());
       for (std::size_t k = 0; k < pool.size(); ++k) pool[k] = static_cast<int>(k);
       const placement::GreedyPath placed = placement::detection_greedy(
           detection, chosen, pool, count > 0 ? count : 2, alarm.model_residual_sigmas);
       const auto unseen = [&](const std::vector<int>& columns) {
-        std::string out;
-        for (int e : placement::unseen_effects(detection, columns, alarm.model_residual_sigmas))
-          out += " " + detection.effects[static_cast<std::size_t>(e)];
-        return out.empty() ? std::string(" none") : out;
+        const auto missed =
+            placement::unseen_effects(detection, columns, alarm.model_residual_sigmas);
+        std::string out =
+            " " + std::to_string(missed.size()) + " of " + std::to_string(detection.effects.size());
+        if (!detection.kinds.empty()) {  // seen per kind
+          std::map<std::string, std::pair<int, int>> per_kind;
+          for (const auto& k : detection.kinds) ++per_kind[k].second;
+          for (std::size_t e = 0; e < detection.kinds.size(); ++e)
+            if (std::find(missed.begin(), missed.end(), static_cast<int>(e)) == missed.end())
+              ++per_kind[detection.kinds[e]].first;
+          out += " (seen per kind:";
+          for (const auto& [k, n] : per_kind)
+            out += " " + k + " " + std::to_string(n.first) + "/" + std::to_string(n.second);
+          return out + ")";
+        }
+        if (missed.size() > 12) return out;
+        for (int e : missed) out += "; " + detection.effects[static_cast<std::size_t>(e)];
+        return out;
       };
       std::cout << "detection placement (" << fmt(seconds_since(t_place)) << " s, "
-                << detection.effects.size() << " effects: heat 5 W, air 1 K, held "
+                << detection.effects.size() << " effects of " << what << ", held "
                 << alarm.sustain_s << " s beyond " << alarm.model_residual_sigmas
                 << " sigma): unseen by the correlation's sensors:" << unseen(chosen);
       chosen.insert(chosen.end(), placed.order.begin(), placed.order.end());
@@ -836,6 +956,9 @@ int main(int argc, char** argv) {
         if (effect.present)
           what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
         line(name, "generator, " + what, o, rr, run);
+        if (catalogue && effect.present)
+          std::cout << name << ": " << criterion_says(*catalogue, effect, spec, chosen, sensors)
+                    << "\n";
         if (axis_models && truth.displacement.cols() == 3 + axis_columns) {
           // The axis points against the generator's own (finer mesh) truth.
           const Eigen::MatrixXd axis_truth = truth.displacement.rightCols(axis_columns);

@@ -40,11 +40,10 @@ double detection_size(const calibration::Candidate& c, const core::CaseSpec& dec
   return 0;
 }
 
-placement::DetectionProblem catalogue_detection_problem(const mesh::TetMesh& mesh,
-                                                        const core::CaseSpec& declared,
-                                                        const std::vector<core::CaseSpec>& runs,
-                                                        const CatalogueDetectionInput& input,
-                                                        const solvers::Progress& progress) {
+CatalogueDetection catalogue_detection(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+                                       const std::vector<core::CaseSpec>& runs,
+                                       const CatalogueDetectionInput& input,
+                                       const solvers::Progress& progress) {
   if (runs.empty()) throw core::DataError("detection placement on the catalogue: no run");
   if (!(input.sustain_s > 0))
     throw core::DataError("detection placement on the catalogue: held for " +
@@ -60,11 +59,15 @@ placement::DetectionProblem catalogue_detection_problem(const mesh::TetMesh& mes
       calibration::heat_flow_candidates(model, declared, r, runs, times, input.catalogue, progress);
   std::vector<std::string> effects, kinds;
   std::vector<std::vector<Eigen::MatrixXd>> changes;
+  CatalogueDetection out;
+  std::vector<double> sizes;
   const auto channels = static_cast<Eigen::Index>(input.names.size());
   for (const auto& c : cands) {
     const double size = detection_size(c, declared, input.sizes);
     if (size == 0) continue;
     effects.push_back(c.name);
+    out.effects.push_back(c.effect);
+    sizes.push_back(size);
     kinds.push_back(calibration::kind_name(calibration::kind(c)));
     changes.emplace_back();
     for (std::size_t k = 0; k < runs.size(); ++k) {
@@ -76,10 +79,12 @@ placement::DetectionProblem catalogue_detection_problem(const mesh::TetMesh& mes
     }
   }
   const int readings = static_cast<int>(std::ceil(input.sustain_s / input.sample_s - 1e-9)) + 1;
-  placement::DetectionProblem out = placement::detection_problem(
+  out.problem = placement::detection_problem(
       effects, changes, Eigen::VectorXd::Constant(channels, input.sensor_sigma_k), readings);
-  out.weights = placement::weights_per_kind(kinds);
-  out.kinds = std::move(kinds);
+  out.problem.weights = placement::weights_per_kind(kinds);
+  out.problem.kinds = std::move(kinds);
+  out.sizes =
+      Eigen::Map<const Eigen::VectorXd>(sizes.data(), static_cast<Eigen::Index>(sizes.size()));
   return out;
 }
 

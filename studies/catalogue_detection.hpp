@@ -45,6 +45,13 @@ struct CatalogueDetectionInput {
   bool full_order = false;
 };
 
+/// The catalogue's effects as placement for detection sees them.
+struct CatalogueDetection {
+  placement::DetectionProblem problem;
+  std::vector<calibration::Effect> effects;  ///< #effects: what each is and where it acts
+  Eigen::VectorXd sizes;                     ///< #effects: its parameter's size (detection_size)
+};
+
 /// Each heat-flow candidate of the catalogue on `declared` (calibration::heat_flow_candidates,
 /// marched on the reduced model whose basis holds the candidates' rows, or in full order) along
 /// `runs` (cases with `declared`'s operators, e.g. the campaign's fitting runs), held at its kind's
@@ -53,11 +60,10 @@ struct CatalogueDetectionInput {
 /// then its place. `progress` gets the simulated time over the runs' total. Throws DataError for no
 /// run, a candidate outside the mesh or sustain_s not > 0, SolverError for sample_s not > 0
 /// (reading_times).
-placement::DetectionProblem catalogue_detection_problem(const mesh::TetMesh& mesh,
-                                                        const core::CaseSpec& declared,
-                                                        const std::vector<core::CaseSpec>& runs,
-                                                        const CatalogueDetectionInput& input,
-                                                        const solvers::Progress& progress = {});
+CatalogueDetection catalogue_detection(const mesh::TetMesh& mesh, const core::CaseSpec& declared,
+                                       const std::vector<core::CaseSpec>& runs,
+                                       const CatalogueDetectionInput& input,
+                                       const solvers::Progress& progress = {});
 
 /// The size of candidate `c`'s (one) parameter at which placement for detection asks to see it,
 /// from `sizes` and the declared films; 0 for a kind it does not ask about (the sensors' own

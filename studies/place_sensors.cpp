@@ -104,8 +104,9 @@ CatalogueDetectionReport catalogue_detection_report(const PlaceInput& input, con
   in.names = h.names;
   for (Eigen::Index c = 0; c < h.positions.rows(); ++c)
     in.points.push_back(h.positions.row(c).transpose());
-  d.problem = catalogue_detection_problem(*input.catalogue_mesh, *input.spec, {*input.spec}, in,
-                                          input.catalogue_progress);
+  d.problem = catalogue_detection(*input.catalogue_mesh, *input.spec, {*input.spec}, in,
+                                  input.catalogue_progress)
+                  .problem;
   std::vector<int> pool(h.names.size());
   for (std::size_t c = 0; c < pool.size(); ++c) pool[c] = static_cast<int>(c);
   d.greedy = placement::detection_greedy(d.problem, {}, pool, input.m_max, d.bound_sigmas);

@@ -57,13 +57,13 @@ struct DetectionReport {
   std::vector<std::pair<std::string, std::vector<int>>> unseen_by_estimation;
 };
 
-/// Placement for detection of the calibration catalogue's heat-flow effects (studies::
-/// catalogue_detection_problem on the case's duty cycle, read at its output interval), each kind
-/// counted once.
 /// Up to this many candidates the catalogue's effects are marched on the reduced model on their
 /// rows; beyond, in full order (each candidate's row adds Krylov vectors to the basis).
 inline constexpr std::size_t kCatalogueReducedCandidates = 64;
 
+/// Placement for detection of the calibration catalogue's heat-flow effects
+/// (studies::catalogue_detection on the case's duty cycle, read at its output interval), each
+/// kind counted once.
 struct CatalogueDetectionReport {
   CatalogueDetectionInput settings;  /// sizes, patches, sigma, readings (names and points left out)
   double bound_sigmas = 0;           /// the declared-run test's bound (ConsistencyOptions defaults)

@@ -754,7 +754,7 @@ TEST_F(Observer, DetectionPlacementReadsTheChangeAnUndeclaredAirMakes) {
 
 TEST_F(Observer, CatalogueDetectionReadsEachEffectAsTheFullModelAndTheTwinDo) {
   // Placement for detection on the calibration catalogue's effects
-  // (studies::catalogue_detection_problem), marched on the reduced model on the candidates' rows:
+  // (studies::catalogue_detection), marched on the reduced model on the candidates' rows:
   // every effect's held change as the full-order march gives it, and the air's 1 K on every sink
   // as the twin run twice gives it (with the declared air; with every sink 1 K warmer); held over
   // 900 s of readings every 300 s (four readings), in the candidates' sigmas.
@@ -771,11 +771,17 @@ TEST_F(Observer, CatalogueDetectionReadsEachEffectAsTheFullModelAndTheTwinDo) {
   in.catalogue.patch_spacing = 0.15;
   in.catalogue.patch_half_size = 0.1;
   in.catalogue.heat_laws = {calibration::HeatLaw::constant};
-  const placement::DetectionProblem d =
-      studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in);
+  const studies::CatalogueDetection detection =
+      studies::catalogue_detection(s_->mesh, s_->spec, {c}, in);
+  const placement::DetectionProblem& d = detection.problem;
   in.full_order = true;
   const placement::DetectionProblem full =
-      studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in);
+      studies::catalogue_detection(s_->mesh, s_->spec, {c}, in).problem;
+  ASSERT_EQ(detection.effects.size(), d.effects.size());
+  ASSERT_EQ(detection.sizes.size(), static_cast<Eigen::Index>(d.effects.size()));
+  for (std::size_t e = 0; e < detection.effects.size(); ++e)
+    if (const auto* h = std::get_if<calibration::HeatInput>(&detection.effects[e]))
+      EXPECT_NEAR(detection.sizes(static_cast<Eigen::Index>(e)) * h->area, 5.0, 1e-12);  // W
   ASSERT_EQ(d.effects, full.effects);
   ASSERT_EQ(d.held_sigmas.rows(), static_cast<Eigen::Index>(d.effects.size()));
   ASSERT_EQ(d.held_sigmas.cols(), 4);
@@ -830,7 +836,7 @@ TEST_F(Observer, CatalogueDetectionReadsEachEffectAsTheFullModelAndTheTwinDo) {
         << in.names[k];
   }
   in.sustain_s = 0;
-  EXPECT_THROW(studies::catalogue_detection_problem(s_->mesh, s_->spec, {c}, in), core::DataError);
+  EXPECT_THROW(studies::catalogue_detection(s_->mesh, s_->spec, {c}, in), core::DataError);
 }
 
 TEST(ObserverPieces, ChiSquareQuantileAndMonitor) {
