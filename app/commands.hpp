@@ -117,6 +117,9 @@ struct CompensateArgs {
   std::filesystem::path case_file;  /// with rom: the case it was built from (default: its record)
   ObserverOptions observer;         /// with rom
   std::optional<double> initial_temperature_c;  /// with rom: the machine's at t = 0 (the case's)
+  /// with rom: a recorded run's meta.json: its sensors are read at their positions (as `observe`
+  /// reads them), its initial temperature is the machine's at t = 0 unless given
+  std::filesystem::path meta;
   std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input
   std::filesystem::path out;  /// empty: standard output
   bool until_eof = false;     /// with in: stop at its end instead of following it

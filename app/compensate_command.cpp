@@ -86,9 +86,10 @@ Binder fitted_model(const std::filesystem::path& path) {
 }
 
 /// The reduced model and the case it was built from (--case, or the one it records), checked
-/// against each other.
-std::shared_ptr<const io::ReducedModelFile> reduced_model(const CompensateArgs& args,
-                                                          std::shared_ptr<core::CaseSpec>& spec) {
+/// against each other; `mesh` gets the case's mesh.
+std::shared_ptr<const io::ReducedModelFile> reduced_model(
+    const CompensateArgs& args, std::shared_ptr<core::CaseSpec>& spec,
+    std::shared_ptr<const mesh::TetMesh>& mesh) {
   auto rom = std::make_shared<io::ReducedModelFile>(io::read_reduced_model(args.rom));
   const std::filesystem::path case_file =
       args.case_file.empty() ? std::filesystem::path(rom->case_file) : args.case_file;
@@ -97,25 +98,41 @@ std::shared_ptr<const io::ReducedModelFile> reduced_model(const CompensateArgs& 
                           ": the case it was built from, " + case_file.string() +
                           ", is not there; give it with --case");
   spec = std::make_shared<core::CaseSpec>(io::read_case(case_file));
-  io::check_reduced_model_fits(*rom, io::reduced_model_key(*spec, mesh::mesh_case(*spec)),
-                               args.rom);
+  mesh = std::make_shared<const mesh::TetMesh>(mesh::mesh_case(*spec));
+  io::check_reduced_model_fits(*rom, io::reduced_model_key(*spec, *mesh), args.rom);
   if (args.initial_temperature_c) spec->thermal.initial_temperature_c = *args.initial_temperature_c;
   return rom;
 }
 
 /// The physics observer on the reduced model, on its sensors: --sensors, or every column the
-/// model names.
+/// model can read (located by --meta, or a named point of the model).
 Binder observed_model(const CompensateArgs& args) {
   std::shared_ptr<core::CaseSpec> spec;
-  const auto rom = reduced_model(args, spec);
+  std::shared_ptr<const mesh::TetMesh> mesh;
+  const auto rom = reduced_model(args, spec, mesh);
+  auto meta = std::make_shared<io::MeasuredRun>();
+  if (!args.meta.empty()) {
+    *meta = io::read_measured_meta(args.meta);
+    if (meta->initial_temperature_c && !args.initial_temperature_c)
+      spec->thermal.initial_temperature_c = *meta->initial_temperature_c;
+  } else {
+    mesh.reset();  // no positions: every sensor at its named point
+  }
   const ObserverOptions options = args.observer;
-  return [rom, spec, options](const std::vector<std::string>& columns) {
+  const std::string source = args.meta.empty() ? "the stream" : args.meta.string();
+  return [rom, spec, mesh, meta, options, source](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;
-    if (sensors.empty()) sensors = studies::named_by_twin(rom->twin.outputs, columns);
+    if (sensors.empty())
+      sensors = studies::readable_sensors(rom->twin.outputs, mesh.get(), meta->sensors, columns,
+                                          meta->ambient_sensor);
     if (sensors.empty())
       throw core::DataError(
-          "no column is a named point of the reduced model; name the sensors with --sensors");
-    const solvers::ObserverSetup setup = observer_setup(options, rom->twin, *spec, sensors);
+          "no column is located by --meta or a named point of the reduced model; name the "
+          "sensors with --sensors");
+    const studies::SensorReadout readout =
+        studies::sensor_readout(rom->twin, mesh.get(), meta->sensors, sensors, source);
+    const solvers::ObserverSetup setup =
+        observer_setup(options, rom->twin, *spec, sensors, readout.rows);
     auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
                                                             sensors, columns, "speed_rpm");
     // The stream's temperatures are in degC (the measured-data format), the observer's in K. The

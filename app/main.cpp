@@ -369,6 +369,14 @@ Command compensate_line(CLI::App& cli) {
                    "case's)")
       ->check(finite_number())
       ->needs(compensate_rom);
+  compensate
+      ->add_option("--meta", compensate_args.meta,
+                   "with --rom: the recorded run's meta.json; its sensors are read at their "
+                   "positions (not only at named points of the model), its "
+                   "initial_temperature_degC is the machine's at t = 0 unless "
+                   "--initial-temperature-c says otherwise")
+      ->check(CLI::ExistingFile)
+      ->needs(compensate_rom);
   add_observer_options(*compensate, compensate_args.observer);
   add_stream_options(*compensate, compensate_args);
   return {compensate, [args] {

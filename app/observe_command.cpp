@@ -33,14 +33,15 @@ int observe_command(const ObserveArgs& args) {
   io::OutputDir out(args.out, inputs);
   // 2. The reduced model, built for this machine and mesh.
   const io::ReducedModelFile rom = io::read_reduced_model(args.rom);
-  io::check_reduced_model_fits(rom, io::reduced_model_key(declared, mesh::mesh_case(declared)),
-                               args.rom);
-  // 3. The study.
-  const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors) {
-    return observer_setup(args.observer, rom.twin, spec, sensors);
+  const mesh::TetMesh mesh = mesh::mesh_case(declared);
+  io::check_reduced_model_fits(rom, io::reduced_model_key(declared, mesh), args.rom);
+  // 3. The study: the run's sensors read at their positions where it gives them.
+  const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors,
+                         const Eigen::MatrixXd& rows) {
+    return observer_setup(args.observer, rom.twin, spec, sensors, rows);
   };
   const studies::ObserveReport report =
-      studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup});
+      studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup, &mesh});
   // 4. Outputs.
   io::write_observe(out.path(), report,
                     {run.run, declared.name, rom.twin.model.states(), args.rom,

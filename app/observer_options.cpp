@@ -153,7 +153,8 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
 
 solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
                                       const core::CaseSpec& spec,
-                                      const std::vector<std::string>& sensors) {
+                                      const std::vector<std::string>& sensors,
+                                      const Eigen::MatrixXd& sensor_rows) {
   solvers::ObserverNoise noise;
   noise.sensor_sigma_k = per_name(o.sensor_sigma_k, sensors, "--sensor-sigma-k", "sensors");
   noise.heat_walk_w = o.heat_walk_w;
@@ -166,7 +167,8 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.drift_relative_sigma = o.drift_relative_sigma;
   noise.correction_relative_sigma = o.correction_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
-  solvers::ObserverSetup setup = solvers::twin_observer_setup(twin, spec, sensors, noise);
+  solvers::ObserverSetup setup =
+      solvers::twin_observer_setup(twin, spec, sensors, noise, sensor_rows);
   setup.noise.expansion_relative_sigma = expansion_sigmas(o.expansion_relative_sigma, setup);
   if (!o.drift_sigma_scale.empty())
     setup.noise.drift_sigma_scale =

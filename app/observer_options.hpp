@@ -25,12 +25,14 @@ void add_observer_options(CLI::App& command, ObserverOptions& options);
 /// test's window; a part of add_observer_options.
 void add_consistency_options(CLI::App& command, ObserverOptions& options);
 
-/// The set-up on `twin` for `sensors` (ids): the noise and the consistency test of `options`.
-/// Throws DataError when --sensor-sigma-k or --drift-sigma-scale has neither one value nor one
-/// per sensor (target), naming them.
+/// The set-up on `twin` for `sensors` (ids; read through `sensor_rows` when given, else at their
+/// named points): the noise and the consistency test of `options`. Throws DataError when
+/// --sensor-sigma-k or --drift-sigma-scale has neither one value nor one per sensor (target),
+/// naming them.
 solvers::ObserverSetup observer_setup(const ObserverOptions& options, const solvers::Twin& twin,
                                       const core::CaseSpec& spec,
-                                      const std::vector<std::string>& sensors);
+                                      const std::vector<std::string>& sensors,
+                                      const Eigen::MatrixXd& sensor_rows = Eigen::MatrixXd());
 
 /// The noise model and consistency test of a set-up, for a result file.
 nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup);

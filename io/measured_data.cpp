@@ -679,6 +679,13 @@ MeasuredRun read_measured_run(const fs::path& folder, const MeasuredReadLimits& 
   return run;
 }
 
+MeasuredRun read_measured_meta(const fs::path& meta_json, const MeasuredReadLimits& limits) {
+  require_regular_file(meta_json);
+  MeasuredRun run = run_from_meta(meta_json, limits);
+  run.folder = meta_json.parent_path();
+  return run;
+}
+
 void write_measured_run(const fs::path& folder, const MeasuredRun& run) {
   require_shape(run);
   json meta = run.meta.is_object() ? run.meta : json::object();

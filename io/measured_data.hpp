@@ -68,6 +68,12 @@ struct MeasuredReadLimits {
 MeasuredRun read_measured_run(const std::filesystem::path& folder,
                               const MeasuredReadLimits& limits = {});
 
+/// Reads a run's meta.json alone (its sensors and their positions, probes, inputs, initial and
+/// ambient temperatures; no samples): for a stream whose samples come elsewhere. Throws as
+/// read_measured_run does for meta.json.
+MeasuredRun read_measured_meta(const std::filesystem::path& meta_json,
+                               const MeasuredReadLimits& limits = {});
+
 /// True when `a` and `b` name one run folder (relative paths and symbolic links resolved).
 bool same_run(const std::filesystem::path& a, const std::filesystem::path& b);
 

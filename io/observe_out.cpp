@@ -83,6 +83,20 @@ nlohmann::json departures_json(const solvers::ObserverRun& r,
   return out;
 }
 
+/// Where each sensor was read: at the run's position, or at the named point of its id.
+nlohmann::json places_json(const studies::ObserveReport& report) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t k = 0; k < report.sensors.size(); ++k) {
+    const studies::SensorPlace& p = report.places.at(k);
+    nlohmann::json entry{{"sensor", report.sensors[k]},
+                         {"read_at", p.position ? "position" : "named point"}};
+    if (p.position) entry["position_m"] = {(*p.position)(0), (*p.position)(1), (*p.position)(2)};
+    if (p.from_named_point_m) entry["from_named_point_m"] = *p.from_named_point_m;
+    out.push_back(std::move(entry));
+  }
+  return out;
+}
+
 std::string final_status(const solvers::ObserverRun& r) {
   if (r.recalibrate) return "recalibrate";
   return r.sensor_faults.empty() ? "ok" : "sensor_fault";
@@ -100,6 +114,7 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
       {"case", source.case_name},
       {"model", {{"kind", "reduced"}, {"order", source.order}, {"rom", source.rom.string()}}},
       {"sensors", report.sensors},
+      {"sensor_places", places_json(report)},
       {"noise", source.noise},
       {"consistency",
        {{"window_s", setup.consistency.window_s},

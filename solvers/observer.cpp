@@ -88,9 +88,23 @@ std::vector<int> air_entries(const core::CaseSpec& spec) {
   return out;
 }
 
+Eigen::RowVectorXd twin_point_row(const Twin& twin,
+                                  const std::vector<std::pair<int, double>>& weights) {
+  const Eigen::MatrixXd& basis = twin.model.basis;
+  Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(basis.cols());
+  for (const auto& [node, w] : weights) {
+    if (node < 0 || node >= basis.rows())
+      throw core::SolverError("observer: node " + std::to_string(node) +
+                              " is not a node of the reduced model's basis (" +
+                              std::to_string(basis.rows()) + " nodes)");
+    row += w * basis.row(node);
+  }
+  return row;
+}
+
 ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
                                   const std::vector<std::string>& sensors,
-                                  const ObserverNoise& noise) {
+                                  const ObserverNoise& noise, const Eigen::MatrixXd& sensor_rows) {
   const TwinOutputs& out = twin.outputs;
   if (!out.tcp)
     throw core::SolverError(
@@ -98,7 +112,14 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
         "the case it was built from): there is no drift to predict");
   ObserverSetup s;
   s.sensor_rows.resize(static_cast<Eigen::Index>(sensors.size()), out.rows.cols());
-  for (std::size_t k = 0; k < sensors.size(); ++k) {
+  if (sensor_rows.size() != 0 &&
+      (sensor_rows.rows() != s.sensor_rows.rows() || sensor_rows.cols() != out.rows.cols()))
+    throw core::SolverError("observer: " + std::to_string(sensor_rows.rows()) + " x " +
+                            std::to_string(sensor_rows.cols()) + " sensor rows for " +
+                            std::to_string(sensors.size()) + " sensors of a twin of " +
+                            std::to_string(out.rows.cols()) + " states");
+  if (sensor_rows.size() != 0) s.sensor_rows = sensor_rows;
+  for (std::size_t k = 0; k < sensors.size() && sensor_rows.size() == 0; ++k) {
     const auto first = out.names.begin(), last = first + out.temperatures;
     const auto it = std::find(first, last, sensors[k]);
     if (it == last) {

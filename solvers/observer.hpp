@@ -130,11 +130,21 @@ struct ObserverSetup {
 };
 
 /// The set-up on a twin: the named points `sensors` (ids) read with `noise`, the TCP's drift
-/// (dx, dy, dz) and every axis point's as targets, the air offset on air_entries(spec). Throws
-/// SolverError naming an id that is not a named point of the twin, or a twin without TCP rows.
+/// (dx, dy, dz) and every axis point's as targets, the air offset on air_entries(spec). With
+/// `sensor_rows` (#sensors x the twin's states: sensors read elsewhere than at a named point, e.g.
+/// twin_point_row), the sensors are read through those rows and `sensors` only names them. Throws
+/// SolverError naming an id that is not a named point of the twin (without rows), rows of another
+/// shape, or a twin without TCP rows.
 ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
                                   const std::vector<std::string>& sensors,
-                                  const ObserverNoise& noise);
+                                  const ObserverNoise& noise,
+                                  const Eigen::MatrixXd& sensor_rows = Eigen::MatrixXd());
+
+/// The twin's temperature row at a point given by interpolation weights over mesh nodes
+/// ((node, weight) pairs): sum of weight x the basis's row of the node. Throws SolverError for a
+/// node outside the basis.
+Eigen::RowVectorXd twin_point_row(const Twin& twin,
+                                  const std::vector<std::pair<int, double>>& weights);
 
 /// Convection entries of `spec` that are not on a mechanically fixed group (the shop's air; the
 /// bed contact's sink is the foundation): the calibration generator's air acts on these.

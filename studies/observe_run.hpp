@@ -6,11 +6,13 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/case_spec.hpp"
 #include "io/measured_data.hpp"
+#include "mesh/tet_mesh.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
 
@@ -25,23 +27,60 @@ struct ObserveInput {
   const io::MeasuredRun* run = nullptr;
   /// the reduced model, checked by the caller against the declared case and its mesh
   const solvers::Twin* twin = nullptr;
-  /// the run's columns to observe; empty: every sensor of the run that the twin names
+  /// the run's columns to observe; empty: every sensor of the run (not its ambient sensor) that
+  /// has a position (with `mesh`) or that the twin names
   std::vector<std::string> sensors;
-  /// the observer's noise and consistency test on the case under the run and the chosen sensors
-  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&)>
+  /// the observer's noise and consistency test on the case under the run and the chosen sensors,
+  /// read through the given rows (#sensors x the twin's states; empty: at their named points)
+  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
+                                       const Eigen::MatrixXd&)>
       setup;
+  /// the case's mesh (the twin's): a sensor the run locates (its position in meta.json) is read
+  /// there, interpolated on the twin's basis, as the measured-data format says a sensor need not
+  /// sit at a mesh vertex; nullptr: every sensor at the named point of its id
+  const mesh::TetMesh* mesh = nullptr;
+};
+
+/// Where a sensor was read on the model.
+struct SensorPlace {
+  std::optional<Eigen::Vector3d> position;  /// the run's position [m]; none: the named point
+  /// distance from the twin's named point of the same id [m], when both exist
+  std::optional<double> from_named_point_m;
 };
 
 struct ObserveReport {
   core::CaseSpec spec;               /// the declared case under the run's inputs
   std::vector<std::string> sensors;  /// the observed columns, in the readings' order
+  std::vector<SensorPlace> places;   /// per sensor: where it was read
   solvers::ObserverSetup setup;
   solvers::ObserverRun result;
 };
 
-/// Throws DataError when the run has no speed column, when none of its sensors is a named point of
-/// the twin (and none was chosen) or a chosen sensor is not a column of the run; what the observer
-/// throws.
+/// The ids of `ids` the observer can read: those `located` (a run's sensors, or a stream's
+/// meta.json) gives a position (when there is a mesh) and those the twin names; not `ambient`.
+std::vector<std::string> readable_sensors(const solvers::TwinOutputs& outputs,
+                                          const mesh::TetMesh* mesh,
+                                          const std::vector<io::MeasuredSensor>& located,
+                                          const std::vector<std::string>& ids,
+                                          const std::optional<std::string>& ambient);
+
+/// Where each sensor is read, and its rows on the twin.
+struct SensorReadout {
+  std::vector<SensorPlace> places;
+  Eigen::MatrixXd rows;  /// #sensors x the twin's states; empty: every one at its named point
+};
+
+/// Each of `ids` read at its position in `located` (interpolated on the twin's basis on `mesh`,
+/// when there is one), else at the twin's named point of its id. Throws DataError naming
+/// `source` and the sensor for one that has neither, or a position outside the mesh.
+SensorReadout sensor_readout(const solvers::Twin& twin, const mesh::TetMesh* mesh,
+                             const std::vector<io::MeasuredSensor>& located,
+                             const std::vector<std::string>& ids, const std::string& source);
+
+/// Throws DataError when the run has no speed column, when none of its sensors is located or a
+/// named point of the twin (and none was chosen), a chosen sensor is not a column of the run or is
+/// neither located nor named, or a position lies outside the mesh (naming the run and sensor);
+/// what the observer throws.
 ObserveReport observe_run(const ObserveInput& input);
 
 }  // namespace tt::studies

@@ -321,6 +321,86 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
   EXPECT_LT((found - heat.centre).norm(), 0.06);
 }
 
+TEST(ObserveCli, SensorsAreReadAtTheRunsPositions) {
+  // The measured-data format locates a sensor by its position, which need not be a mesh vertex
+  // or carry a named point's id. A clean 2-hour generated run (sensors at nine named points) is
+  // observed as written, then with T17 renamed, then with no positions (by the ids' named
+  // points): the same predictions. T17 moved by 30 mm inside the housing is read there (and so
+  // predicts otherwise); a position in the air beside the machine is refused, naming the sensor,
+  // and nothing is written.
+  const fs::path dir = rt::scratch("observe_positions");
+  const fs::path rom = dir / "rom", log = dir / "log";
+  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
+                     "--quick-validation", "--quiet"},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const OwnMeshGenerator o;
+  std::mt19937_64 rng = core::generator(17, 0);
+  const calibration::InjectedEffect none;
+  const io::MeasuredRun clean = calibration::synthetic_run(
+      o.mesh, calibration::truth_case(o.gen, none, calibration::random_duty_cycle(2, rng), 0), none,
+      o.inst, o.g, "clean", rng);
+  const auto observe = [&](const io::MeasuredRun& run, const std::string& name) {
+    io::write_measured_run(dir / ("run_" + name), run);
+    return rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
+                    (dir / ("run_" + name)).string(), "--out", (dir / name).string(), "--quiet"},
+                   {}, log);
+  };
+  const auto places = [&](const std::string& name) {
+    return nlohmann::json::parse(std::ifstream(dir / name / "observer.json"))["sensor_places"];
+  };
+  /// The largest difference of dy and dz's predictions from the run as written [um].
+  const auto dy_dz_apart = [&](const std::string& name) {
+    const auto a = tt::test::csv_rows(dir / "written" / "observer.csv");
+    const auto b = tt::test::csv_rows(dir / name / "observer.csv");
+    EXPECT_EQ(a.size(), b.size());
+    double most = 0;
+    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+      for (const char* c : {"dy_predicted_um", "dz_predicted_um"})
+        most = std::max(most, std::abs(std::stod(a[i].at(c)) - std::stod(b[i].at(c))));
+    return most;
+  };
+  ASSERT_EQ(observe(clean, "written"), 0) << rt::read_text(log);
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "written"));
+  ASSERT_EQ(places("written").size(), 9u);
+  for (const auto& p : places("written")) {
+    EXPECT_EQ(p["read_at"], "position") << p;
+    EXPECT_LT(p["from_named_point_m"].get<double>(), 1e-12) << p;
+  }
+  io::MeasuredRun renamed = clean;
+  renamed.sensors[4].id = "probe_a";  // T17, where it was
+  ASSERT_EQ(observe(renamed, "renamed"), 0) << rt::read_text(log);
+  EXPECT_EQ(places("renamed")[4]["sensor"], "probe_a");
+  EXPECT_FALSE(places("renamed")[4].contains("from_named_point_m"));
+  EXPECT_LT(dy_dz_apart("renamed"), 1e-9);
+  io::MeasuredRun unlocated = clean;
+  for (auto& s : unlocated.sensors) s.position.reset();
+  ASSERT_EQ(observe(unlocated, "unlocated"), 0) << rt::read_text(log);
+  for (const auto& p : places("unlocated")) EXPECT_EQ(p["read_at"], "named point") << p;
+  EXPECT_LT(dy_dz_apart("unlocated"), 1e-9);
+  io::MeasuredRun moved = clean;
+  // T17 sits on the housing; 30 mm towards the housing's centre is inside it.
+  const Eigen::Vector3d t17 = *clean.sensors[4].position;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : o.mesh.points) centre += p.position;
+  centre /= static_cast<double>(o.mesh.points.size());
+  moved.sensors[4].position = t17 + 0.03 * (centre - t17).normalized();
+  ASSERT_EQ(observe(moved, "moved"), 0) << rt::read_text(log);
+  EXPECT_NEAR(places("moved")[4]["from_named_point_m"].get<double>(), 0.03, 1e-9);
+  EXPECT_GT(dy_dz_apart("moved"), 1e-4);
+  std::printf(
+      "[observe positions] T17 read 30 mm off its named point moves dy/dz by up to %.3g um\n",
+      dy_dz_apart("moved"));
+  io::MeasuredRun outside = clean;  // within the machine's box, below the housing: in the air
+  outside.sensors[4].position = Eigen::Vector3d(0.15, 0.29, -0.035);
+  EXPECT_NE(observe(outside, "outside"), 0);
+  EXPECT_NE(rt::read_text(log).find("sensor 'T17'"), std::string::npos) << rt::read_text(log);
+  EXPECT_NE(rt::read_text(log).find("run_outside"), std::string::npos) << rt::read_text(log);
+  EXPECT_FALSE(fs::exists(dir / "outside"));
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
 TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
   // The observer's settings are flags of `observe` and `compensate --rom`, in their --help; a
   // value that makes no sense is refused before any file is read, naming the flag and the value,
