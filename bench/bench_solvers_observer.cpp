@@ -318,6 +318,7 @@ std::string criterion_says(const studies::CatalogueDetection& d,
                            const calibration::InjectedEffect& effect, const core::CaseSpec& spec,
                            const std::vector<int>& chosen,
                            const std::vector<std::string>& sensors) {
+  // `chosen`: the sensors' columns in `d` (`sensors` their names, in the same order).
   const auto [e, factor] = catalogue_match(d, effect, spec);
   if (e < 0) return "the catalogue criterion has no such effect (not a heat flow: unseen by it)";
   double most = 0;
@@ -404,6 +405,7 @@ int main(int argc, char** argv) {
     // 3. Sensors and regression.
     std::vector<int> chosen;
     std::optional<studies::CatalogueDetection> catalogue;  // correlation+catalogue
+    studies::CatalogueDetectionInput catalogue_input;      // ... and how it was formed
     for (int d = 0; d < 2; ++d)
       for (int c :
            fitting::sensors_by_correlation(fitting::group_subset(noisy, split.fitting), d, 4))
@@ -454,6 +456,7 @@ int main(int argc, char** argv) {
         input.catalogue.patch_half_size = 0.65 * catalogue_spacing;
         input.catalogue.heat_laws = {calibration::HeatLaw::constant};
         catalogue = studies::catalogue_detection(mesh, spec, fitting_runs, input);
+        catalogue_input = input;
         detection = catalogue->problem;
         what = "the catalogue's heat-flow effects (patches every " + fmt(catalogue_spacing) +
                " m, constant law): heat 5 W, films 25 %, sources 0.02/K, materials 10 %, air 1 K";
@@ -956,9 +959,31 @@ int main(int argc, char** argv) {
         if (effect.present)
           what += " " + fmt(effect.magnitude) + (effect.target.empty() ? "" : " " + effect.target);
         line(name, "generator, " + what, o, rr, run);
-        if (catalogue && effect.present)
-          std::cout << name << ": " << criterion_says(*catalogue, effect, spec, chosen, sensors)
-                    << "\n";
+        if (catalogue && effect.present) {
+          std::cout << name << ": on the campaign's fitting cycles (as placed, sigma "
+                    << catalogue_input.sensor_sigma_k << " K), "
+                    << criterion_says(*catalogue, effect, spec, chosen, sensors) << "\n";
+          if (catalogue_match(*catalogue, effect, spec).first >= 0) {
+            // The same on this run's own duty cycle, read by the chosen sensors with the
+            // observer's sigma (patches only for a heat input: the rest is cheap).
+            studies::CatalogueDetectionInput own = catalogue_input;
+            own.names = sensors;
+            own.points.clear();
+            for (const auto& id : sensors)
+              own.points.push_back(
+                  mesh.points[static_cast<std::size_t>(point_column(mesh, id))].position);
+            own.sensor_sigma_k = gen_noise.sensor_sigma_k(0);
+            if (effect.kind != calibration::EffectKind::heat_input) own.catalogue.heat_laws.clear();
+            const auto t_own = Clock::now();
+            const studies::CatalogueDetection d =
+                studies::catalogue_detection(mesh, spec, {declared}, own);
+            std::vector<int> all(sensors.size());
+            for (std::size_t c = 0; c < all.size(); ++c) all[c] = static_cast<int>(c);
+            std::cout << name << ": on this run's duty cycle (sigma " << own.sensor_sigma_k
+                      << " K, " << fmt(seconds_since(t_own)) << " s), "
+                      << criterion_says(d, effect, spec, all, sensors) << "\n";
+          }
+        }
         if (axis_models && truth.displacement.cols() == 3 + axis_columns) {
           // The axis points against the generator's own (finer mesh) truth.
           const Eigen::MatrixXd axis_truth = truth.displacement.rightCols(axis_columns);

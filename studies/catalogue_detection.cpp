@@ -1,6 +1,5 @@
 #include "studies/catalogue_detection.hpp"
 
-#include <cmath>
 #include <variant>
 
 #include "calibration/model.hpp"
@@ -78,9 +77,9 @@ CatalogueDetection catalogue_detection(const mesh::TetMesh& mesh, const core::Ca
           size * Eigen::Map<const Eigen::MatrixXd>(column.data(), times[k].size(), channels));
     }
   }
-  const int readings = static_cast<int>(std::ceil(input.sustain_s / input.sample_s - 1e-9)) + 1;
   out.problem = placement::detection_problem(
-      effects, changes, Eigen::VectorXd::Constant(channels, input.sensor_sigma_k), readings);
+      effects, changes, Eigen::VectorXd::Constant(channels, input.sensor_sigma_k),
+      sustain_readings(input.sustain_s, input.sample_s));
   out.problem.weights = placement::weights_per_kind(kinds);
   out.problem.kinds = std::move(kinds);
   out.sizes =

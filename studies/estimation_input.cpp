@@ -30,6 +30,10 @@ Eigen::VectorXd reading_times(const core::CaseSpec& run, double sample_s) {
   return Eigen::VectorXd::LinSpaced(count, sample_s, static_cast<double>(count) * sample_s);
 }
 
+int sustain_readings(double sustain_s, double sample_s) {
+  return static_cast<int>(std::ceil(sustain_s / sample_s - 1e-9)) + 1;
+}
+
 namespace {
 
 /// A candidate's row on the reduced state (r columns).
@@ -116,13 +120,10 @@ placement::DetectionProblem observer_detection_problem(const solvers::Twin& twin
     states.push_back(twin.model.states() + static_cast<Eigen::Index>(j));
     size.push_back(kinds[j] == solvers::UnknownInputKind::heat ? sizes.heat_w : sizes.air_k);
   }
-  // Beyond the bound at every reading over the sustain time: the first and the last sustain_s
-  // apart (solvers::HeldBeyondMonitor raises at t - since >= sustain_s).
-  const int readings = static_cast<int>(std::ceil(sustain_s / sample_s - 1e-9)) + 1;
   return placement::detection_problem(
       problem, effects, states,
       Eigen::Map<const Eigen::VectorXd>(size.data(), static_cast<Eigen::Index>(size.size())),
-      readings);
+      sustain_readings(sustain_s, sample_s));
 }
 
 }  // namespace tt::studies

@@ -28,6 +28,11 @@ placement::CovarianceTrack observer_covariance_track(const solvers::ReducedTherm
 /// sample_s is not > 0.
 Eigen::VectorXd reading_times(const core::CaseSpec& run, double sample_s);
 
+/// The readings a change must stay beyond the bound over to be held for `sustain_s` when read
+/// every `sample_s`: the first and the last sustain_s apart (solvers::HeldBeyondMonitor raises at
+/// t - since >= sustain_s).
+int sustain_readings(double sustain_s, double sample_s);
+
 /// Candidates of an estimation problem on a twin: a named point of the twin reads through its
 /// output row; any other candidate through the reduced basis's row of its mesh node.
 struct EstimationCandidates {
