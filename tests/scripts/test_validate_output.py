@@ -57,6 +57,17 @@ with tempfile.TemporaryDirectory() as tmp:
     code, out = check("observe", d)
     expect(code == 1 and "'offset_K' is a required property" in out,
            f"a sensor fault without its offset passes: exit {code}: {out}")
+    # Where each sensor was read (absent in files written before it): a position or a named point.
+    placed = dict(observer, sensor_places=[{"sensor": "T02", "read_at": "position",
+                                            "position_m": [0.1, 0.2, 0.3],
+                                            "from_named_point_m": 0.0}])
+    (d / "observer.json").write_text(json.dumps(placed))
+    code, out = check("observe", d)
+    expect(code == 0, f"an observer.json with sensor places fails: {out}")
+    placed["sensor_places"] = [{"sensor": "T02", "read_at": "nearby"}]
+    (d / "observer.json").write_text(json.dumps(placed))
+    code, out = check("observe", d)
+    expect(code == 1 and "nearby" in out, f"an unknown read_at passes: exit {code}: {out}")
     faulty = dict(observer, status="sensor fault")
     (d / "observer.json").write_text(json.dumps(faulty))
     code, out = check("observe", d)
