@@ -130,6 +130,16 @@ std::vector<int> unseen_effects(const DetectionProblem& problem, std::span<const
   return out;
 }
 
+double seen_weight(const DetectionProblem& problem, std::span<const int> columns, double bound) {
+  const auto ne = problem.held_sigmas.rows();
+  double seen = 0;
+  for (Eigen::Index e = 0; e < ne; ++e)
+    if (std::any_of(columns.begin(), columns.end(),
+                    [&](int c) { return problem.held_sigmas(e, c) >= bound; }))
+      seen += problem.weights.size() == ne ? problem.weights(e) : 1.0;
+  return seen;
+}
+
 GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int> chosen,
                             std::span<const int> pool, int m_max, double bound) {
   if (!(bound > 0) || !std::isfinite(bound))
@@ -147,11 +157,6 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
   const auto start = std::chrono::steady_clock::now();
   std::vector<int> columns(chosen.begin(), chosen.end());
   std::vector<int> unseen = unseen_effects(problem, columns, bound);
-  const auto seen_weight = [&] {
-    double unseen_weight = 0;
-    for (int e : unseen) unseen_weight += weight(e);
-    return weight.sum() - unseen_weight;
-  };
   GreedyPath path;
   for (int step = 0; step < m_max; ++step) {
     // Per unseen effect, how far the chosen sensors already get towards the bound.
@@ -179,7 +184,7 @@ GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int
     columns.push_back(best);
     unseen = unseen_effects(problem, columns, bound);
     path.order.push_back(best);
-    path.scores.push_back(seen_weight());
+    path.scores.push_back(seen_weight(problem, columns, bound));
     path.seconds.push_back(core::seconds_since(start));
   }
   return path;

@@ -66,6 +66,10 @@ DetectionProblem detection_problem(const std::vector<std::string>& effects,
 GreedyPath detection_greedy(const DetectionProblem& problem, std::span<const int> chosen,
                             std::span<const int> pool, int m_max, double bound);
 
+/// The weighted number of effects some sensor of `columns` sees at `bound` (each at its weight, 1
+/// when there are none: with weights_per_kind, the kinds seen).
+double seen_weight(const DetectionProblem& problem, std::span<const int> columns, double bound);
+
 /// The effects no sensor of `columns` sees at `bound` (their indices, in order).
 std::vector<int> unseen_effects(const DetectionProblem& problem, std::span<const int> columns,
                                 double bound);

@@ -76,17 +76,6 @@ DetectionReport detection_report(const PlaceInput& input, const placement::Estim
   return d;
 }
 
-/// The weighted number of effects of `d` that `columns` see at `bound` (the kinds seen, when the
-/// weights count each kind once).
-double seen_weight(const placement::DetectionProblem& d, const std::vector<int>& columns,
-                   double bound) {
-  const Eigen::VectorXd w =
-      d.weights.size() ? d.weights : Eigen::VectorXd::Ones(d.held_sigmas.rows());
-  double seen = w.sum();
-  for (int e : placement::unseen_effects(d, columns, bound)) seen -= w(e);
-  return seen;
-}
-
 /// Placement for detection of the catalogue's effects on the case's duty cycle: the greedy from
 /// no sensor, and the kinds each method's set of the largest m sees.
 CatalogueDetectionReport catalogue_detection_report(const PlaceInput& input, const Histories& h,
@@ -119,7 +108,7 @@ CatalogueDetectionReport catalogue_detection_report(const PlaceInput& input, con
     auto& by_method =
         d.kinds_seen.emplace_back(t.target, std::vector<std::pair<std::string, double>>{}).second;
     for (const auto& [method, s] : largest)
-      by_method.emplace_back(method, seen_weight(d.problem, s->columns, d.bound_sigmas));
+      by_method.emplace_back(method, placement::seen_weight(d.problem, s->columns, d.bound_sigmas));
   }
   return d;
 }
