@@ -111,6 +111,9 @@ int place_command(const PlaceArgs& args) {
        twin ? &*twin : nullptr, args.catalogue_detection ? &*mesh : nullptr,
        args.quiet ? solvers::Progress{} : [](double done, double total) {
          report_progress("place: the catalogue's effects for detection", done, total);
+       },
+       args.quiet ? studies::Progress{} : [](const std::string& line) {
+         std::cerr << "thermotwin: place: " << line << "\n";
        }});
   // 3. Outputs, all or nothing.
   io::write_place(out->path(), report, {args.sensor_noise, c.model, args.rom});

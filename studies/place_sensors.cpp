@@ -132,17 +132,28 @@ PlaceReport place_sensors(const PlaceInput& input) {
   report.histories =
       input.sensor_noise ? with_sensor_noise(input.histories, input.spec->seed) : input.histories;
   placement::PlacementInput in = placement_input(report.histories);
+  const auto say = [&](const std::string& line) {
+    if (input.progress) input.progress(line);
+  };
   if (input.twin) {
+    say("placement for estimation: the observer's covariance along the duty cycle (" +
+        std::to_string(input.twin->model.states()) + " reduced states)");
     report.estimation.emplace();
     in.estimation =
         estimation_problem(*input.spec, report.histories, *input.twin, *report.estimation);
   }
   const auto t = std::chrono::steady_clock::now();
+  say(std::to_string(input.methods.size()) + " methods, m = 1.." + std::to_string(input.m_max) +
+      ", " + std::to_string(report.histories.names.size()) + " candidates");
   report.result = placement::place_all(in, placement_options(input));
-  if (in.estimation)
+  if (in.estimation) {
+    say("placement for detection: the observer's unknown inputs");
     report.detection = detection_report(input, *in.estimation, *report.estimation, report.result);
-  if (input.catalogue_mesh)
+  }
+  if (input.catalogue_mesh) {
+    say("placement for detection: the calibration catalogue's effects");
     report.catalogue_detection = catalogue_detection_report(input, report.histories, report.result);
+  }
   report.place_s = core::seconds_since(t);
   return report;
 }

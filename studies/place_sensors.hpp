@@ -35,6 +35,8 @@ struct PlaceInput {
   const mesh::TetMesh* catalogue_mesh = nullptr;
   /// gets the simulated time over the total as the catalogue's effects are marched
   solvers::Progress catalogue_progress;
+  /// gets a line as each stage starts (the observer's covariance, the methods, detection)
+  Progress progress;
 };
 
 /// The observer's settings for placement for estimation.

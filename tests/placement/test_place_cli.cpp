@@ -236,6 +236,11 @@ TEST(PlaceCli, PlacesForDetectionOfTheCataloguesEffectsWhenAsked) {
                 .find("thermotwin: place: the catalogue's effects for detection 100 %"),
             std::string::npos)
       << text_of(dir / "place.log");
+  EXPECT_NE(text_of(dir / "place.log")
+                .find("thermotwin: place: placement for detection: the calibration catalogue's "
+                      "effects"),
+            std::string::npos)
+      << text_of(dir / "place.log");
   EXPECT_TRUE(tt::test::matches_output_schemas("place", dir / "place"));
   const auto doc = nlohmann::json::parse(text_of(dir / "place" / "placement.json"));
   ASSERT_TRUE(doc.contains("catalogue_detection"));
