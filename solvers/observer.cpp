@@ -118,18 +118,21 @@ ObserverSetup twin_observer_setup(const Twin& twin, const core::CaseSpec& spec,
                             std::to_string(sensor_rows.cols()) + " sensor rows for " +
                             std::to_string(sensors.size()) + " sensors of a twin of " +
                             std::to_string(out.rows.cols()) + " states");
-  if (sensor_rows.size() != 0) s.sensor_rows = sensor_rows;
-  for (std::size_t k = 0; k < sensors.size() && sensor_rows.size() == 0; ++k) {
-    const auto first = out.names.begin(), last = first + out.temperatures;
-    const auto it = std::find(first, last, sensors[k]);
-    if (it == last) {
-      std::string known;
-      for (auto n = first; n != last; ++n) known += (known.empty() ? "" : ", ") + *n;
-      throw core::SolverError("observer: sensor '" + sensors[k] +
-                              "' is not a named point of the reduced model; expected one of " +
-                              known);
+  if (sensor_rows.size() != 0) {
+    s.sensor_rows = sensor_rows;
+  } else {
+    for (std::size_t k = 0; k < sensors.size(); ++k) {
+      const int row = temperature_row(out, sensors[k]);
+      if (row < 0) {
+        std::string known;
+        for (int n = 0; n < out.temperatures; ++n)
+          known += (known.empty() ? "" : ", ") + out.names[static_cast<std::size_t>(n)];
+        throw core::SolverError("observer: sensor '" + sensors[k] +
+                                "' is not a named point of the reduced model; expected one of " +
+                                known);
+      }
+      s.sensor_rows.row(static_cast<Eigen::Index>(k)) = out.rows.row(row);
     }
-    s.sensor_rows.row(static_cast<Eigen::Index>(k)) = out.rows.row(it - first);
   }
   const Eigen::Index first = out.temperatures;
   const Eigen::Index axis = static_cast<Eigen::Index>(out.names.size()) - first - 9;

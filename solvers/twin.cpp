@@ -74,6 +74,12 @@ TwinOutputs full_outputs(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
   return out;
 }
 
+int temperature_row(const TwinOutputs& outputs, const std::string& id) {
+  const auto first = outputs.names.begin(), last = first + outputs.temperatures;
+  const auto it = std::find(first, last, id);
+  return it == last ? -1 : static_cast<int>(it - first);
+}
+
 TwinOutputs projected_outputs(const TwinOutputs& full, const Eigen::MatrixXd& basis) {
   if (full.rows.cols() != basis.rows())
     throw core::SolverError("output rows have " + std::to_string(full.rows.cols()) +

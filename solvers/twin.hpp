@@ -34,6 +34,10 @@ struct TwinOutputs {
   std::vector<std::string> materials;
 };
 
+/// The row of named point `id`'s temperature in `outputs` (in [0, temperatures)); -1 when the
+/// outputs do not name it.
+int temperature_row(const TwinOutputs& outputs, const std::string& id);
+
 /// The case's outputs on the full mesh: every named point's temperature, and with `elastic` (the
 /// case's factored stiffness; mechanical enabled and a TCP named) the nine TCP/probe influence
 /// rows and three per axis point.

@@ -38,9 +38,8 @@ namespace {
 
 /// A candidate's row on the reduced state (r columns).
 Eigen::RowVectorXd candidate_row(const solvers::Twin& twin, const std::string& name, int node) {
-  const solvers::TwinOutputs& out = twin.outputs;
-  const auto first = out.names.begin(), last = first + out.temperatures;
-  if (const auto it = std::find(first, last, name); it != last) return out.rows.row(it - first);
+  if (const int row = solvers::temperature_row(twin.outputs, name); row >= 0)
+    return twin.outputs.rows.row(row);
   if (node >= 0 && node < twin.model.basis.rows()) return twin.model.basis.row(node);
   throw core::SolverError("estimation placement: candidate '" + name + "' (node " +
                           std::to_string(node) +

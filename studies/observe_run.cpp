@@ -27,9 +27,8 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
 std::vector<std::string> named_by_twin(const solvers::TwinOutputs& outputs,
                                        const std::vector<std::string>& ids) {
   std::vector<std::string> named;
-  const auto first = outputs.names.begin(), last = first + outputs.temperatures;
   for (const auto& id : ids)
-    if (std::find(first, last, id) != last) named.push_back(id);
+    if (solvers::temperature_row(outputs, id) >= 0) named.push_back(id);
   return named;
 }
 
@@ -43,7 +42,8 @@ std::vector<std::string> readable_sensors(const solvers::TwinOutputs& outputs,
     const auto s =
         std::find_if(located.begin(), located.end(), [&](const auto& l) { return l.id == id; });
     const bool positioned = mesh && s != located.end() && s->position;
-    if (id != ambient && (positioned || !named_by_twin(outputs, {id}).empty())) out.push_back(id);
+    if (id != ambient && (positioned || solvers::temperature_row(outputs, id) >= 0))
+      out.push_back(id);
   }
   return out;
 }
@@ -51,16 +51,13 @@ std::vector<std::string> readable_sensors(const solvers::TwinOutputs& outputs,
 SensorReadout sensor_readout(const solvers::Twin& twin, const mesh::TetMesh* mesh,
                              const std::vector<io::MeasuredSensor>& located,
                              const std::vector<std::string>& ids, const std::string& source) {
-  const solvers::TwinOutputs& out = twin.outputs;
   SensorReadout r;
   r.places.resize(ids.size());
-  Eigen::MatrixXd rows(static_cast<Eigen::Index>(ids.size()), out.rows.cols());
-  bool any = false;
+  r.rows.resize(static_cast<Eigen::Index>(ids.size()), twin.outputs.rows.cols());
   for (std::size_t k = 0; k < ids.size(); ++k) {
     const auto s =
         std::find_if(located.begin(), located.end(), [&](const auto& l) { return l.id == ids[k]; });
-    const auto first = out.names.begin(), last = first + out.temperatures;
-    const auto named = std::find(first, last, ids[k]);
+    const int named = solvers::temperature_row(twin.outputs, ids[k]);
     if (mesh && s != located.end() && s->position) {
       r.places[k].position = *s->position;
       std::vector<std::pair<int, double>> weights;
@@ -69,18 +66,16 @@ SensorReadout sensor_readout(const solvers::Twin& twin, const mesh::TetMesh* mes
       } catch (const core::DataError& e) {
         throw core::DataError(source + ": sensor '" + ids[k] + "': " + e.what());
       }
-      rows.row(static_cast<Eigen::Index>(k)) = solvers::twin_point_row(twin, weights);
-      any = true;
+      r.rows.row(static_cast<Eigen::Index>(k)) = solvers::twin_point_row(twin, weights);
       for (const auto& p : mesh->points)
         if (p.id == ids[k]) r.places[k].from_named_point_m = (*s->position - p.position).norm();
-    } else if (named != last) {
-      rows.row(static_cast<Eigen::Index>(k)) = out.rows.row(named - first);
+    } else if (named >= 0) {
+      r.rows.row(static_cast<Eigen::Index>(k)) = twin.outputs.rows.row(named);
     } else {
       throw core::DataError(source + ": sensor '" + ids[k] +
                             "' has no position and is not a named point of the reduced model");
     }
   }
-  if (any) r.rows = std::move(rows);
   return r;
 }
 

@@ -31,7 +31,7 @@ struct ObserveInput {
   /// has a position (with `mesh`) or that the twin names
   std::vector<std::string> sensors;
   /// the observer's noise and consistency test on the case under the run and the chosen sensors,
-  /// read through the given rows (#sensors x the twin's states; empty: at their named points)
+  /// read through the given rows (#sensors x the twin's states: sensor_readout's)
   std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
                                        const Eigen::MatrixXd&)>
       setup;
@@ -67,7 +67,7 @@ std::vector<std::string> readable_sensors(const solvers::TwinOutputs& outputs,
 /// Where each sensor is read, and its rows on the twin.
 struct SensorReadout {
   std::vector<SensorPlace> places;
-  Eigen::MatrixXd rows;  /// #sensors x the twin's states; empty: every one at its named point
+  Eigen::MatrixXd rows;  /// #sensors x the twin's states
 };
 
 /// Each of `ids` read at its position in `located` (interpolated on the twin's basis on `mesh`,
