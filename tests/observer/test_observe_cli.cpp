@@ -46,14 +46,24 @@ struct OwnMeshGenerator {
   calibration::Instrumentation inst;
 };
 
+/// The coarse SB-1's reduced model (`reduce --quick-validation`), made once for every test here.
+const fs::path& coarse_rom() {
+  static const fs::path rom = [] {
+    const fs::path dir = rt::scratch("observe_rom");
+    EXPECT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", (dir / "rom").string(),
+                       "--quick-validation", "--quiet"},
+                      {}, dir / "reduce.log"),
+              0)
+        << rt::read_text(dir / "reduce.log");
+    return dir / "rom";
+  }();
+  return rom;
+}
+
 TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   const fs::path dir = rt::scratch("observe");
-  const fs::path rom = dir / "rom", data = dir / "run", out = dir / "out";
-  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
-                     "--quick-validation", "--quiet"},
-                    {}, dir / "reduce.log"),
-            0)
-      << rt::read_text(dir / "reduce.log");
+  const fs::path& rom = coarse_rom();
+  const fs::path data = dir / "run", out = dir / "out";
   // 1. A generated run with a sensor offset.
   const OwnMeshGenerator o;
   const core::CaseSpec& spec = o.spec;
@@ -256,12 +266,8 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
   // raises recalibrate, dated; `calibrate --case` on that run and two earlier runs of the same
   // machine then names a heat input near the true place.
   const fs::path dir = rt::scratch("observe_then_calibrate");
-  const fs::path rom = dir / "rom", observed = dir / "observed", log = dir / "log";
-  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
-                     "--quick-validation", "--quiet"},
-                    {}, log),
-            0)
-      << rt::read_text(log);
+  const fs::path& rom = coarse_rom();
+  const fs::path observed = dir / "observed", log = dir / "log";
   const OwnMeshGenerator o;
   std::mt19937_64 rng = core::generator(11, 0);
   calibration::InjectedEffect heat = calibration::random_effect(
@@ -329,12 +335,8 @@ TEST(ObserveCli, SensorsAreReadAtTheRunsPositions) {
   // predicts otherwise); a position in the air beside the machine is refused, naming the sensor,
   // and nothing is written.
   const fs::path dir = rt::scratch("observe_positions");
-  const fs::path rom = dir / "rom", log = dir / "log";
-  ASSERT_EQ(rt::run({"reduce", rt::kCoarseCase.string(), "--out", rom.string(),
-                     "--quick-validation", "--quiet"},
-                    {}, log),
-            0)
-      << rt::read_text(log);
+  const fs::path& rom = coarse_rom();
+  const fs::path log = dir / "log";
   const OwnMeshGenerator o;
   std::mt19937_64 rng = core::generator(17, 0);
   const calibration::InjectedEffect none;

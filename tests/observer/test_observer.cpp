@@ -94,6 +94,31 @@ class Observer : public ::testing::Test {
     n.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(kSensors.size()), 0.04);
     return n;
   }
+  /// Per candidate of `names` (named points), the held change of its reading [sigmas of 0.04 K]
+  /// between two twin runs, `c` and `c` with the sinks of `entries` 1 K warmer: over every four
+  /// consecutive outputs after t = 0, the largest of the smallest |change| (900 s of readings
+  /// every 300 s); and the number of output times.
+  static std::pair<std::vector<double>, std::size_t> held_air_change(
+      const core::CaseSpec& c, const std::vector<int>& entries,
+      const std::vector<std::string>& names) {
+    core::CaseSpec warmer = c;
+    for (int k : entries)
+      for (double& v : warmer.thermal.convection[static_cast<std::size_t>(k)].sink.value) v += 1;
+    const solvers::TwinRun declared = solvers::twin_run(s_->twin, c);
+    const solvers::TwinRun changed = solvers::twin_run(s_->twin, warmer);
+    const auto times = static_cast<Eigen::Index>(declared.times.size());
+    std::vector<double> out;
+    for (const auto& name : names) {
+      const int col = solvers::temperature_row(s_->twin.outputs, name);
+      const Eigen::VectorXd change =
+          (changed.outputs.col(col) - declared.outputs.col(col)).tail(times - 1).cwiseAbs() / 0.04;
+      double held = 0;
+      for (Eigen::Index i = 0; i + 4 <= change.size(); ++i)
+        held = std::max(held, change.segment(i, 4).minCoeff());
+      out.push_back(held);
+    }
+    return {out, declared.times.size()};
+  }
   /// The clean run's true drift as the observer's targets: the TCP's known, the rest NaN.
   static Eigen::MatrixXd clean_tcp_truth(const solvers::ObserverRun& run) {
     Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(run.drift.rows(), run.drift.cols(),
@@ -728,20 +753,10 @@ TEST_F(Observer, DetectionPlacementReadsTheChangeAnUndeclaredAirMakes) {
   ASSERT_NE(air, d.effects.end());
   for (const auto& e : d.effects) EXPECT_EQ(e.rfind("offset:", 0), std::string::npos) << e;
   EXPECT_EQ(static_cast<std::size_t>(d.held_sigmas.rows()), d.effects.size());
-  core::CaseSpec warmer = c;
-  for (int k : solvers::air_entries(c))
-    for (double& v : warmer.thermal.convection[static_cast<std::size_t>(k)].sink.value) v += 1;
-  const solvers::TwinRun declared = solvers::twin_run(s_->twin, c);
-  const solvers::TwinRun changed = solvers::twin_run(s_->twin, warmer);
-  ASSERT_EQ(declared.times.size(), 37u);  // t = 0, then every 300 s for 3 h
-  const auto& names = s_->twin.outputs.names;
+  const auto [helds, times] = held_air_change(c, solvers::air_entries(c), candidates);
+  ASSERT_EQ(times, 37u);  // t = 0, then every 300 s for 3 h
   for (std::size_t k = 0; k < candidates.size(); ++k) {
-    const auto col = std::find(names.begin(), names.end(), candidates[k]) - names.begin();
-    const Eigen::VectorXd change =
-        (changed.outputs.col(col) - declared.outputs.col(col)).tail(36).cwiseAbs() / 0.04;
-    double held = 0;
-    for (Eigen::Index i = 0; i + 4 <= change.size(); ++i)
-      held = std::max(held, change.segment(i, 4).minCoeff());
+    const double held = helds[k];
     EXPECT_NEAR(d.held_sigmas(air - d.effects.begin(), static_cast<Eigen::Index>(k)), held,
                 1e-6 * held)
         << candidates[k];
@@ -817,20 +832,12 @@ TEST_F(Observer, CatalogueDetectionReadsEachEffectAsTheFullModelAndTheTwinDo) {
   const auto air =
       std::find(d.effects.begin(), d.effects.end(), "air temperature on every convective sink");
   ASSERT_NE(air, d.effects.end());
-  core::CaseSpec warmer = c;
-  for (auto& entry : warmer.thermal.convection)
-    for (double& v : entry.sink.value) v += 1;
-  const solvers::TwinRun declared = solvers::twin_run(s_->twin, c);
-  const solvers::TwinRun changed = solvers::twin_run(s_->twin, warmer);
-  ASSERT_EQ(declared.times.size(), 25u);  // t = 0, then every 300 s for 2 h
-  const auto& names = s_->twin.outputs.names;
+  std::vector<int> every_sink(c.thermal.convection.size());
+  for (std::size_t k = 0; k < every_sink.size(); ++k) every_sink[k] = static_cast<int>(k);
+  const auto [helds, times] = held_air_change(c, every_sink, in.names);
+  ASSERT_EQ(times, 25u);  // t = 0, then every 300 s for 2 h
   for (std::size_t k = 0; k < in.names.size(); ++k) {
-    const auto col = std::find(names.begin(), names.end(), in.names[k]) - names.begin();
-    const Eigen::VectorXd change =
-        (changed.outputs.col(col) - declared.outputs.col(col)).tail(24).cwiseAbs() / 0.04;
-    double held = 0;
-    for (Eigen::Index i = 0; i + 4 <= change.size(); ++i)
-      held = std::max(held, change.segment(i, 4).minCoeff());
+    const double held = helds[k];
     EXPECT_NEAR(d.held_sigmas(air - d.effects.begin(), static_cast<Eigen::Index>(k)), held,
                 0.01 * held)
         << in.names[k];
