@@ -43,6 +43,10 @@ struct PlaceArgs {
   /// also place for detection of the calibration catalogue's effects (placement.json
   /// catalogue_detection)
   bool catalogue_detection = false;
+  /// with catalogue_detection: the sizes each kind is asked to be seen at (unset: the defaults of
+  /// studies::CatalogueSizes)
+  std::optional<double> detect_heat_w, detect_film_share, detect_source_per_k,
+      detect_material_change, detect_air_k;
 };
 
 struct FitArgs {

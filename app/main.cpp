@@ -182,11 +182,31 @@ Command place_line(CLI::App& cli) {
                   "place on readings as real sensors give them: the campaign's noise (0.05 K, "
                   "0.01 K resolution; 0.3 um on the error), seeded by the case");
   place->add_flag("--quiet", place_args.quiet, "no progress on stderr");
-  place->add_flag("--catalogue-detection", place_args.catalogue_detection,
-                  "also place for detection of the calibration catalogue's effects (a heat input "
-                  "on any patch of the surface, films, sources, materials, the air): where each "
-                  "would move a reading 3 sigma for 900 s (placement.json catalogue_detection, "
-                  "docs/placement.md)");
+  auto* detection_flag = place->add_flag(
+      "--catalogue-detection", place_args.catalogue_detection,
+      "also place for detection of the calibration catalogue's effects (a heat input "
+      "on any patch of the surface, films, sources, materials, the air): where each "
+      "would move a reading 3 sigma for 900 s (placement.json catalogue_detection, "
+      "docs/placement.md)");
+  const std::pair<const char*, std::optional<double>*> sizes[] = {
+      {"--detect-heat-w", &place_args.detect_heat_w},
+      {"--detect-film-share", &place_args.detect_film_share},
+      {"--detect-source-per-k", &place_args.detect_source_per_k},
+      {"--detect-material-change", &place_args.detect_material_change},
+      {"--detect-air-k", &place_args.detect_air_k}};
+  const char* size_help[] = {
+      "with --catalogue-detection: a heat input's power on its patch [W] (default 5)",
+      "with --catalogue-detection: a film's change, or its growth with speed, as a share of its "
+      "declared coefficient (default 0.25)",
+      "with --catalogue-detection: a source's heat growing with its temperature [1/K] (default "
+      "0.02)",
+      "with --catalogue-detection: a conductivity's or heat capacity's relative change (default "
+      "0.1)",
+      "with --catalogue-detection: the air's offset over the run [K] (default 1)"};
+  for (std::size_t k = 0; k < std::size(sizes); ++k)
+    place->add_option(sizes[k].first, *sizes[k].second, size_help[k])
+        ->check(positive_number())
+        ->needs(detection_flag);
   place
       ->add_option("--methods", place_args.methods,
                    "placement methods, comma-separated (default: all but observer_variance, the "

@@ -92,6 +92,17 @@ Candidates candidates_of(const PlaceArgs& args, std::optional<io::OutputDir>& ou
   return c;
 }
 
+/// The sizes `args` asks the catalogue's effects to be seen at; the defaults where it is silent.
+studies::CatalogueSizes catalogue_sizes(const PlaceArgs& args) {
+  studies::CatalogueSizes s;
+  s.heat_w = args.detect_heat_w.value_or(s.heat_w);
+  s.film_share = args.detect_film_share.value_or(s.film_share);
+  s.source_coefficient_per_k = args.detect_source_per_k.value_or(s.source_coefficient_per_k);
+  s.material_change = args.detect_material_change.value_or(s.material_change);
+  s.air_k = args.detect_air_k.value_or(s.air_k);
+  return s;
+}
+
 }  // namespace
 
 int place_command(const PlaceArgs& args) {
@@ -108,7 +119,7 @@ int place_command(const PlaceArgs& args) {
   // 2. Every placement method, for each target and m = 1..m_max.
   const studies::PlaceReport report = studies::place_sensors(
       {&c.spec, c.histories, methods, args.samples, args.bins, args.m_max, args.sensor_noise,
-       twin ? &*twin : nullptr, args.catalogue_detection ? &*mesh : nullptr,
+       twin ? &*twin : nullptr, args.catalogue_detection ? &*mesh : nullptr, catalogue_sizes(args),
        args.quiet ? solvers::Progress{} : [](double done, double total) {
          report_progress("place: the catalogue's effects for detection", done, total);
        },

@@ -85,6 +85,7 @@ CatalogueDetectionReport catalogue_detection_report(const PlaceInput& input, con
   d.bound_sigmas = alarm.model_residual_sigmas;
   d.settings.sustain_s = alarm.sustain_s;
   d.settings.sample_s = input.spec->thermal.output_interval;
+  d.settings.sizes = input.catalogue_sizes;
   d.settings.sensor_sigma_k = fitting::SensorNoise{}.temperature_sigma;
   // Many candidates (a surface's vertices) make the reduced basis on their rows larger than the
   // mesh is worth: the full model then.

@@ -33,6 +33,8 @@ struct PlaceInput {
   /// the case's mesh, for placement for detection of the calibration catalogue's effects (the
   /// candidates are read at their positions on it); nullptr: not asked for
   const mesh::TetMesh* catalogue_mesh = nullptr;
+  /// the sizes at which catalogue_mesh's detection asks to see each kind
+  CatalogueSizes catalogue_sizes;
   /// gets the simulated time over the total as the catalogue's effects are marched
   solvers::Progress catalogue_progress;
   /// gets a line as each stage starts (the observer's covariance, the methods, detection)

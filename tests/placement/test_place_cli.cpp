@@ -279,6 +279,59 @@ TEST(PlaceCli, PlacesForDetectionOfTheCataloguesEffectsWhenAsked) {
             0);
   EXPECT_FALSE(nlohmann::json::parse(text_of(dir / "without" / "placement.json"))
                    .contains("catalogue_detection"));
+  // The sizes on the command line: each kind asked at twice its default size moves every reading
+  // twice as far (the catalogue's responses are linear in their parameter), and the file says so.
+  ASSERT_EQ(thermotwin({"place",
+                        kCoarse.string(),
+                        "--out",
+                        (dir / "twice").string(),
+                        "--methods",
+                        "correlation",
+                        "--m-max",
+                        "3",
+                        "--catalogue-detection",
+                        "--quiet",
+                        "--detect-heat-w",
+                        "10",
+                        "--detect-film-share",
+                        "0.5",
+                        "--detect-source-per-k",
+                        "0.04",
+                        "--detect-material-change",
+                        "0.2",
+                        "--detect-air-k",
+                        "2"},
+                       dir / "place.log"),
+            0)
+      << text_of(dir / "place.log");
+  const auto twice =
+      nlohmann::json::parse(text_of(dir / "twice" / "placement.json"))["catalogue_detection"];
+  EXPECT_EQ(twice["sizes"], nlohmann::json({{"heat_W", 10.0},
+                                            {"film_share", 0.5},
+                                            {"source_coefficient_per_K", 0.04},
+                                            {"material_change", 0.2},
+                                            {"air_K", 2.0}}));
+  EXPECT_EQ(d["sizes"]["heat_W"], 5.0);
+  ASSERT_EQ(twice["effects"].size(), d["effects"].size());
+  for (std::size_t e = 0; e < d["effects"].size(); ++e)
+    EXPECT_NEAR(twice["effects"][e]["best_held_sigmas"].get<double>(),
+                2 * d["effects"][e]["best_held_sigmas"].get<double>(),
+                1e-9 * (1 + d["effects"][e]["best_held_sigmas"].get<double>()))
+        << d["effects"][e];
+  // A size that is no size, or one without the detection it sizes: refused, nothing written.
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--catalogue-detection", "--detect-heat-w", "0"},
+        std::vector<std::string>{"--catalogue-detection", "--detect-air-k", "nan"},
+        std::vector<std::string>{"--detect-film-share", "0.5"}}) {
+    std::vector<std::string> cli{
+        "place",     kCoarse.string(), "--out",  (dir / "refused").string(),
+        "--methods", "correlation",    "--quiet"};
+    cli.insert(cli.end(), extra.begin(), extra.end());
+    EXPECT_NE(thermotwin(cli, dir / "refused.log"), 0) << extra.back();
+    EXPECT_NE(text_of(dir / "refused.log").find(extra[extra.size() - 2]), std::string::npos)
+        << text_of(dir / "refused.log");
+    EXPECT_FALSE(fs::exists(dir / "refused"));
+  }
   if (!HasFailure()) fs::remove_all(dir);
 }
 
