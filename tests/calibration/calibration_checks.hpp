@@ -94,10 +94,15 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
     std::printf("[calibration] lag found %.4g s\n",
                 claims[0]["parameters"]["time_constant_s"].get<double>());
   for (const auto& e : effects)
-    std::printf("[calibration] %s magnitude %.4g target '%s'%s\n", kind_name(e.kind).c_str(),
+    std::printf("[calibration] %s magnitude %.4g target '%s'%s%s\n", kind_name(e.kind).c_str(),
                 e.magnitude, e.target.c_str(),
                 e.kind == EffectKind::speed_dependent_convection
                     ? (" exponent " + std::to_string(e.speed_exponent)).c_str()
+                    : "",
+                e.kind == EffectKind::heat_input
+                    ? (" at (" + std::to_string(e.centre.x()) + ", " +
+                       std::to_string(e.centre.y()) + ", " + std::to_string(e.centre.z()) + ") m")
+                          .c_str()
                     : "");
   std::printf("[calibration] first %s, RMS before %.4g after %.4g (%s)\n", out.first.c_str(),
               before, after, sensor_kind ? "K" : "um");
