@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <set>
 #include <string>
@@ -317,20 +318,50 @@ TargetResult target_result(const PlacementInput& input, const PlacementOptions& 
   tr.mi_bits = single_mi_bits(binned);
   tr.mi_rank = ranks_descending(tr.mi_bits);
   auto& out = tr.selections;
-  if (wants(o, Method::kHistogramMi)) histogram_selections(d, tr.mi_bits, out);
-  if (wants(o, Method::kGaussianGreedy))
+  auto start = Clock::now();
+  // A method that took progress_after_s or more says so as it is done, with its wall time.
+  const auto done = [&](std::string_view methods) {
+    if (o.progress && seconds_since(start) >= o.progress_after_s) {
+      char took[32];
+      std::snprintf(took, sizeof took, "%.1f s", seconds_since(start));
+      o.progress(target.name + ": " + std::string(methods) + ", m = 1.." + std::to_string(o.m_max) +
+                 ", " + took);
+    }
+    start = Clock::now();
+  };
+  if (wants(o, Method::kHistogramMi)) {
+    histogram_selections(d, tr.mi_bits, out);
+    done(method_name(Method::kHistogramMi));
+  }
+  if (wants(o, Method::kGaussianGreedy)) {
     path_selections(d, Method::kGaussianGreedy, greedy, "gaussian_bits", out);
-  if (wants(o, Method::kGaussianGa)) gaussian_ga_selections(d, out);
-  if (wants(o, Method::kKsgGreedy) || wants(o, Method::kJmiKsg)) ksg_selections(d, tr);
-  if (wants(o, Method::kQrPod)) qr_pod_selections(d, modes, result.pod_seconds, out);
-  if (wants(o, Method::kCorrelation))
+    done(method_name(Method::kGaussianGreedy));
+  }
+  if (wants(o, Method::kGaussianGa)) {
+    gaussian_ga_selections(d, out);
+    done(method_name(Method::kGaussianGa));
+  }
+  if (wants(o, Method::kKsgGreedy) || wants(o, Method::kJmiKsg)) {
+    ksg_selections(d, tr);
+    done("KSG and JMI");
+  }
+  if (wants(o, Method::kQrPod)) {
+    qr_pod_selections(d, modes, result.pod_seconds, out);
+    done(method_name(Method::kQrPod));
+  }
+  if (wants(o, Method::kCorrelation)) {
     ranked_selections(d, Method::kCorrelation, linear.r_y.cwiseAbs(), "abs_r", 0.0, out);
+    done(method_name(Method::kCorrelation));
+  }
   if (wants(o, Method::kGreyRelational)) {
-    const auto start = Clock::now();
     const auto grades = grey_relational_grades(temperatures, y, o.grey_rho);
     ranked_selections(d, Method::kGreyRelational, grades, "grey_grade", seconds_since(start), out);
+    done(method_name(Method::kGreyRelational));
   }
-  if (wants(o, Method::kObserverVariance) && input.estimation) estimation_selections(d, out);
+  if (wants(o, Method::kObserverVariance) && input.estimation) {
+    estimation_selections(d, out);
+    done(method_name(Method::kObserverVariance));
+  }
   return tr;
 }
 

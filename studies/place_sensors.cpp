@@ -47,6 +47,7 @@ placement::PlacementOptions placement_options(const PlaceInput& input) {
   options.m_max = input.m_max;
   options.seed = input.spec->seed;
   options.methods = input.methods;
+  options.progress = input.progress;
   return options;
 }
 

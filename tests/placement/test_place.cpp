@@ -42,8 +42,20 @@ TEST(Place, TwinsAreNeverBothChosenWithOrWithoutTheMirrorRule) {
   ASSERT_EQ(pairs.size(), 24u);
 
   auto options = quick_options();
+  std::vector<std::string> lines;
+  options.progress = [&](const std::string& line) { lines.push_back(line); };
+  options.progress_after_s = 0;  // every method says when it is done
   const auto with_rule = place_all(input, options);
   EXPECT_EQ(with_rule.pool.size(), 30u);
+  // A line per target and method as it is done (KSG and JMI share theirs), in the targets' order.
+  ASSERT_EQ(lines.size(), with_rule.targets.size() * (all_methods().size() - 1));
+  for (std::size_t t = 0; t < with_rule.targets.size(); ++t) {
+    const std::string& first = lines[t * (all_methods().size() - 1)];
+    EXPECT_EQ(first.rfind(with_rule.targets[t].target + ": histogram_mi, m = 1..6, ", 0), 0u)
+        << first;
+  }
+  EXPECT_NE(lines.back().find("observer_variance"), std::string::npos) << lines.back();
+  options.progress = {};
   expect_no_twin_pair(with_rule, pairs);
 
   // Without the declared mirror pairs only the correlation guard protects: twins differ by
