@@ -14,6 +14,9 @@
 // rises; ridge on them with lambda by leave-one-group-out cross-validation (lowest mean); ridge on
 // each temperature and its first-order lags at 600 s and 3600 s (plus speed and its lags where
 // there is one), lambda the same way.
+// Whole test runs are also streamed through `thermotwin compensate --model fit.json` sample by
+// sample, as a machine sends them: the largest difference from fit --data's offline prediction,
+// and the samples whose status is not ok (column "compensate replay").
 // Writes DIR/real-data-table.md (the table of docs/real-data.md) and prints it.
 #include <cmath>
 #include <filesystem>
@@ -208,7 +211,55 @@ struct Row {
   std::string data, split, channel;
   Errors none, ls, ridge, lagged, chosen, before, after;
   std::string chosen_label;
+  /// The test runs streamed through `compensate`: the largest difference from the offline
+  /// prediction [um] and the samples whose status is not ok (NaN, 0: no whole test run).
+  double replay_um = std::nan("");
+  int replay_not_ok = 0;
 };
+
+/// The split's whole test runs streamed through `thermotwin compensate --model` sample by
+/// sample, as a machine sends them (a time split's window is not: fit --data predicts it from the
+/// run's start with its refit): one CSV per test run.
+std::vector<fs::path> replays(const Split& s, const fs::path& out) {
+  std::vector<fs::path> files;
+  if (s.split_s) return files;
+  for (std::size_t k = 0; k < s.test.size(); ++k) {
+    files.push_back(out / ("replay_" + std::to_string(k + 1) + ".csv"));
+    if (reliability_test::run(
+            {"compensate", "--model", (out / "fit" / "fit.json").string(), "--in",
+             (s.test[k] / "data.csv").string(), "--until-eof", "--out", files.back().string()},
+            {}, out / "replay.log") != 0)
+      throw std::runtime_error(s.data + " " + s.name + ": compensate failed: " +
+                               reliability_test::read_text(out / "replay.log"));
+  }
+  return files;
+}
+
+/// `r`'s replay figures: the streamed predictions of its channel against compensation.csv's.
+void replay_figures(const std::vector<fs::path>& files, const fs::path& comp, Row& r) {
+  if (files.empty()) return;
+  Eigen::VectorXd streamed(0);
+  for (const auto& f : files) {
+    const Eigen::VectorXd p = csv_column(f, r.channel + "_predicted_um");
+    streamed.conservativeResize(streamed.size() + p.size());
+    streamed.tail(p.size()) = p;
+    r.replay_not_ok += static_cast<int>(csv_column(f, "time_s").size() -
+                                        csv_column(f, "time_s", "status", "ok").size());
+  }
+  const Eigen::VectorXd offline = csv_column(comp, "predicted_um", "target", r.channel);
+  r.replay_um = streamed.size() != offline.size() ? std::numeric_limits<double>::infinity()
+                : streamed.size() == 0            ? 0.0
+                                                  : (streamed - offline).cwiseAbs().maxCoeff();
+}
+
+/// `v` in scientific notation, 1 digit after the point.
+std::string num_e(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::scientific);
+  s.precision(1);
+  s << v;
+  return s.str();
+}
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "-";
@@ -253,6 +304,7 @@ std::vector<Row> run_split(const Split& s, const fs::path& work) {
   const auto train = fitting::segment_groups(side(s, true));
   const auto test = fitting::segment_groups(side(s, false));
   const std::vector<double> lambdas{1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0};
+  const std::vector<fs::path> replayed = replays(s, out);
   std::vector<Row> rows;
   for (int target = 0; target < static_cast<int>(train.front().target_names.size()); ++target) {
     Row r;
@@ -282,6 +334,8 @@ std::vector<Row> run_split(const Split& s, const fs::path& work) {
     const fs::path res = out / "cal" / ("residual_" + r.channel + ".csv");
     r.before = errors_of(csv_column(res, "residual_before_um") * 1e-6);
     r.after = errors_of(csv_column(res, "residual_after_um") * 1e-6);
+    // 4. The streamed test runs against the offline prediction.
+    replay_figures(replayed, comp, r);
     rows.push_back(r);
   }
   return rows;
@@ -355,8 +409,10 @@ int main(int argc, char** argv) {
   if (splits.size() > max_splits) splits.resize(max_splits);
   std::ostringstream md;
   md << "| data | split | channel | uncompensated | LS all dT | ridge CV | ridge + lags CV | "
-        "fit --data (chosen) | calibrate before | calibrate after | chosen model | targets |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "fit --data (chosen) | calibrate before | calibrate after | chosen model | compensate "
+        "replay "
+        "| targets |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   int misses = 0;
   for (const auto& s : splits) {
     std::cerr << "bench: " << s.data << " " << s.name << "\n";
@@ -370,13 +426,20 @@ int main(int argc, char** argv) {
       if (r.chosen.rms > r.none.rms * (1 + 1e-9)) missed.push_back("chosen > uncompensated");
       if (r.after.rms > r.before.rms * (1 + 1e-9)) missed.push_back("after > before");
       if (s.data == "fl" && r.after.rms > 2.5e-6) missed.push_back("after > 2.5 um");
+      // The CSVs' 10 significant digits: the same prediction reads back equal to about 1e-8 um.
+      if (r.replay_um > 1e-6) missed.push_back("replay differs from fit --data");
+      if (r.replay_not_ok > 0) missed.push_back("replay not ok");
       misses += static_cast<int>(missed.size());
       std::string verdict = missed.empty() ? "met" : "";
       for (const auto& m : missed) verdict += (verdict.empty() ? "" : "; ") + m;
       md << "| " << r.data << " | " << r.split << " | " << r.channel << " | " << cell(r.none)
          << " | " << cell(r.ls) << " | " << cell(r.ridge) << " | " << cell(r.lagged) << " | "
          << cell(r.chosen) << " | " << cell(r.before) << " | " << cell(r.after) << " | `"
-         << r.chosen_label << "` | " << verdict << " |\n";
+         << r.chosen_label << "` | "
+         << (std::isfinite(r.replay_um)
+                 ? num_e(r.replay_um) + " um, " + std::to_string(r.replay_not_ok) + " not ok"
+                 : std::string("-"))
+         << " | " << verdict << " |\n";
       std::cout << md.str().substr(md.str().rfind("| " + r.data)) << std::flush;
     }
   }
