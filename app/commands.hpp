@@ -138,6 +138,10 @@ struct ObserveArgs {
   std::filesystem::path case_file, rom, data, out;
   ObserverOptions observer;
   bool quiet = false;
+  /// > 0: the run's displacement columns named after targets are read as drift readings, one
+  /// every this many seconds (a probe cycle); 0: temperatures only
+  double drift_readings_every_s = 0;
+  double drift_reading_sigma_um = 0.3;  /// white noise of a drift reading [um]
 };
 
 /// export --model FIT.json --out DIR: the compensation in the controllers' formats

@@ -38,10 +38,13 @@ int observe_command(const ObserveArgs& args) {
   // 3. The study: the run's sensors read at their positions where it gives them.
   const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors,
                          const Eigen::MatrixXd& rows) {
-    return observer_setup(args.observer, rom.twin, spec, sensors, rows);
+    solvers::ObserverSetup s = observer_setup(args.observer, rom.twin, spec, sensors, rows);
+    s.noise.drift_reading_sigma_m = 1e-6 * args.drift_reading_sigma_um;
+    return s;
   };
   const studies::ObserveReport report =
-      studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup, &mesh});
+      studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup, &mesh,
+                            args.drift_readings_every_s});
   // 4. Outputs.
   io::write_observe(out.path(), report,
                     {run.run, declared.name, rom.twin.model.states(), args.rom,
@@ -65,6 +68,11 @@ int observe_command(const ObserveArgs& args) {
               << report.sensors[static_cast<std::size_t>(d.sensor)]
               << " read away from the declared model's run since t = " << d.since_s
               << " s, beginning near t = " << d.onset_s << " s (observer.json model_departures)\n";
+  for (const solvers::HeldSensor& d : r.drift_departures)
+    std::cerr << "thermotwin: observe: the drift readings of "
+              << report.setup.target_names[static_cast<std::size_t>(d.sensor)]
+              << " departed from the model since t = " << d.since_s
+              << " s (observer.json drift_readings)\n";
   return 0;
 }
 

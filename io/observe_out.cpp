@@ -1,6 +1,7 @@
 #include "io/observe_out.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -18,12 +19,23 @@ std::string observer_csv(const solvers::ObserverRun& r,
   std::ostringstream csv;
   csv << std::setprecision(9) << "time_s";
   for (const auto& t : target_names) csv << "," << t << "_predicted_um," << t << "_sigma_um";
+  // With drift readings: each target's reading minus prediction and its sigma (empty between).
+  const bool drifts = r.drift_innovation.size() != 0;
+  if (drifts)
+    for (const auto& t : target_names)
+      csv << "," << t << "_drift_innovation_um," << t << "_drift_innovation_sigma_um";
   csv << ",nis,readings,window_nis,window_bound,status\n";
+  const auto um = [](double v) {
+    return std::isfinite(v) ? std::to_string(v * core::kMicrometresPerMetre) : std::string();
+  };
   for (Eigen::Index i = 0; i < r.times.size(); ++i) {
     csv << r.times(i);
     for (Eigen::Index k = 0; k < r.drift.cols(); ++k)
       csv << "," << r.drift(i, k) * core::kMicrometresPerMetre << ","
           << r.drift_sigma(i, k) * core::kMicrometresPerMetre;
+    if (drifts)
+      for (Eigen::Index k = 0; k < r.drift.cols(); ++k)
+        csv << "," << um(r.drift_innovation(i, k)) << "," << um(r.drift_innovation_sigma(i, k));
     const bool alarm = r.recalibrate && r.times(i) >= r.recalibrate_at_s;
     std::vector<std::string> faulty;
     for (const solvers::HeldSensor& f : r.sensor_faults)
@@ -83,6 +95,22 @@ nlohmann::json departures_json(const solvers::ObserverRun& r,
   return out;
 }
 
+/// The drift readings the observer took (a probe cycle): how often, of which targets, how many
+/// samples, their noise, and the targets whose readings departed from the model.
+nlohmann::json drift_readings_json(const studies::ObserveReport& report) {
+  const solvers::ObserverRun& r = report.result;
+  nlohmann::json departures = nlohmann::json::array();
+  for (const solvers::HeldSensor& d : r.drift_departures)
+    departures.push_back({{"target", report.setup.target_names[static_cast<std::size_t>(d.sensor)]},
+                          {"since_s", d.since_s},
+                          {"raised_s", d.raised_s}});
+  return {{"every_s", report.drift_readings_every_s},
+          {"targets", report.drift_targets},
+          {"samples", report.drift_samples},
+          {"sigma_um", 1e6 * report.setup.noise.drift_reading_sigma_m},
+          {"departures", departures}};
+}
+
 /// Where each sensor was read: at the run's position, or at the named point of its id.
 nlohmann::json places_json(const studies::ObserveReport& report) {
   nlohmann::json out = nlohmann::json::array();
@@ -129,6 +157,7 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
       {"model_departures", departures_json(r, report.sensors)},
       {"recalibrate_since_s", nullptr},
       {"recalibrate_raised_s", nullptr}};
+  if (report.drift_readings_every_s > 0) doc["drift_readings"] = drift_readings_json(report);
   if (r.recalibrate) {
     doc["recalibrate_since_s"] = r.recalibrate_since_s;
     doc["recalibrate_raised_s"] = r.recalibrate_at_s;

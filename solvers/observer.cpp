@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <string>
 
 #include "core/dense_product.hpp"
@@ -437,52 +438,57 @@ std::vector<UnknownInputKind> KalmanObserver::unknown_input_kinds() const {
   return kinds;
 }
 
-ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& readings) {
-  const Eigen::Index m = setup_.sensor_rows.rows();
+namespace {
+
+/// The rows an assimilation reads (`used`: sensor k < #sensors, drift reading #sensors + target),
+/// without the offsets: H, the innovations y - H z (a drift reading's relative to t = 0, d - L (z -
+/// z(0))) and the readings' variances (a drift reading's with the rows' own relative error at the
+/// predicted drift).
+struct MeasurementRows {
+  Eigen::MatrixXd h;
+  Eigen::VectorXd innovation, variance;
+};
+
+MeasurementRows measurement_rows(const ObserverSetup& setup, const Eigen::VectorXd& z,
+                                 const Eigen::VectorXd& z0, const std::vector<Eigen::Index>& used,
+                                 const Eigen::VectorXd& readings,
+                                 const Eigen::VectorXd& drift_readings) {
+  const Eigen::Index m = setup.sensor_rows.rows();
+  const auto nu = static_cast<Eigen::Index>(used.size());
+  const ObserverNoise& n = setup.noise;
+  MeasurementRows out{Eigen::MatrixXd(nu, z.size()), Eigen::VectorXd(nu), Eigen::VectorXd(nu)};
+  for (Eigen::Index i = 0; i < nu; ++i) {
+    const Eigen::Index k = used[static_cast<std::size_t>(i)];
+    if (k < m) {
+      out.h.row(i) = setup.sensor_rows.row(k);
+      out.innovation(i) = readings(k) - out.h.row(i).dot(z);
+      out.variance(i) = n.sensor_sigma_k(k) * n.sensor_sigma_k(k);
+    } else {
+      out.h.row(i) = setup.target_rows.row(k - m);
+      const double predicted = out.h.row(i).dot(z - z0);
+      out.innovation(i) = drift_readings(k - m) - predicted;
+      out.variance(i) = n.drift_reading_sigma_m * n.drift_reading_sigma_m +
+                        std::pow(n.drift_relative_sigma * predicted, 2);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& readings,
+                                            const Eigen::VectorXd& drift_readings) {
+  const Eigen::Index m = setup_.sensor_rows.rows(), nt = setup_.target_rows.rows();
   if (readings.size() != m)
     throw core::SolverError("observer: " + std::to_string(readings.size()) + " readings for " +
                             std::to_string(m) + " sensors");
+  if (drift_readings.size() != 0 && drift_readings.size() != nt)
+    throw core::SolverError("observer: " + std::to_string(drift_readings.size()) +
+                            " drift readings for " + std::to_string(nt) + " targets");
   advance_to(t);
   ObserverEstimate e;
   e.time = t;
-  e.innovation = Eigen::VectorXd::Constant(m, std::numeric_limits<double>::quiet_NaN());
-  std::vector<Eigen::Index> used;
-  for (Eigen::Index k = 0; k < m; ++k)
-    if (std::isfinite(readings(k))) used.push_back(k);
-  const auto nu = static_cast<Eigen::Index>(used.size());
-  if (nu > 0) {
-    Eigen::MatrixXd h(nu, r_);
-    Eigen::VectorXd y(nu), r2(nu);
-    for (Eigen::Index i = 0; i < nu; ++i) {
-      h.row(i) = setup_.sensor_rows.row(used[i]);
-      y(i) = readings(used[i]);
-      r2(i) = setup_.noise.sensor_sigma_k(used[i]) * setup_.noise.sensor_sigma_k(used[i]);
-    }
-    Eigen::VectorXd innovation = y - h * x_.head(r_);
-    Eigen::MatrixXd pht = p_.leftCols(r_).lazyProduct(h.transpose());  // (r + nb) x nu
-    // With offsets a reading is H z + o: its row has a 1 at its sensor's offset, so P H^T gains
-    // that offset's column of P, and H P H^T that offset's row of P H^T.
-    if (offsets_ >= 0)
-      for (Eigen::Index i = 0; i < nu; ++i) {
-        innovation(i) -= x_(r_ + offsets_ + used[i]);
-        pht.col(i) += p_.col(r_ + offsets_ + used[i]);
-      }
-    Eigen::MatrixXd s = h.lazyProduct(pht.topRows(r_));
-    if (offsets_ >= 0)
-      for (Eigen::Index i = 0; i < nu; ++i) s.row(i) += pht.row(r_ + offsets_ + used[i]);
-    s.diagonal() += r2;
-    const Eigen::LLT<Eigen::MatrixXd> llt(s);
-    if (llt.info() != Eigen::Success)
-      throw core::SolverError("observer: the innovation covariance at t = " + number(t) +
-                              " s is not positive definite");
-    const Eigen::MatrixXd gain = llt.solve(pht.transpose()).transpose();  // (r + nb) x nu
-    x_ += gain * innovation;
-    p_ -= gain.lazyProduct(pht.transpose());
-    p_ = 0.5 * (p_ + p_.transpose()).eval();
-    e.nis = innovation.dot(llt.solve(innovation));
-    e.dof = static_cast<int>(nu);
-    for (Eigen::Index i = 0; i < nu; ++i) e.innovation(used[i]) = innovation(i);
-  }
+  update(t, readings, drift_readings, e);
   e.drift = setup_.target_rows * (x_.head(r_) - z0_);
   e.drift_sigma = drift_sigma(e.drift);
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
@@ -491,6 +497,61 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   e.recalibrate_since_s = monitor_.since_s();
   test_departures(t, readings, e);
   return e;
+}
+
+void KalmanObserver::update(double t, const Eigen::VectorXd& readings,
+                            const Eigen::VectorXd& drift_readings, ObserverEstimate& e) {
+  const Eigen::Index m = setup_.sensor_rows.rows(), nt = setup_.target_rows.rows();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  e.innovation = Eigen::VectorXd::Constant(m, nan);
+  if (drift_readings.size() != 0)
+    e.drift_innovation = e.drift_innovation_sigma = Eigen::VectorXd::Constant(nt, nan);
+  // The rows read: the sensors' (k < m) and the drift readings' (m + target).
+  std::vector<Eigen::Index> used;
+  for (Eigen::Index k = 0; k < m; ++k)
+    if (std::isfinite(readings(k))) used.push_back(k);
+  for (Eigen::Index k = 0; k < drift_readings.size(); ++k)
+    if (std::isfinite(drift_readings(k))) used.push_back(m + k);
+  const auto nu = static_cast<Eigen::Index>(used.size());
+  if (nu == 0) return;
+  const auto [h, innovation0, r2] =
+      measurement_rows(setup_, x_.head(r_), z0_, used, readings, drift_readings);
+  Eigen::VectorXd innovation = innovation0;
+  Eigen::MatrixXd pht = p_.leftCols(r_).lazyProduct(h.transpose());  // (r + nb) x nu
+  // With offsets a reading is H z + o: its row has a 1 at its sensor's offset, so P H^T gains
+  // that offset's column of P, and H P H^T that offset's row of P H^T (drift readings have none).
+  const auto offset_of = [&](Eigen::Index i) {
+    const Eigen::Index k = used[static_cast<std::size_t>(i)];
+    return offsets_ >= 0 && k < m ? r_ + offsets_ + k : Eigen::Index{-1};
+  };
+  for (Eigen::Index i = 0; i < nu; ++i)
+    if (const Eigen::Index o = offset_of(i); o >= 0) {
+      innovation(i) -= x_(o);
+      pht.col(i) += p_.col(o);
+    }
+  Eigen::MatrixXd s = h.lazyProduct(pht.topRows(r_));
+  for (Eigen::Index i = 0; i < nu; ++i)
+    if (const Eigen::Index o = offset_of(i); o >= 0) s.row(i) += pht.row(o);
+  s.diagonal() += r2;
+  const Eigen::LLT<Eigen::MatrixXd> llt(s);
+  if (llt.info() != Eigen::Success)
+    throw core::SolverError("observer: the innovation covariance at t = " + number(t) +
+                            " s is not positive definite");
+  for (Eigen::Index i = 0; i < nu; ++i) {
+    const Eigen::Index k = used[static_cast<std::size_t>(i)];
+    if (k < m) {
+      e.innovation(k) = innovation(i);
+    } else {
+      e.drift_innovation(k - m) = innovation(i);
+      e.drift_innovation_sigma(k - m) = std::sqrt(s(i, i));
+    }
+  }
+  const Eigen::MatrixXd gain = llt.solve(pht.transpose()).transpose();  // (r + nb) x nu
+  x_ += gain * innovation;
+  p_ -= gain.lazyProduct(pht.transpose());
+  p_ = 0.5 * (p_ + p_.transpose()).eval();
+  e.nis = innovation.dot(llt.solve(innovation));
+  e.dof = static_cast<int>(nu);
 }
 
 void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
@@ -570,12 +631,80 @@ CovarianceMap KalmanObserver::advance(double t) {
   return map;
 }
 
+namespace {
+
+/// observe's drift test: a filter on the temperatures alone, and each drift reading against its
+/// drift, in its reported sigma and the reading's; a target held beyond model_residual_sigmas over
+/// readings sustain_s apart is raised.
+class DriftTest {
+ public:
+  DriftTest(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+            const ObserverSetup& setup)
+      : blind_(system, spec, setup),
+        held_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false),
+        reading_sigma_m_(setup.noise.drift_reading_sigma_m),
+        on_(setup.consistency.model_residual_sigmas > 0) {}
+  /// Steps the blind filter to t with `readings` and tests `drift` (#targets [m], NaN: none).
+  /// Returns the earliest start of a target raised now (NaN: none).
+  double add(double t, const Eigen::VectorXd& readings, const Eigen::VectorXd& drift) {
+    const ObserverEstimate e = blind_.assimilate(t, readings);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!on_ || !drift.array().isFinite().any()) return nan;
+    Eigen::VectorXd z = Eigen::VectorXd::Constant(drift.size(), nan);
+    for (Eigen::Index j = 0; j < drift.size(); ++j)
+      if (std::isfinite(drift(j)))
+        z(j) = (drift(j) - e.drift(j)) /
+               std::sqrt(e.drift_sigma(j) * e.drift_sigma(j) + reading_sigma_m_ * reading_sigma_m_);
+    const std::size_t before = held_.raised().size();
+    held_.add(t, z, Eigen::VectorXd::Ones(drift.size()));
+    double since = nan;
+    for (std::size_t k = before; k < held_.raised().size(); ++k)
+      if (std::isnan(since) || held_.raised()[k].since_s < since) since = held_.raised()[k].since_s;
+    return since;
+  }
+  const std::vector<HeldSensor>& raised() const { return held_.raised(); }
+
+ private:
+  KalmanObserver blind_;
+  HeldBeyondMonitor held_;
+  double reading_sigma_m_;
+  bool on_;
+};
+
+/// `run`'s record of sample i: the estimate, the filter's state and its unknown inputs.
+void record(const KalmanObserver& kf, const ObserverEstimate& e, Eigen::Index i, ObserverRun& run) {
+  if (e.drift_innovation.size() != 0) {
+    if (run.drift_innovation.size() == 0) {
+      run.drift_innovation.resize(run.drift.rows(), run.drift.cols());
+      run.drift_innovation_sigma.resize(run.drift.rows(), run.drift.cols());
+    }
+    run.drift_innovation.row(i) = e.drift_innovation.transpose();
+    run.drift_innovation_sigma.row(i) = e.drift_innovation_sigma.transpose();
+  }
+  const auto nb = static_cast<Eigen::Index>(kf.unknown_inputs().size());
+  run.drift.row(i) = e.drift.transpose();
+  run.drift_sigma.row(i) = e.drift_sigma.transpose();
+  run.innovation.row(i) = e.innovation.transpose();
+  run.nis(i) = e.nis;
+  run.dof(i) = e.dof;
+  run.window_nis(i) = kf.monitor().window_nis();
+  run.window_bound(i) = kf.monitor().window_bound();
+  run.states.col(i) = kf.state().head(kf.states());
+  run.unknown_inputs.row(i) = kf.state().tail(nb).transpose();
+  run.unknown_inputs_sigma.row(i) =
+      kf.covariance().bottomRightCorner(nb, nb).diagonal().cwiseMax(0.0).cwiseSqrt().transpose();
+}
+
+}  // namespace
+
 ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                     const ObserverSetup& setup, const Eigen::VectorXd& times,
-                    const Eigen::MatrixXd& readings) {
-  if (readings.rows() != times.size())
+                    const Eigen::MatrixXd& readings, const Eigen::MatrixXd& drift_readings) {
+  if (readings.rows() != times.size() ||
+      (drift_readings.size() != 0 && drift_readings.rows() != times.size()))
     throw core::SolverError("observer: " + std::to_string(readings.rows()) +
-                            " rows of readings for " + std::to_string(times.size()) + " times");
+                            " rows of readings and " + std::to_string(drift_readings.rows()) +
+                            " of drift readings for " + std::to_string(times.size()) + " times");
   KalmanObserver kf(system, spec, setup);
   const Eigen::Index n = times.size(), nt = setup.target_rows.rows();
   const Eigen::Index nb = static_cast<Eigen::Index>(kf.unknown_inputs().size());
@@ -593,29 +722,29 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
   run.unknown_inputs_sigma.resize(n, nb);
   run.unknown_input_names = kf.unknown_inputs();
   run.unknown_input_kinds = kf.unknown_input_kinds();
+  std::optional<DriftTest> test;
+  if (drift_readings.size() != 0) test.emplace(system, spec, setup);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const ObserverEstimate e = kf.assimilate(times(i), readings.row(i).transpose());
-    run.drift.row(i) = e.drift.transpose();
-    run.drift_sigma.row(i) = e.drift_sigma.transpose();
-    run.innovation.row(i) = e.innovation.transpose();
-    run.nis(i) = e.nis;
-    run.dof(i) = e.dof;
-    run.window_nis(i) = kf.monitor().window_nis();
-    run.window_bound(i) = kf.monitor().window_bound();
-    const Eigen::Index r = kf.states();
-    run.states.col(i) = kf.state().head(r);
-    run.unknown_inputs.row(i) = kf.state().tail(nb).transpose();
-    run.unknown_inputs_sigma.row(i) =
-        kf.covariance().bottomRightCorner(nb, nb).diagonal().cwiseMax(0.0).cwiseSqrt().transpose();
+    const Eigen::VectorXd y = readings.row(i).transpose();
+    const Eigen::VectorXd d =
+        test ? Eigen::VectorXd(drift_readings.row(i).transpose()) : Eigen::VectorXd();
+    const ObserverEstimate e = kf.assimilate(times(i), y, d);
+    record(kf, e, i, run);
     if (e.recalibrate && !run.recalibrate) {
       run.recalibrate = true;
       run.recalibrate_since_s = e.recalibrate_since_s;
       run.recalibrate_at_s = e.time;
     }
+    if (const double since = test ? test->add(times(i), y, d) : std::nan(""); !std::isnan(since)) {
+      run.recalibrate_since_s = run.recalibrate ? std::min(run.recalibrate_since_s, since) : since;
+      if (!run.recalibrate) run.recalibrate_at_s = times(i);
+      run.recalibrate = true;
+    }
   }
   if (n > 0) {
     run.sensor_faults = kf.sensor_faults();
     run.model_departures = kf.model_departures();
+    if (test) run.drift_departures = test->raised();
   }
   return run;
 }

@@ -14,7 +14,9 @@
 // Phi and u the stepper's affine map (ReducedStepper), Gamma = (C + theta dt A)^{-1} dt B(h) with
 // B the unknown inputs' columns (the air's column is sum_c h_c(speed) a_c: it follows the film).
 // Readings y = H z + o + v, H the sensors' rows on the reduced state, o the offsets (0 without
-// them), v ~ N(0, diag(sigma^2)).
+// them), v ~ N(0, diag(sigma^2)). A drift reading (a probe cycle measuring the tool, when there is
+// one) d = L (z - z(0)) + v_d, L the target's drift row: it enters the filter and its NIS the same
+// way, and sees what no temperature shows (a wrong expansion coefficient).
 #pragma once
 
 #include <Eigen/Core>
@@ -72,6 +74,10 @@ struct ObserverNoise {
   /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
   /// alarm) as it is. Empty: 1 for every target.
   Eigen::VectorXd drift_sigma_scale;
+  /// Standard deviation of a drift reading's white noise [m] (a probe cycle measuring the tool's
+  /// drift, KalmanObserver::assimilate's drift_readings); the drift rows' relative error
+  /// (drift_relative_sigma) is added to it at the predicted drift.
+  double drift_reading_sigma_m = 0.3e-6;
   /// Widen the reported sigma while the innovations say the machine is no longer the model: by
   /// sqrt(NIS / dof) over the consistency window when that is above 1 (a filter whose noise is
   /// too small by a factor a has innovations a times its S, and errors a times its P). It leaves
@@ -230,8 +236,11 @@ struct ObserverEstimate {
   Eigen::VectorXd drift;        /// #targets [m], relative to t = 0
   Eigen::VectorXd drift_sigma;  /// #targets standard deviation [m]
   Eigen::VectorXd innovation;   /// #sensors reading minus prediction [K], NaN where missing
-  double nis = 0;               /// normalised innovation squared
-  int dof = 0;                  /// readings used
+  /// #targets drift reading minus prediction [m], and its standard deviation under the noise
+  /// model [m]; NaN where there is none (empty: no drift reading)
+  Eigen::VectorXd drift_innovation, drift_innovation_sigma;
+  double nis = 0;  /// normalised innovation squared
+  int dof = 0;     /// readings used (temperatures and drifts)
   bool recalibrate = false;
   double recalibrate_since_s = std::numeric_limits<double>::quiet_NaN();
 };
@@ -257,10 +266,12 @@ class KalmanObserver {
   /// convection entry of `spec`.
   KalmanObserver(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                  const ObserverSetup& setup);
-  /// Steps to time t (a step ends there) and assimilates `readings`
-  /// (#sensors [K], NaN: missing). Throws SolverError for t before the last assimilation or
+  /// Steps to time t (a step ends there) and assimilates `readings` (#sensors [K], NaN: missing)
+  /// and, when given, `drift_readings` (#targets [m] relative to t = 0, NaN: none; a probe cycle
+  /// measuring the tool now and then). Throws SolverError for t before the last assimilation or
   /// beyond the duty cycle's end, or readings of another size.
-  ObserverEstimate assimilate(double t, const Eigen::VectorXd& readings);
+  ObserverEstimate assimilate(double t, const Eigen::VectorXd& readings,
+                              const Eigen::VectorXd& drift_readings = Eigen::VectorXd());
   /// Steps to time t as assimilate does, without a reading, and returns the covariance's map over
   /// those steps: what a criterion on the covariance alone needs (it does not see the readings'
   /// values; placement for estimation). Throws as assimilate does.
@@ -291,6 +302,9 @@ class KalmanObserver {
   /// The tests beside the NIS's after an assimilation at t (the offsets' faults, the readings
   /// against the declared model's run): raises `e.recalibrate` where they say so.
   void test_departures(double t, const Eigen::VectorXd& readings, ObserverEstimate& e);
+  /// The Kalman update with the readings and drift readings that are not NaN.
+  void update(double t, const Eigen::VectorXd& readings, const Eigen::VectorXd& drift_readings,
+              ObserverEstimate& e);
 
   const ReducedThermalSystem& sys_;
   const core::CaseSpec& spec_;
@@ -332,12 +346,26 @@ struct ObserverRun {
   /// Readings held away from the declared model's run, in the order raised (the first says
   /// recalibrate; ConsistencyOptions::model_residual_sigmas).
   std::vector<HeldSensor> model_departures;
+  /// Drift readings' innovations and their sigmas (#samples x #targets [m], NaN where none; empty
+  /// without drift readings).
+  Eigen::MatrixXd drift_innovation, drift_innovation_sigma;
+  /// Targets whose drift readings departed from what the temperatures alone predict (observe's
+  /// drift test; HeldSensor::sensor: the target's index), in the order raised; each says
+  /// recalibrate.
+  std::vector<HeldSensor> drift_departures;
 };
 
-/// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle).
+/// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle);
+/// `drift_readings`: none (empty) or #samples x #targets [m], NaN where a target is not read.
+/// With drift readings the filter assimilates them, and a second filter on the temperatures alone
+/// tests them: a target whose reading stays more than model_residual_sigmas from that filter's
+/// drift (in its reported sigma, drift_sigma_scale and all, and the reading's) over readings
+/// sustain_s apart has changed in a way no temperature shows (a wrong expansion coefficient):
+/// recalibrate, dated from the first such reading.
 ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                     const ObserverSetup& setup, const Eigen::VectorXd& times,
-                    const Eigen::MatrixXd& readings);
+                    const Eigen::MatrixXd& readings,
+                    const Eigen::MatrixXd& drift_readings = Eigen::MatrixXd());
 
 /// The mean normalised squared error of the reported drift per target over runs whose true drift
 /// is known (training runs): mean over samples of ((estimate - truth)^2 - truth_sigma^2) / sigma^2,

@@ -1,6 +1,7 @@
 #include "studies/observe_run.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "calibration/model.hpp"
 #include "core/errors.hpp"
@@ -20,6 +21,36 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
     y.col(static_cast<Eigen::Index>(k)) = run.temperature.col(it - run.sensors.begin());
   }
   return y;
+}
+
+/// The drift readings of `run` for `setup`'s targets: each displacement column whose id names a
+/// target, at the first sample at or after each multiple of every_s (NaN elsewhere); `report`
+/// gets the targets read and the samples that read them.
+Eigen::MatrixXd drift_readings_of(const io::MeasuredRun& run, const solvers::ObserverSetup& setup,
+                                  double every_s, ObserveReport& report) {
+  const Eigen::Index n = run.time.size();
+  const auto nt = static_cast<Eigen::Index>(setup.target_names.size());
+  Eigen::MatrixXd d = Eigen::MatrixXd::Constant(n, nt, std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> columns;  // (target, displacement column)
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (std::size_t p = 0; p < run.displacements.size(); ++p)
+      if (run.displacements[p].id == setup.target_names[static_cast<std::size_t>(t)]) {
+        columns.emplace_back(t, static_cast<Eigen::Index>(p));
+        report.drift_targets.push_back(run.displacements[p].id);
+      }
+  if (columns.empty())
+    throw core::DataError(
+        run.folder.string() +
+        ": drift readings asked for, but no displacement column of the run is "
+        "named after a target of the observer (dx, dy, dz, <axis point>_dy, ...)");
+  double next = every_s;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (run.time(i) + 1e-9 < next) continue;
+    for (const auto& [t, p] : columns) d(i, t) = run.displacement(i, p);
+    ++report.drift_samples;
+    while (next <= run.time(i) + 1e-9) next += every_s;
+  }
+  return d;
 }
 
 }  // namespace
@@ -98,8 +129,13 @@ ObserveReport observe_run(const ObserveInput& input) {
       sensor_readout(*input.twin, input.mesh, run.sensors, report.sensors, run.folder.string());
   report.places = std::move(readout.places);
   report.setup = input.setup(report.spec, report.sensors, readout.rows);
-  report.result = solvers::observe(input.twin->model.system, report.spec, report.setup,
-                                   input.run->time, readings_of(*input.run, report.sensors));
+  report.drift_readings_every_s = input.drift_readings_every_s;
+  const Eigen::MatrixXd drifts =
+      input.drift_readings_every_s > 0
+          ? drift_readings_of(run, report.setup, input.drift_readings_every_s, report)
+          : Eigen::MatrixXd();
+  report.result = solvers::observe(input.twin->model.system, report.spec, report.setup, run.time,
+                                   readings_of(run, report.sensors), drifts);
   return report;
 }
 

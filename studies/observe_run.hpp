@@ -39,6 +39,11 @@ struct ObserveInput {
   /// there, interpolated on the twin's basis, as the measured-data format says a sensor need not
   /// sit at a mesh vertex; nullptr: every sensor at the named point of its id
   const mesh::TetMesh* mesh = nullptr;
+  /// > 0: the run's displacement columns whose ids name the observer's targets ("dx", "dy", "dz",
+  /// "<axis point>_dy", ...) are read by the observer as drift readings, one every this many
+  /// seconds (the first sample at or after each multiple: a probe cycle measuring the tool now and
+  /// then); 0: the observer reads temperatures only, and the columns are its truth at most
+  double drift_readings_every_s = 0;
 };
 
 /// Where a sensor was read on the model.
@@ -54,6 +59,10 @@ struct ObserveReport {
   std::vector<SensorPlace> places;   /// per sensor: where it was read
   solvers::ObserverSetup setup;
   solvers::ObserverRun result;
+  /// with drift_readings_every_s: the targets read, and the samples that read them
+  double drift_readings_every_s = 0;
+  std::vector<std::string> drift_targets;
+  int drift_samples = 0;
 };
 
 /// The ids of `ids` the observer can read: those `located` (a run's sensors, or a stream's
@@ -79,8 +88,9 @@ SensorReadout sensor_readout(const solvers::Twin& twin, const mesh::TetMesh* mes
 
 /// Throws DataError when the run has no speed column, when none of its sensors is located or a
 /// named point of the twin (and none was chosen), a chosen sensor is not a column of the run or is
-/// neither located nor named, or a position lies outside the mesh (naming the run and sensor);
-/// what the observer throws.
+/// neither located nor named, a position lies outside the mesh (naming the run and sensor), or
+/// drift readings are asked for and no displacement column names a target; what the observer
+/// throws.
 ObserveReport observe_run(const ObserveInput& input);
 
 }  // namespace tt::studies

@@ -7,9 +7,11 @@
 // and alarm sample by sample; a stream without the observer's sensor columns is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -325,6 +327,100 @@ TEST(ObserveCli, AlarmThenCalibrateNamesTheEffect) {
       j["before"]["displacement_rms_um"].get<double>(),
       j["after"]["displacement_rms_um"].get<double>());
   EXPECT_LT((found - heat.centre).norm(), 0.06);
+}
+
+/// RMS of observer.csv's `column` [um] against the run's displacement column of the same target.
+double drift_error_rms_um(const fs::path& observed, const io::MeasuredRun& run,
+                          const std::string& target) {
+  const auto rows = tt::test::csv_rows(observed / "observer.csv");
+  const auto p = std::find_if(run.displacements.begin(), run.displacements.end(),
+                              [&](const auto& d) { return d.id == target; });
+  EXPECT_NE(p, run.displacements.end()) << target;
+  EXPECT_EQ(rows.size(), static_cast<std::size_t>(run.time.size()));
+  double ss = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double e =
+        std::stod(rows[i].at(target + "_predicted_um")) -
+        1e6 * run.displacement(static_cast<Eigen::Index>(i), p - run.displacements.begin());
+    ss += e * e;
+  }
+  return std::sqrt(ss / static_cast<double>(rows.size()));
+}
+
+TEST(ObserveCli, DriftReadingsSeeAWrongExpansionThatNoTemperatureShows) {
+  // A steel whose expansion coefficient is 16 % above the declared one changes no temperature:
+  // the observer on temperatures alone cannot see it. With the run's TCP probes read every 30 min
+  // (a probe cycle) the filter follows the machine's drift, and with the sigma calibrated as the
+  // campaign calibrates it (docs/benchmarks.md: 0.35 dy, 0.15 dz) the readings depart from what
+  // the temperatures alone predict on readings in a row and say recalibrate; a clean run read the
+  // same way raises nothing.
+  const fs::path dir = rt::scratch("observe_drift_readings");
+  const fs::path& rom = coarse_rom();
+  const OwnMeshGenerator o;
+  std::mt19937_64 rng = core::generator(23, 0);
+  calibration::InjectedEffect expansion;
+  expansion.present = true;
+  expansion.kind = calibration::EffectKind::material_parameter;
+  expansion.target = "steel.expansion";
+  expansion.magnitude = 0.16;
+  const calibration::InjectedEffect none;
+  const core::DutyCycle duty = calibration::random_duty_cycle(4, rng);
+  std::map<std::string, io::MeasuredRun> runs;
+  for (const auto& [name, effect] : {std::pair{"expansion", expansion}, std::pair{"clean", none}}) {
+    runs[name] = calibration::synthetic_run(o.mesh, calibration::truth_case(o.gen, effect, duty, 0),
+                                            effect, o.inst, o.g, name, rng);
+    io::write_measured_run(dir / ("run_" + std::string(name)), runs[name]);
+  }
+  const auto observe = [&](const std::string& run, const std::string& out,
+                           std::vector<std::string> extra) {
+    std::vector<std::string> args{
+        "observe", rt::kCoarseCase.string(),        "--rom", rom.string(),
+        "--data",  (dir / ("run_" + run)).string(), "--out", (dir / out).string(),
+        "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    EXPECT_EQ(rt::run(args, {}, dir / "log"), 0) << rt::read_text(dir / "log");
+    return nlohmann::json::parse(std::ifstream(dir / out / "observer.json"));
+  };
+  const std::vector<std::string> probe_cycle{"--drift-readings-every-s", "1800",
+                                             "--drift-sigma-scale", "0.35,0.35,0.15"};
+  const auto blind = observe("expansion", "blind", {});
+  const auto probed = observe("expansion", "probed", probe_cycle);
+  const auto clean = observe("clean", "clean", probe_cycle);
+  const double blind_dz = drift_error_rms_um(dir / "blind", runs["expansion"], "dz");
+  const double probed_dz = drift_error_rms_um(dir / "probed", runs["expansion"], "dz");
+  std::printf(
+      "[drift readings] expansion run: without %s, with %s (raised %s s, departures %s); dz RMS "
+      "error %.3f -> %.3f um; clean run with them: %s\n",
+      blind["status"].dump().c_str(), probed["status"].dump().c_str(),
+      probed["recalibrate_raised_s"].dump().c_str(),
+      probed["drift_readings"]["departures"].dump().c_str(), blind_dz, probed_dz,
+      clean["status"].dump().c_str());
+  EXPECT_NE(blind["status"], "recalibrate");
+  EXPECT_FALSE(blind.contains("drift_readings"));
+  EXPECT_EQ(probed["status"], "recalibrate");
+  const auto& d = probed["drift_readings"];
+  EXPECT_EQ(d["every_s"], 1800.0);
+  EXPECT_EQ(d["targets"], nlohmann::json({"dx", "dy", "dz"}));
+  EXPECT_EQ(d["samples"], 8);  // at 1800, 3600, ..., 14 400 s of a 4-hour run
+  ASSERT_FALSE(d["departures"].empty());
+  EXPECT_LE(probed["recalibrate_raised_s"].get<double>(), 3 * 3600.0);
+  EXPECT_LT(probed_dz, 0.5 * blind_dz);
+  EXPECT_EQ(clean["status"], "ok");
+  EXPECT_TRUE(clean["drift_readings"]["departures"].empty());
+  EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "probed"));
+  // No displacement column named after a target: refused, nothing written.
+  io::MeasuredRun unnamed = runs["clean"];
+  for (auto& p : unnamed.displacements) p.id = "probe_" + p.id;
+  io::write_measured_run(dir / "unnamed", unnamed);
+  EXPECT_NE(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",
+                     (dir / "unnamed").string(), "--out", (dir / "refused").string(),
+                     "--drift-readings-every-s", "1800"},
+                    {}, dir / "log"),
+            0);
+  EXPECT_NE(rt::read_text(dir / "log").find("no displacement column"), std::string::npos)
+      << rt::read_text(dir / "log");
+  EXPECT_FALSE(fs::exists(dir / "refused"));
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 TEST(ObserveCli, SensorsAreReadAtTheRunsPositions) {
