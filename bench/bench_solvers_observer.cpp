@@ -6,8 +6,11 @@
 //                               [CLEAN_RUNS=3] [SEED=1] [HEAT_WALK_W=4] [AIR_WALK_K=0.5]
 //                               [DRIFT_RELATIVE_SIGMA=0] [SENSORS=correlation] [COUNT=0]
 //                               [GEN_ONLY=-1] [SENSOR_OFFSET_K=0] [SENSOR_OFFSET_WALK_K=0]
-//                               [CHANGED_TRAINING=0] [CATALOGUE_SPACING=0.25]
+//                               [CHANGED_TRAINING=0] [CATALOGUE_SPACING=0.25] [PROBE_EVERY_S=0]
 //   GEN_HOURS = 0 skips the generator's runs (5.).
+//   PROBE_EVERY_S > 0: each generator run is also observed with its TCP probes read every
+//     PROBE_EVERY_S (a probe cycle; studies::drift_readings, solvers::observe's drift readings and
+//     drift test) and the sigma calibrated on the campaign: its alarms, RMS and coverage.
 //   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
 //   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
 //   SB-1).
@@ -95,6 +98,7 @@
 #include "studies/axis_fit.hpp"
 #include "studies/catalogue_detection.hpp"
 #include "studies/estimation_input.hpp"
+#include "studies/observe_run.hpp"
 #include "studies/placement_input.hpp"
 
 namespace {
@@ -357,6 +361,7 @@ int main(int argc, char** argv) {
     if (argc > 13) campaign_noise.sensor_offset_walk_k = std::stod(argv[13]);
     const bool changed_training = argc > 14 && std::stoi(argv[14]) != 0;
     const double catalogue_spacing = argc > 15 ? std::stod(argv[15]) : 0.25;
+    const double probe_every_s = argc > 16 ? std::stod(argv[16]) : 0;
     if (sensor_choice != "correlation" && sensor_choice != "mutual_info" &&
         sensor_choice != "estimation" && sensor_choice != "estimation_exact" &&
         sensor_choice != "correlation+detection" && sensor_choice != "correlation+catalogue")
@@ -666,6 +671,8 @@ int main(int argc, char** argv) {
               << " s)\n";
     Method held;
     Alarms clean_alarms, effect_alarms;
+    Alarms probe_clean_alarms, probe_effect_alarms;  // with a probe cycle (PROBE_EVERY_S)
+    Score probe_clean, probe_effect;
     double observer_s = 0, observed_h = 0;
     std::cout
         << "\nrun | kind | observer RMS dy, dz [um] | regression RMS dy, dz [um] | "
@@ -949,6 +956,38 @@ int main(int argc, char** argv) {
         m.observer.add(po, so, true_drift, scale, sa);
         m.regression.add(pr, sr, true_drift);
         add_alarm(effect.present ? effect_alarms : clean_alarms, run, gen_hours);
+        if (probe_every_s > 0) {
+          // The same run with its TCP probes read now and then, the sigma the campaign's.
+          solvers::ObserverSetup probed = setup;
+          probed.noise.drift_sigma_scale = campaign_scale;
+          const solvers::ObserverRun pr = solvers::observe(
+              twin.model.system, declared, probed, measured.time, measured.temperature,
+              studies::drift_readings(measured, probed.target_names, probe_every_s).readings);
+          const auto [pp, ps] = dy_dz(pr);
+          Score one;
+          one.add(pp, ps, true_drift);
+          (effect.present ? probe_effect : probe_clean).add(pp, ps, true_drift);
+          add_alarm(effect.present ? probe_effect_alarms : probe_clean_alarms, pr, gen_hours);
+          std::string departed;
+          for (const solvers::HeldSensor& d : pr.drift_departures)
+            departed += " " + probed.target_names[static_cast<std::size_t>(d.sensor)] + " since " +
+                        fmt(d.since_s) + " s";
+          std::cout << name << ": probe cycle every " << probe_every_s << " s: "
+                    << (pr.recalibrate ? "recalibrate at " + fmt(pr.recalibrate_at_s) + " s"
+                                       : std::string("no alarm"))
+                    << ", drift departures:" << (departed.empty() ? " none" : departed)
+                    << "; RMS dy, dz " << fmt(one.rms_um()(0)) << ", " << fmt(one.rms_um()(1))
+                    << " um (without "
+                    << fmt(std::sqrt((po - true_drift).col(0).squaredNorm() /
+                                     static_cast<double>(po.rows())) *
+                           1e6)
+                    << ", "
+                    << fmt(std::sqrt((po - true_drift).col(1).squaredNorm() /
+                                     static_cast<double>(po.rows())) *
+                           1e6)
+                    << "), coverage " << fmt(100 * one.coverage()(0), 3) << " / "
+                    << fmt(100 * one.coverage()(1), 3) << " %\n";
+        }
         const solvers::ObserverRun fast_run =
             fast_alarm(declared, gen_noise, measured.time, measured.temperature);
         add_alarm(effect.present ? effect_fast : clean_fast, fast_run, gen_hours);
@@ -1217,6 +1256,20 @@ int main(int argc, char** argv) {
     std::cout << "alarms on effect runs: " << effect_alarms.raised << " of " << effect_runs
               << "; delays [s]:";
     for (double d : effect_alarms.delays_s) std::cout << " " << d;
+    if (probe_every_s > 0) {
+      std::cout << "\nprobe cycle every " << probe_every_s
+                << " s, sigma calibrated on the campaign: " << probe_clean_alarms.raised
+                << " alarms in " << probe_clean_alarms.hours << " h of clean runs; "
+                << probe_effect_alarms.raised << " of " << effect_runs << " effect runs, at [s]:";
+      for (double d : probe_effect_alarms.delays_s) std::cout << " " << d;
+      std::cout << "\n  clean runs: RMS dy, dz " << fmt(probe_clean.rms_um()(0)) << ", "
+                << fmt(probe_clean.rms_um()(1)) << " um, coverage "
+                << fmt(100 * probe_clean.coverage()(0), 3) << " / "
+                << fmt(100 * probe_clean.coverage()(1), 3) << " %; effect runs: RMS "
+                << fmt(probe_effect.rms_um()(0)) << ", " << fmt(probe_effect.rms_um()(1))
+                << " um, coverage " << fmt(100 * probe_effect.coverage()(0), 3) << " / "
+                << fmt(100 * probe_effect.coverage()(1), 3) << " %";
+    }
     std::cout << "\nobserver: " << fmt(observer_s) << " s for " << fmt(observed_h) << " h of runs ("
               << fmt(observer_s / observed_h * 1e3) << " ms per hour of run); total "
               << fmt(seconds_since(t_all)) << " s\n";

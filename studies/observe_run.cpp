@@ -23,20 +23,20 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
   return y;
 }
 
-/// The drift readings of `run` for `setup`'s targets: each displacement column whose id names a
-/// target, at the first sample at or after each multiple of every_s (NaN elsewhere); `report`
-/// gets the targets read and the samples that read them.
-Eigen::MatrixXd drift_readings_of(const io::MeasuredRun& run, const solvers::ObserverSetup& setup,
-                                  double every_s, ObserveReport& report) {
+}  // namespace
+
+DriftReadings drift_readings(const io::MeasuredRun& run, const std::vector<std::string>& targets,
+                             double every_s) {
   const Eigen::Index n = run.time.size();
-  const auto nt = static_cast<Eigen::Index>(setup.target_names.size());
-  Eigen::MatrixXd d = Eigen::MatrixXd::Constant(n, nt, std::numeric_limits<double>::quiet_NaN());
+  const auto nt = static_cast<Eigen::Index>(targets.size());
+  DriftReadings out;
+  out.readings = Eigen::MatrixXd::Constant(n, nt, std::numeric_limits<double>::quiet_NaN());
   std::vector<std::pair<Eigen::Index, Eigen::Index>> columns;  // (target, displacement column)
   for (Eigen::Index t = 0; t < nt; ++t)
     for (std::size_t p = 0; p < run.displacements.size(); ++p)
-      if (run.displacements[p].id == setup.target_names[static_cast<std::size_t>(t)]) {
+      if (run.displacements[p].id == targets[static_cast<std::size_t>(t)]) {
         columns.emplace_back(t, static_cast<Eigen::Index>(p));
-        report.drift_targets.push_back(run.displacements[p].id);
+        out.targets.push_back(run.displacements[p].id);
       }
   if (columns.empty())
     throw core::DataError(
@@ -46,14 +46,12 @@ Eigen::MatrixXd drift_readings_of(const io::MeasuredRun& run, const solvers::Obs
   double next = every_s;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (run.time(i) + 1e-9 < next) continue;
-    for (const auto& [t, p] : columns) d(i, t) = run.displacement(i, p);
-    ++report.drift_samples;
+    for (const auto& [t, p] : columns) out.readings(i, t) = run.displacement(i, p);
+    ++out.samples;
     while (next <= run.time(i) + 1e-9) next += every_s;
   }
-  return d;
+  return out;
 }
-
-}  // namespace
 
 std::vector<std::string> named_by_twin(const solvers::TwinOutputs& outputs,
                                        const std::vector<std::string>& ids) {
@@ -130,12 +128,14 @@ ObserveReport observe_run(const ObserveInput& input) {
   report.places = std::move(readout.places);
   report.setup = input.setup(report.spec, report.sensors, readout.rows);
   report.drift_readings_every_s = input.drift_readings_every_s;
-  const Eigen::MatrixXd drifts =
-      input.drift_readings_every_s > 0
-          ? drift_readings_of(run, report.setup, input.drift_readings_every_s, report)
-          : Eigen::MatrixXd();
+  DriftReadings drifts;
+  if (input.drift_readings_every_s > 0) {
+    drifts = drift_readings(run, report.setup.target_names, input.drift_readings_every_s);
+    report.drift_targets = drifts.targets;
+    report.drift_samples = drifts.samples;
+  }
   report.result = solvers::observe(input.twin->model.system, report.spec, report.setup, run.time,
-                                   readings_of(run, report.sensors), drifts);
+                                   readings_of(run, report.sensors), drifts.readings);
   return report;
 }
 

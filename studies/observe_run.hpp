@@ -86,6 +86,19 @@ SensorReadout sensor_readout(const solvers::Twin& twin, const mesh::TetMesh* mes
                              const std::vector<io::MeasuredSensor>& located,
                              const std::vector<std::string>& ids, const std::string& source);
 
+/// A run's drift readings for an observer.
+struct DriftReadings {
+  Eigen::MatrixXd readings;          /// #samples x #targets [m], NaN where not read; empty: none
+  std::vector<std::string> targets;  /// the targets read
+  int samples = 0;                   /// the samples that read them
+};
+
+/// The drift readings of `run` for the observer's `targets`: each displacement column whose id
+/// names a target, at the first sample at or after each multiple of every_s (a probe cycle), NaN
+/// elsewhere. Throws DataError naming the run when no displacement column names a target.
+DriftReadings drift_readings(const io::MeasuredRun& run, const std::vector<std::string>& targets,
+                             double every_s);
+
 /// Throws DataError when the run has no speed column, when none of its sensors is located or a
 /// named point of the twin (and none was chosen), a chosen sensor is not a column of the run or is
 /// neither located nor named, a position lies outside the mesh (naming the run and sensor), or
