@@ -112,6 +112,10 @@ struct ObserverOptions {
   double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
   /// a reading held this many sigmas from the declared model's run: recalibrate (0: off)
   double model_residual_sigmas = 3;
+  /// > 0: the run's (the stream's) displacement columns named after targets are read as drift
+  /// readings, one every this many seconds (a probe cycle); 0: temperatures only
+  double drift_readings_every_s = 0;
+  double drift_reading_sigma_um = 0.3;  /// white noise of a drift reading [um]
 };
 
 /// compensate --model FIT.json | --rom DIR: live compensation (app/compensate_command.cpp).
@@ -138,10 +142,6 @@ struct ObserveArgs {
   std::filesystem::path case_file, rom, data, out;
   ObserverOptions observer;
   bool quiet = false;
-  /// > 0: the run's displacement columns named after targets are read as drift readings, one
-  /// every this many seconds (a probe cycle); 0: temperatures only
-  double drift_readings_every_s = 0;
-  double drift_reading_sigma_um = 0.3;  /// white noise of a drift reading [um]
 };
 
 /// export --model FIT.json --out DIR: the compensation in the controllers' formats

@@ -134,15 +134,19 @@ Binder observed_model(const CompensateArgs& args) {
     const solvers::ObserverSetup setup =
         observer_setup(options, rom->twin, *spec, sensors, readout.rows);
     auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
-                                                            sensors, columns, "speed_rpm");
-    // The stream's temperatures are in degC (the measured-data format), the observer's in K. The
-    // observer refers to the system and the case: they live as long as it.
-    auto kelvin = std::make_shared<Eigen::VectorXd>();
-    const auto next = [observer, rom, spec, kelvin](
-                          double t, const Eigen::VectorXd& v) -> const core::LiveStep& {
-      *kelvin = v;
-      for (int c : observer->sensor_columns()) (*kelvin)(c) += core::kCelsiusOffset;
-      return observer->next(t, *kelvin);
+                                                            sensors, columns, "speed_rpm",
+                                                            options.drift_readings_every_s);
+    // The stream's temperatures are in degC and its drifts in um (the measured-data format), the
+    // observer's in K and m. The observer refers to the system and the case: they live as long
+    // as it.
+    auto si = std::make_shared<Eigen::VectorXd>();
+    const auto next = [observer, rom, spec, si](double t,
+                                                const Eigen::VectorXd& v) -> const core::LiveStep& {
+      *si = v;
+      for (int c : observer->sensor_columns()) (*si)(c) += core::kCelsiusOffset;
+      for (int c : observer->drift_columns())
+        if (c >= 0) (*si)(c) *= 1e-6;
+      return observer->next(t, *si);
     };
     return BoundModel{setup.target_names, next};
   };

@@ -462,17 +462,6 @@ Command observe_line(CLI::App& cli) {
       ->check(CLI::ExistingDirectory);
   observe->add_option("--out", observe_args.out, "output directory")->required();
   add_observer_options(*observe, observe_args.observer);
-  observe
-      ->add_option("--drift-readings-every-s", observe_args.drift_readings_every_s,
-                   "read the run's displacement columns named after targets (dx, dy, dz, <axis "
-                   "point>_dy, ...) as drift readings, one every this many seconds: a probe cycle "
-                   "measuring the tool now and then, which sees what no temperature shows (a wrong "
-                   "expansion coefficient; observer.json drift_readings; default 0: none)")
-      ->check(non_negative_number());
-  observe
-      ->add_option("--drift-reading-sigma-um", observe_args.drift_reading_sigma_um,
-                   "white noise of a drift reading [um] (default 0.3)")
-      ->check(positive_number());
   observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
   return {observe, [args] {
             const ObserveArgs& a = *args;

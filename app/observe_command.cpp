@@ -38,13 +38,11 @@ int observe_command(const ObserveArgs& args) {
   // 3. The study: the run's sensors read at their positions where it gives them.
   const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors,
                          const Eigen::MatrixXd& rows) {
-    solvers::ObserverSetup s = observer_setup(args.observer, rom.twin, spec, sensors, rows);
-    s.noise.drift_reading_sigma_m = 1e-6 * args.drift_reading_sigma_um;
-    return s;
+    return observer_setup(args.observer, rom.twin, spec, sensors, rows);
   };
   const studies::ObserveReport report =
       studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup, &mesh,
-                            args.drift_readings_every_s});
+                            args.observer.drift_readings_every_s});
   // 4. Outputs.
   io::write_observe(out.path(), report,
                     {run.run, declared.name, rom.twin.model.states(), args.rom,

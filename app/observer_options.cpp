@@ -116,6 +116,17 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "all targets or one per target, comma-separated (default 1)")
       ->delimiter(',')
       ->check(positive_number());
+  command
+      .add_option("--drift-readings-every-s", o.drift_readings_every_s,
+                  "read the columns named after targets (dx, dy, dz, <axis point>_dy, ...; um) as "
+                  "drift readings, one every this many seconds: a probe cycle measuring the tool "
+                  "now and then, which sees what no temperature shows (a wrong expansion "
+                  "coefficient); default 0: none")
+      ->check(non_negative_number());
+  command
+      .add_option("--drift-reading-sigma-um", o.drift_reading_sigma_um,
+                  "white noise of a drift reading [um] (default 0.3)")
+      ->check(positive_number());
   add_consistency_options(command, o);
 }
 
@@ -165,6 +176,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.sensor_offset_initial_k = o.sensor_offset_k;
   noise.sensor_offset_walk_k = o.sensor_offset_walk_k;
   noise.drift_relative_sigma = o.drift_relative_sigma;
+  noise.drift_reading_sigma_m = 1e-6 * o.drift_reading_sigma_um;
   noise.correction_relative_sigma = o.correction_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
   solvers::ObserverSetup setup =

@@ -631,45 +631,38 @@ CovarianceMap KalmanObserver::advance(double t) {
   return map;
 }
 
+bool ProbeCycle::due(double t) {
+  if (t + 1e-9 < next_) return false;
+  while (next_ <= t + 1e-9) next_ += every_s_;
+  return true;
+}
+
+DriftReadingTest::DriftReadingTest(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                                   const ObserverSetup& setup)
+    : blind_(system, spec, setup),
+      held_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false),
+      reading_sigma_m_(setup.noise.drift_reading_sigma_m),
+      on_(setup.consistency.model_residual_sigmas > 0) {}
+
+double DriftReadingTest::add(double t, const Eigen::VectorXd& readings,
+                             const Eigen::VectorXd& drift) {
+  const ObserverEstimate e = blind_.assimilate(t, readings);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!on_ || drift.size() == 0 || !drift.array().isFinite().any()) return nan;
+  Eigen::VectorXd z = Eigen::VectorXd::Constant(drift.size(), nan);
+  for (Eigen::Index j = 0; j < drift.size(); ++j)
+    if (std::isfinite(drift(j)))
+      z(j) = (drift(j) - e.drift(j)) /
+             std::sqrt(e.drift_sigma(j) * e.drift_sigma(j) + reading_sigma_m_ * reading_sigma_m_);
+  const std::size_t before = held_.raised().size();
+  held_.add(t, z, Eigen::VectorXd::Ones(drift.size()));
+  double since = nan;
+  for (std::size_t k = before; k < held_.raised().size(); ++k)
+    if (std::isnan(since) || held_.raised()[k].since_s < since) since = held_.raised()[k].since_s;
+  return since;
+}
+
 namespace {
-
-/// observe's drift test: a filter on the temperatures alone, and each drift reading against its
-/// drift, in its reported sigma and the reading's; a target held beyond model_residual_sigmas over
-/// readings sustain_s apart is raised.
-class DriftTest {
- public:
-  DriftTest(const ReducedThermalSystem& system, const core::CaseSpec& spec,
-            const ObserverSetup& setup)
-      : blind_(system, spec, setup),
-        held_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false),
-        reading_sigma_m_(setup.noise.drift_reading_sigma_m),
-        on_(setup.consistency.model_residual_sigmas > 0) {}
-  /// Steps the blind filter to t with `readings` and tests `drift` (#targets [m], NaN: none).
-  /// Returns the earliest start of a target raised now (NaN: none).
-  double add(double t, const Eigen::VectorXd& readings, const Eigen::VectorXd& drift) {
-    const ObserverEstimate e = blind_.assimilate(t, readings);
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (!on_ || !drift.array().isFinite().any()) return nan;
-    Eigen::VectorXd z = Eigen::VectorXd::Constant(drift.size(), nan);
-    for (Eigen::Index j = 0; j < drift.size(); ++j)
-      if (std::isfinite(drift(j)))
-        z(j) = (drift(j) - e.drift(j)) /
-               std::sqrt(e.drift_sigma(j) * e.drift_sigma(j) + reading_sigma_m_ * reading_sigma_m_);
-    const std::size_t before = held_.raised().size();
-    held_.add(t, z, Eigen::VectorXd::Ones(drift.size()));
-    double since = nan;
-    for (std::size_t k = before; k < held_.raised().size(); ++k)
-      if (std::isnan(since) || held_.raised()[k].since_s < since) since = held_.raised()[k].since_s;
-    return since;
-  }
-  const std::vector<HeldSensor>& raised() const { return held_.raised(); }
-
- private:
-  KalmanObserver blind_;
-  HeldBeyondMonitor held_;
-  double reading_sigma_m_;
-  bool on_;
-};
 
 /// `run`'s record of sample i: the estimate, the filter's state and its unknown inputs.
 void record(const KalmanObserver& kf, const ObserverEstimate& e, Eigen::Index i, ObserverRun& run) {
@@ -722,7 +715,7 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
   run.unknown_inputs_sigma.resize(n, nb);
   run.unknown_input_names = kf.unknown_inputs();
   run.unknown_input_kinds = kf.unknown_input_kinds();
-  std::optional<DriftTest> test;
+  std::optional<DriftReadingTest> test;
   if (drift_readings.size() != 0) test.emplace(system, spec, setup);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::VectorXd y = readings.row(i).transpose();

@@ -355,6 +355,40 @@ struct ObserverRun {
   std::vector<HeldSensor> drift_departures;
 };
 
+/// Which samples of a probe cycle read the tool's drift: the first at or after each multiple of
+/// every_s (> 0), asked in increasing time.
+class ProbeCycle {
+ public:
+  explicit ProbeCycle(double every_s) : every_s_(every_s), next_(every_s) {}
+  /// Whether the sample at t reads the drift (and, if so, the next multiple after t is the next).
+  bool due(double t);
+
+ private:
+  double every_s_, next_;
+};
+
+/// observe's drift test: a filter on the temperatures alone beside the one that assimilates the
+/// drift readings, and each drift reading against its drift, in its reported sigma (with
+/// drift_sigma_scale) and the reading's (drift_reading_sigma_m); a target held beyond
+/// model_residual_sigmas over readings sustain_s apart is raised (HeldBeyondMonitor; never with
+/// model_residual_sigmas 0). `system`, `spec` must outlive it.
+class DriftReadingTest {
+ public:
+  DriftReadingTest(const ReducedThermalSystem& system, const core::CaseSpec& spec,
+                   const ObserverSetup& setup);
+  /// Steps the temperature-only filter to t with `readings` (#sensors [K], NaN: missing) and tests
+  /// `drift` (#targets [m], NaN or empty: none). Returns the earliest start of a target raised
+  /// now (NaN: none).
+  double add(double t, const Eigen::VectorXd& readings, const Eigen::VectorXd& drift);
+  const std::vector<HeldSensor>& raised() const { return held_.raised(); }
+
+ private:
+  KalmanObserver blind_;
+  HeldBeyondMonitor held_;
+  double reading_sigma_m_;
+  bool on_;
+};
+
 /// `readings`: #samples x #sensors [K] at `times` (increasing, after 0, within the duty cycle);
 /// `drift_readings`: none (empty) or #samples x #targets [m], NaN where a target is not read.
 /// With drift readings the filter assimilates them, and a second filter on the temperatures alone

@@ -24,7 +24,8 @@ int column_of(const std::string& name, const std::vector<std::string>& columns, 
 
 LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
                            const ObserverSetup& setup, const std::vector<std::string>& sensors,
-                           const std::vector<std::string>& columns, const std::string& speed_column)
+                           const std::vector<std::string>& columns, const std::string& speed_column,
+                           double drift_every_s)
     : spec_(std::make_unique<core::CaseSpec>(declared)), target_names_(setup.target_names) {
   if (static_cast<Eigen::Index>(sensors.size()) != setup.sensor_rows.rows())
     throw core::SolverError("live observer: " + std::to_string(sensors.size()) +
@@ -36,6 +37,19 @@ LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseS
   spec_->duty_cycle.end = 0;
   spec_->duty_cycle.csv.clear();
   filter_ = std::make_unique<KalmanObserver>(system, *spec_, setup);
+  for (const std::string& t : target_names_) {
+    const auto it = std::find(columns.begin(), columns.end(), t);
+    drift_columns_.push_back(
+        it == columns.end() || !(drift_every_s > 0) ? -1 : static_cast<int>(it - columns.begin()));
+  }
+  if (drift_every_s > 0) {
+    if (std::all_of(drift_columns_.begin(), drift_columns_.end(), [](int c) { return c < 0; }))
+      throw core::DataError(
+          "drift readings asked for, but no column is named after a target of the observer (dx, "
+          "dy, dz, <axis point>_dy, ...)");
+    cycle_ = std::make_unique<ProbeCycle>(drift_every_s);
+    drift_test_ = std::make_unique<DriftReadingTest>(system, *spec_, setup);
+  }
   readings_.resize(static_cast<Eigen::Index>(sensors.size()));
   const auto nt = static_cast<Eigen::Index>(target_names_.size());
   step_.predicted = Eigen::VectorXd::Constant(nt, std::numeric_limits<double>::quiet_NaN());
@@ -65,12 +79,20 @@ const core::LiveStep& LiveObserver::next(double time,
     if (!std::isfinite(v)) step_.held.push_back(sensor_columns_[k]);
   }
   std::sort(step_.held.begin(), step_.held.end());
-  const ObserverEstimate e = filter_->assimilate(time, readings_);
+  Eigen::VectorXd drift;  // a probe cycle's reading when one is due (an empty cell: none)
+  if (cycle_ && cycle_->due(time)) {
+    drift = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(drift_columns_.size()),
+                                      std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t t = 0; t < drift_columns_.size(); ++t)
+      if (drift_columns_[t] >= 0) drift(static_cast<Eigen::Index>(t)) = values(drift_columns_[t]);
+  }
+  const ObserverEstimate e = filter_->assimilate(time, readings_, drift);
+  if (drift_test_) drift_raised_ |= !std::isnan(drift_test_->add(time, readings_, drift));
   started_ = true;
   last_time_ = time;
   step_.predicted = e.drift;
   step_.sigma = e.drift_sigma;
-  step_.recalibrate = e.recalibrate;
+  step_.recalibrate = e.recalibrate || drift_raised_;
   // Faults are only ever added: map the new ones to their columns.
   const std::vector<HeldSensor>& faults = filter_->sensor_faults();
   for (std::size_t k = step_.faulty.size(); k < faults.size(); ++k)

@@ -23,9 +23,13 @@ class LiveObserver {
   /// is the stream's. `sensors`: the setup's sensors (ids), in its order; columns: the stream's
   /// columns after time_s. Throws DataError naming the first column it reads (a sensor, or
   /// `speed_column`) that `columns` lacks, and the columns the stream has.
+  /// `drift_every_s` > 0: the columns named after the setup's targets (in m) are read as drift
+  /// readings on a probe cycle (ProbeCycle), tested as observe tests them (DriftReadingTest);
+  /// throws DataError when no column is named after a target.
   LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
                const ObserverSetup& setup, const std::vector<std::string>& sensors,
-               const std::vector<std::string>& columns, const std::string& speed_column);
+               const std::vector<std::string>& columns, const std::string& speed_column,
+               double drift_every_s = 0);
   ~LiveObserver();
   LiveObserver(const LiveObserver&) = delete;
   LiveObserver& operator=(const LiveObserver&) = delete;
@@ -41,11 +45,16 @@ class LiveObserver {
   const std::vector<std::string>& target_names() const { return target_names_; }
   /// The stream's columns of the setup's sensors, in its order.
   const std::vector<int>& sensor_columns() const { return sensor_columns_; }
+  /// Per target, the stream's column of its drift readings (-1: none; all -1 without a cycle).
+  const std::vector<int>& drift_columns() const { return drift_columns_; }
 
  private:
   std::unique_ptr<core::CaseSpec> spec_;  /// the duty cycle read so far; the filter refers to it
   std::unique_ptr<KalmanObserver> filter_;
-  std::vector<int> sensor_columns_;
+  std::unique_ptr<ProbeCycle> cycle_;             /// with drift readings
+  std::unique_ptr<DriftReadingTest> drift_test_;  /// with drift readings
+  bool drift_raised_ = false;
+  std::vector<int> sensor_columns_, drift_columns_;
   int speed_column_ = -1;
   std::vector<std::string> target_names_;
   Eigen::VectorXd readings_;

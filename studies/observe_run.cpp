@@ -43,12 +43,11 @@ DriftReadings drift_readings(const io::MeasuredRun& run, const std::vector<std::
         run.folder.string() +
         ": drift readings asked for, but no displacement column of the run is "
         "named after a target of the observer (dx, dy, dz, <axis point>_dy, ...)");
-  double next = every_s;
+  solvers::ProbeCycle cycle(every_s);
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (run.time(i) + 1e-9 < next) continue;
+    if (!cycle.due(run.time(i))) continue;
     for (const auto& [t, p] : columns) out.readings(i, t) = run.displacement(i, p);
     ++out.samples;
-    while (next <= run.time(i) + 1e-9) next += every_s;
   }
   return out;
 }

@@ -408,6 +408,39 @@ TEST(ObserveCli, DriftReadingsSeeAWrongExpansionThatNoTemperatureShows) {
   EXPECT_EQ(clean["status"], "ok");
   EXPECT_TRUE(clean["drift_readings"]["departures"].empty());
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "probed"));
+  // The same run streamed through `compensate --rom` with the same probe cycle: observe's
+  // predictions, sigmas and status, sample by sample.
+  std::vector<std::string> live{"compensate",
+                                "--rom",
+                                rom.string(),
+                                "--case",
+                                rt::kCoarseCase.string(),
+                                "--meta",
+                                (dir / "run_expansion" / "meta.json").string(),
+                                "--in",
+                                (dir / "run_expansion" / "data.csv").string(),
+                                "--until-eof",
+                                "--out",
+                                (dir / "live.csv").string()};
+  live.insert(live.end(), probe_cycle.begin(), probe_cycle.end());
+  ASSERT_EQ(rt::run(live, {}, dir / "log"), 0) << rt::read_text(dir / "log");
+  const auto offline = tt::test::csv_rows(dir / "probed" / "observer.csv");
+  const auto streamed = tt::test::csv_rows(dir / "live.csv");
+  ASSERT_EQ(streamed.size(), offline.size());
+  double worst = 0;
+  std::size_t alarmed = 0;
+  for (std::size_t i = 0; i < offline.size(); ++i) {
+    for (const char* t : {"dx", "dy", "dz"})
+      for (const char* what : {"_predicted_um", "_sigma_um"}) {
+        const std::string key = std::string(t) + what;
+        worst = std::max(worst,
+                         std::abs(std::stod(offline[i].at(key)) - std::stod(streamed[i].at(key))));
+      }
+    EXPECT_EQ(streamed[i].at("status"), offline[i].at("status")) << "sample " << i;
+    alarmed += offline[i].at("status") == "recalibrate";
+  }
+  EXPECT_LE(worst, 1e-6);  // um: observer.csv holds 9 digits
+  EXPECT_GT(alarmed, 0u);
   // No displacement column named after a target: refused, nothing written.
   io::MeasuredRun unnamed = runs["clean"];
   for (auto& p : unnamed.displacements) p.id = "probe_" + p.id;
@@ -511,7 +544,7 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
          {"--sensor-offset-k", "--sensor-offset-walk-k", "--widen-on-inconsistency",
           "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale",
           "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma",
-          "--model-residual-sigmas"})
+          "--model-residual-sigmas", "--drift-readings-every-s", "--drift-reading-sigma-um"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
