@@ -10,7 +10,8 @@
 //   GEN_HOURS = 0 skips the generator's runs (5.).
 //   PROBE_EVERY_S > 0: each generator run is also observed with its TCP probes read every
 //     PROBE_EVERY_S (a probe cycle; studies::drift_readings, solvers::observe's drift readings and
-//     drift test) and the sigma calibrated on the campaign: its alarms, RMS and coverage.
+//     drift test; the readings' sigma the generator's probes') and the sigma calibrated on the
+//     campaign: its alarms, RMS and coverage.
 //   COUNT: how many sensors the estimation criteria place (0, the default: as many as the
 //   correlation union; the mutual-information union of m = 4 for dy and dz has 6 on the coarse
 //   SB-1).
@@ -960,6 +961,7 @@ int main(int argc, char** argv) {
           // The same run with its TCP probes read now and then, the sigma the campaign's.
           solvers::ObserverSetup probed = setup;
           probed.noise.drift_sigma_scale = campaign_scale;
+          probed.noise.drift_reading_sigma_m = gopt.noise_displacement_m;  // the run's probes
           const solvers::ObserverRun pr = solvers::observe(
               twin.model.system, declared, probed, measured.time, measured.temperature,
               studies::drift_readings(measured, probed.target_names, probe_every_s).readings);
