@@ -108,6 +108,9 @@ struct ObserverOptions {
   std::vector<double> expansion_relative_sigma{0};
   /// factor on the reported drift sigma: one value for every target or one per target; empty: 1
   std::vector<double> drift_sigma_scale;
+  /// with drift readings: the factor on the sigma of the filter that reads them (calibrated with
+  /// the probe cycle); empty: drift_sigma_scale
+  std::vector<double> probed_drift_sigma_scale;
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
   double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
   /// a reading held this many sigmas from the declared model's run: recalibrate (0: off)

@@ -124,6 +124,14 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "coefficient); default 0: none")
       ->check(non_negative_number());
   command
+      .add_option("--probed-drift-sigma-scale", o.probed_drift_sigma_scale,
+                  "with --drift-readings-every-s: the factor on the reported drift sigma of the "
+                  "filter that reads them, calibrated on runs observed with the probe cycle (the "
+                  "readings narrow it); one value for all targets or one per target, "
+                  "comma-separated (default: --drift-sigma-scale; the drift test keeps that)")
+      ->delimiter(',')
+      ->check(positive_number());
+  command
       .add_option("--drift-reading-sigma-um", o.drift_reading_sigma_um,
                   "white noise of a drift reading [um] (default 0.3)")
       ->check(positive_number());
@@ -185,6 +193,9 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   if (!o.drift_sigma_scale.empty())
     setup.noise.drift_sigma_scale =
         per_name(o.drift_sigma_scale, setup.target_names, "--drift-sigma-scale", "targets");
+  if (!o.probed_drift_sigma_scale.empty())
+    setup.noise.probed_drift_sigma_scale = per_name(o.probed_drift_sigma_scale, setup.target_names,
+                                                    "--probed-drift-sigma-scale", "targets");
   setup.consistency.window_s = o.window_s;
   setup.consistency.sustain_s = o.sustain_s;
   setup.consistency.probability = o.probability;
@@ -198,19 +209,22 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
   const Eigen::VectorXd scale = n.drift_sigma_scale.size() != 0
                                     ? n.drift_sigma_scale
                                     : Eigen::VectorXd::Ones(setup.target_rows.rows());
-  return {{"sensor_sigma_K", as_vector(n.sensor_sigma_k)},
-          {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
-          {"heat_initial_W", n.heat_initial_w},
-          {"air_walk_K_per_sqrt_h", n.air_walk_k},
-          {"air_initial_K", n.air_initial_k},
-          {"state_walk_K_per_sqrt_h", n.state_walk_k},
-          {"sensor_offset_K", n.sensor_offset_initial_k},
-          {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
-          {"drift_relative_sigma", n.drift_relative_sigma},
-          {"correction_relative_sigma", n.correction_relative_sigma},
-          {"expansion_relative_sigma", expansion_json(setup)},
-          {"drift_sigma_scale", as_vector(scale)},
-          {"widen_on_inconsistency", n.widen_on_inconsistency}};
+  nlohmann::json out = {{"sensor_sigma_K", as_vector(n.sensor_sigma_k)},
+                        {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
+                        {"heat_initial_W", n.heat_initial_w},
+                        {"air_walk_K_per_sqrt_h", n.air_walk_k},
+                        {"air_initial_K", n.air_initial_k},
+                        {"state_walk_K_per_sqrt_h", n.state_walk_k},
+                        {"sensor_offset_K", n.sensor_offset_initial_k},
+                        {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
+                        {"drift_relative_sigma", n.drift_relative_sigma},
+                        {"correction_relative_sigma", n.correction_relative_sigma},
+                        {"expansion_relative_sigma", expansion_json(setup)},
+                        {"drift_sigma_scale", as_vector(scale)},
+                        {"widen_on_inconsistency", n.widen_on_inconsistency}};
+  if (n.probed_drift_sigma_scale.size() != 0)
+    out["probed_drift_sigma_scale"] = as_vector(n.probed_drift_sigma_scale);
+  return out;
 }
 
 }  // namespace tt::app

@@ -625,6 +625,32 @@ int main(int argc, char** argv) {
     const Eigen::VectorXd campaign_scale =
         solvers::drift_sigma_calibration(training, training_truth);
     const Eigen::Vector2d scale = campaign_scale.segment(1, 2);
+    // With a probe cycle: the factors calibrated on the training runs observed with it (their
+    // noisy probes read on the cycle), for the sigma such a filter reports.
+    Eigen::Vector2d probe_ratio = Eigen::Vector2d::Ones();
+    if (probe_every_s > 0) {
+      std::vector<solvers::ObserverRun> probed_training;
+      for (int i : fitted) {
+        const auto& r = runs[static_cast<std::size_t>(i)];
+        const auto& g = noisy_s[static_cast<std::size_t>(i)];
+        solvers::ObserverSetup su =
+            solvers::twin_observer_setup(twin, r.spec, sensors, campaign_noise);
+        su.noise.drift_reading_sigma_m = fitting::SensorNoise{}.error_sigma;
+        Eigen::MatrixXd d = Eigen::MatrixXd::Constant(g.time.size(), su.target_rows.rows(),
+                                                      std::numeric_limits<double>::quiet_NaN());
+        solvers::ProbeCycle cycle(probe_every_s);
+        for (Eigen::Index k = 0; k < g.time.size(); ++k)
+          if (cycle.due(g.time(k))) d.row(k).segment(1, 2) = g.error.row(k);  // dy, dz
+        probed_training.push_back(
+            solvers::observe(twin.model.system, r.spec, su, g.time, g.temperature, d));
+      }
+      const Eigen::VectorXd probe_scale =
+          solvers::drift_sigma_calibration(probed_training, training_truth);
+      probe_ratio = probe_scale.segment(1, 2).cwiseQuotient(scale);
+      std::cout << "calibration on the training runs with a probe cycle every " << probe_every_s
+                << " s: sigma scale dy " << fmt(probe_scale(1)) << ", dz " << fmt(probe_scale(2))
+                << "\n";
+    }
     // The adapted sigma: widened by the innovations (ObserverNoise::widen_on_inconsistency), its
     // factor the 95 % quantile of |error| / 2σ on the same training runs observed so
     // (solvers::drift_sigma_coverage_calibration). Both rules fixed before any run was scored.
@@ -967,8 +993,8 @@ int main(int argc, char** argv) {
               studies::drift_readings(measured, probed.target_names, probe_every_s).readings);
           const auto [pp, ps] = dy_dz(pr);
           Score one;
-          one.add(pp, ps, true_drift);
-          (effect.present ? probe_effect : probe_clean).add(pp, ps, true_drift);
+          one.add(pp, ps, true_drift, probe_ratio);
+          (effect.present ? probe_effect : probe_clean).add(pp, ps, true_drift, probe_ratio);
           add_alarm(effect.present ? probe_effect_alarms : probe_clean_alarms, pr, gen_hours);
           std::string departed;
           for (const solvers::HeldSensor& d : pr.drift_departures)
@@ -988,7 +1014,9 @@ int main(int argc, char** argv) {
                                      static_cast<double>(po.rows())) *
                            1e6)
                     << "), coverage " << fmt(100 * one.coverage()(0), 3) << " / "
-                    << fmt(100 * one.coverage()(1), 3) << " %\n";
+                    << fmt(100 * one.coverage()(1), 3) << " % (probe-calibrated "
+                    << fmt(100 * one.coverage_calibrated()(0), 3) << " / "
+                    << fmt(100 * one.coverage_calibrated()(1), 3) << " %)\n";
         }
         const solvers::ObserverRun fast_run =
             fast_alarm(declared, gen_noise, measured.time, measured.temperature);
@@ -1267,10 +1295,14 @@ int main(int argc, char** argv) {
       std::cout << "\n  clean runs: RMS dy, dz " << fmt(probe_clean.rms_um()(0)) << ", "
                 << fmt(probe_clean.rms_um()(1)) << " um, coverage "
                 << fmt(100 * probe_clean.coverage()(0), 3) << " / "
-                << fmt(100 * probe_clean.coverage()(1), 3) << " %; effect runs: RMS "
+                << fmt(100 * probe_clean.coverage()(1), 3) << " % (probe-calibrated "
+                << fmt(100 * probe_clean.coverage_calibrated()(0), 3) << " / "
+                << fmt(100 * probe_clean.coverage_calibrated()(1), 3) << " %); effect runs: RMS "
                 << fmt(probe_effect.rms_um()(0)) << ", " << fmt(probe_effect.rms_um()(1))
                 << " um, coverage " << fmt(100 * probe_effect.coverage()(0), 3) << " / "
-                << fmt(100 * probe_effect.coverage()(1), 3) << " %";
+                << fmt(100 * probe_effect.coverage()(1), 3) << " % (probe-calibrated "
+                << fmt(100 * probe_effect.coverage_calibrated()(0), 3) << " / "
+                << fmt(100 * probe_effect.coverage_calibrated()(1), 3) << " %)";
     }
     std::cout << "\nobserver: " << fmt(observer_s) << " s for " << fmt(observed_h) << " h of runs ("
               << fmt(observer_s / observed_h * 1e3) << " ms per hour of run); total "

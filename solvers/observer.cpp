@@ -274,12 +274,12 @@ void check_setup(const ReducedThermalSystem& system, const core::CaseSpec& spec,
       fail("sensor fault, model residual or departure onset bound " + number(bound) +
            " sigma: expected a finite value >= 0");
   if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup);
-  const Eigen::VectorXd& scale = n.drift_sigma_scale;
-  if (scale.size() != 0 && (scale.size() != setup.target_rows.rows() ||
-                            !(scale.array() > 0).all() || !scale.allFinite()))
-    fail("drift sigma scale: " + std::to_string(scale.size()) + " values for " +
-         std::to_string(setup.target_rows.rows()) +
-         " targets; expected none or one finite factor > 0 per target");
+  for (const Eigen::VectorXd* scale : {&n.drift_sigma_scale, &n.probed_drift_sigma_scale})
+    if (scale->size() != 0 && (scale->size() != setup.target_rows.rows() ||
+                               !(scale->array() > 0).all() || !scale->allFinite()))
+      fail("drift sigma scale: " + std::to_string(scale->size()) + " values for " +
+           std::to_string(setup.target_rows.rows()) +
+           " targets; expected none or one finite factor > 0 per target");
   const auto& conv = spec.thermal.convection;
   for (int c : setup.air_entries)
     if (c < 0 || c >= static_cast<int>(conv.size()) ||
@@ -631,6 +631,13 @@ CovarianceMap KalmanObserver::advance(double t) {
   return map;
 }
 
+ObserverSetup probed_setup(const ObserverSetup& setup) {
+  ObserverSetup s = setup;
+  if (s.noise.probed_drift_sigma_scale.size() != 0)
+    s.noise.drift_sigma_scale = s.noise.probed_drift_sigma_scale;
+  return s;
+}
+
 bool ProbeCycle::due(double t) {
   if (t + 1e-9 < next_) return false;
   while (next_ <= t + 1e-9) next_ += every_s_;
@@ -698,7 +705,7 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
     throw core::SolverError("observer: " + std::to_string(readings.rows()) +
                             " rows of readings and " + std::to_string(drift_readings.rows()) +
                             " of drift readings for " + std::to_string(times.size()) + " times");
-  KalmanObserver kf(system, spec, setup);
+  KalmanObserver kf(system, spec, drift_readings.size() != 0 ? probed_setup(setup) : setup);
   const Eigen::Index n = times.size(), nt = setup.target_rows.rows();
   const Eigen::Index nb = static_cast<Eigen::Index>(kf.unknown_inputs().size());
   ObserverRun run;

@@ -74,6 +74,11 @@ struct ObserverNoise {
   /// whose drift is known (drift_sigma_calibration); it leaves the filter (gain, innovations,
   /// alarm) as it is. Empty: 1 for every target.
   Eigen::VectorXd drift_sigma_scale;
+  /// Per target: the factor on the reported sigma of a filter that assimilates drift readings (a
+  /// probe cycle), calibrated on runs observed with it: the readings narrow the posterior, so
+  /// drift_sigma_scale, calibrated on temperatures alone, would cover too little. The drift test's
+  /// temperature-only filter keeps drift_sigma_scale. Empty: drift_sigma_scale.
+  Eigen::VectorXd probed_drift_sigma_scale;
   /// Standard deviation of a drift reading's white noise [m] (a probe cycle measuring the tool's
   /// drift, KalmanObserver::assimilate's drift_readings); the drift rows' relative error
   /// (drift_relative_sigma) is added to it at the predicted drift.
@@ -354,6 +359,10 @@ struct ObserverRun {
   /// recalibrate.
   std::vector<HeldSensor> drift_departures;
 };
+
+/// `setup` for a filter that assimilates drift readings: its reported sigma scaled by
+/// noise.probed_drift_sigma_scale when that is set.
+ObserverSetup probed_setup(const ObserverSetup& setup);
 
 /// Which samples of a probe cycle read the tool's drift: the first at or after each multiple of
 /// every_s (> 0), asked in increasing time.

@@ -36,7 +36,8 @@ LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseS
   spec_->duty_cycle.segments.clear();
   spec_->duty_cycle.end = 0;
   spec_->duty_cycle.csv.clear();
-  filter_ = std::make_unique<KalmanObserver>(system, *spec_, setup);
+  filter_ = std::make_unique<KalmanObserver>(system, *spec_,
+                                             drift_every_s > 0 ? probed_setup(setup) : setup);
   for (const std::string& t : target_names_) {
     const auto it = std::find(columns.begin(), columns.end(), t);
     drift_columns_.push_back(

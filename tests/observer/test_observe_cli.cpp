@@ -408,6 +408,27 @@ TEST(ObserveCli, DriftReadingsSeeAWrongExpansionThatNoTemperatureShows) {
   EXPECT_EQ(clean["status"], "ok");
   EXPECT_TRUE(clean["drift_readings"]["departures"].empty());
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "probed"));
+  // A factor calibrated with the probe cycle scales the sigma of the filter that reads the probes
+  // (here twice the other); the predictions and the drift test (on the temperatures' factor) stay.
+  std::vector<std::string> rescaled = probe_cycle;
+  rescaled.insert(rescaled.end(), {"--probed-drift-sigma-scale", "0.7,0.7,0.3"});
+  const auto twice = observe("expansion", "twice", rescaled);
+  EXPECT_EQ(twice["noise"]["probed_drift_sigma_scale"], nlohmann::json({0.7, 0.7, 0.3}));
+  EXPECT_EQ(twice["recalibrate_raised_s"], probed["recalibrate_raised_s"]);
+  {
+    const auto a = tt::test::csv_rows(dir / "probed" / "observer.csv");
+    const auto b = tt::test::csv_rows(dir / "twice" / "observer.csv");
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 1; i < a.size(); ++i)
+      for (const char* t : {"dx", "dy", "dz"}) {
+        const std::string key(t);
+        EXPECT_EQ(b[i].at(key + "_predicted_um"), a[i].at(key + "_predicted_um")) << i;
+        EXPECT_NEAR(std::stod(b[i].at(key + "_sigma_um")),
+                    2 * std::stod(a[i].at(key + "_sigma_um")),
+                    1e-7 * (1 + std::stod(b[i].at(key + "_sigma_um"))))
+            << i;
+      }
+  }
   // The same run streamed through `compensate --rom` with the same probe cycle: observe's
   // predictions, sigmas and status, sample by sample.
   std::vector<std::string> live{"compensate",
