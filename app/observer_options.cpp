@@ -47,6 +47,30 @@ nlohmann::json expansion_json(const solvers::ObserverSetup& setup) {
   return j;
 }
 
+/// A probe cycle's drift readings (observe, compensate --rom): how often, their noise, the factor
+/// on the sigma of the filter that reads them.
+void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
+  command
+      .add_option("--drift-readings-every-s", o.drift_readings_every_s,
+                  "read the columns named after targets (dx, dy, dz, <axis point>_dy, ...; um) as "
+                  "drift readings, one every this many seconds: a probe cycle measuring the tool "
+                  "now and then, which sees what no temperature shows (a wrong expansion "
+                  "coefficient); default 0: none")
+      ->check(non_negative_number());
+  command
+      .add_option("--probed-drift-sigma-scale", o.probed_drift_sigma_scale,
+                  "with --drift-readings-every-s: the factor on the reported drift sigma of the "
+                  "filter that reads them, calibrated on runs observed with the probe cycle (the "
+                  "readings narrow it); one value for all targets or one per target, "
+                  "comma-separated (default: --drift-sigma-scale; the drift test keeps that)")
+      ->delimiter(',')
+      ->check(positive_number());
+  command
+      .add_option("--drift-reading-sigma-um", o.drift_reading_sigma_um,
+                  "white noise of a drift reading [um] (default 0.3)")
+      ->check(positive_number());
+}
+
 }  // namespace
 
 void add_observer_options(CLI::App& command, ObserverOptions& o) {
@@ -116,25 +140,7 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "all targets or one per target, comma-separated (default 1)")
       ->delimiter(',')
       ->check(positive_number());
-  command
-      .add_option("--drift-readings-every-s", o.drift_readings_every_s,
-                  "read the columns named after targets (dx, dy, dz, <axis point>_dy, ...; um) as "
-                  "drift readings, one every this many seconds: a probe cycle measuring the tool "
-                  "now and then, which sees what no temperature shows (a wrong expansion "
-                  "coefficient); default 0: none")
-      ->check(non_negative_number());
-  command
-      .add_option("--probed-drift-sigma-scale", o.probed_drift_sigma_scale,
-                  "with --drift-readings-every-s: the factor on the reported drift sigma of the "
-                  "filter that reads them, calibrated on runs observed with the probe cycle (the "
-                  "readings narrow it); one value for all targets or one per target, "
-                  "comma-separated (default: --drift-sigma-scale; the drift test keeps that)")
-      ->delimiter(',')
-      ->check(positive_number());
-  command
-      .add_option("--drift-reading-sigma-um", o.drift_reading_sigma_um,
-                  "white noise of a drift reading [um] (default 0.3)")
-      ->check(positive_number());
+  add_drift_reading_options(command, o);
   add_consistency_options(command, o);
 }
 
