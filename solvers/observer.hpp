@@ -386,8 +386,8 @@ class DriftReadingTest {
   DriftReadingTest(const ReducedThermalSystem& system, const core::CaseSpec& spec,
                    const ObserverSetup& setup);
   /// Steps the temperature-only filter to t with `readings` (#sensors [K], NaN: missing) and tests
-  /// `drift` (#targets [m], NaN or empty: none). Returns the earliest start of a target raised
-  /// now (NaN: none).
+  /// `drift` (#targets [m], NaN or empty: none); with model_residual_sigmas 0 it does neither.
+  /// Returns the earliest start of a target raised now (NaN: none).
   double add(double t, const Eigen::VectorXd& readings, const Eigen::VectorXd& drift);
   const std::vector<HeldSensor>& raised() const { return held_.raised(); }
 
