@@ -250,11 +250,10 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
 // "Refit").
 TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
   const Study& s = study();
-  InjectedEffect e;
-  e.present = true;
-  e.kind = EffectKind::temperature_dependent_heat;
-  e.target = "front_bearing_friction";
-  e.magnitude = 0.07;
+  const InjectedEffect e{.present = true,
+                         .kind = EffectKind::temperature_dependent_heat,
+                         .magnitude = 0.07,
+                         .target = "front_bearing_friction"};
   std::mt19937_64 rng = core::generator(31, 1);
   std::vector<io::MeasuredRun> clean;
   const auto runs = testing::effect_runs(s, {e}, rng, &clean);
@@ -302,16 +301,14 @@ TEST(Refit, HeatGrowingWithTemperatureIsSizedNotItsShadow) {
 TEST(Pairs, TwoEffectsAreClaimedTogether) {
   const Study& s = study();
   std::mt19937_64 rng = core::generator(41, 1);
-  InjectedEffect film;
-  film.present = true;
-  film.kind = EffectKind::boundary_conductance;
-  film.target = "shaft_outside";
-  film.magnitude = 1.0;
-  InjectedEffect heat;
-  heat.present = true;
-  heat.kind = EffectKind::temperature_dependent_heat;
-  heat.target = "front_bearing_friction";
-  heat.magnitude = 0.04;
+  const InjectedEffect film{.present = true,
+                            .kind = EffectKind::boundary_conductance,
+                            .magnitude = 1.0,
+                            .target = "shaft_outside"};
+  const InjectedEffect heat{.present = true,
+                            .kind = EffectKind::temperature_dependent_heat,
+                            .magnitude = 0.04,
+                            .target = "front_bearing_friction"};
   std::vector<io::MeasuredRun> runs, clean;
   for (int k = 0; k < 3; ++k) {
     const core::CaseSpec t =

@@ -70,11 +70,10 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   const OwnMeshGenerator o;
   const core::CaseSpec& spec = o.spec;
   std::mt19937_64 rng = core::generator(5, 0);
-  calibration::InjectedEffect e;
-  e.present = true;
-  e.kind = calibration::EffectKind::sensor_offset;
-  e.target = "T11";
-  e.magnitude = 0.6;
+  const calibration::InjectedEffect e{.present = true,
+                                      .kind = calibration::EffectKind::sensor_offset,
+                                      .magnitude = 0.6,
+                                      .target = "T11"};
   const core::DutyCycle duty = calibration::random_duty_cycle(3, rng);
   io::write_measured_run(
       data, calibration::synthetic_run(o.mesh, calibration::truth_case(o.gen, e, duty, 0), e,
@@ -358,11 +357,10 @@ TEST(ObserveCli, DriftReadingsSeeAWrongExpansionThatNoTemperatureShows) {
   const fs::path& rom = coarse_rom();
   const OwnMeshGenerator o;
   std::mt19937_64 rng = core::generator(23, 0);
-  calibration::InjectedEffect expansion;
-  expansion.present = true;
-  expansion.kind = calibration::EffectKind::material_parameter;
-  expansion.target = "steel.expansion";
-  expansion.magnitude = 0.16;
+  const calibration::InjectedEffect expansion{.present = true,
+                                              .kind = calibration::EffectKind::material_parameter,
+                                              .magnitude = 0.16,
+                                              .target = "steel.expansion"};
   const calibration::InjectedEffect none;
   const core::DutyCycle duty = calibration::random_duty_cycle(4, rng);
   std::map<std::string, io::MeasuredRun> runs;

@@ -574,11 +574,10 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
   const Eigen::MatrixXd clean = s_->clean_truth.displacement.leftCols(3);
   Eigen::MatrixXd sum_squares = Eigen::MatrixXd::Zero(clean.rows(), 3);
   for (std::size_t m = 0; m < s_->spec.materials.size(); ++m) {
-    calibration::InjectedEffect e;
-    e.present = true;
-    e.kind = calibration::EffectKind::material_parameter;
-    e.target = s_->spec.materials[m].name + ".expansion";
-    e.magnitude = 0.1;
+    const calibration::InjectedEffect e{.present = true,
+                                        .kind = calibration::EffectKind::material_parameter,
+                                        .magnitude = 0.1,
+                                        .target = s_->spec.materials[m].name + ".expansion"};
     const io::MeasuredRun run =
         calibration::clean_run(s_->mesh, calibration::truth_case(s_->gen, e, s_->duty, 2), e,
                                s_->inst, s_->g, "expansion");
