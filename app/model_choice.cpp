@@ -14,7 +14,7 @@ CampaignOnModel campaign_on_model(const mesh::TetMesh& mesh, const core::CaseSpe
                                   const ModelChoice& choice, const std::vector<int>& sampled_nodes,
                                   bool quiet) {
   io::ReducedModelFile file;
-  studies::ModelRequest request{choice.full};
+  studies::ModelRequest request{.full = choice.full};
   if (!choice.full && !choice.rom.empty()) {
     file = io::read_reduced_model(choice.rom);
     io::check_reduced_model_fits(file, io::reduced_model_key(spec, mesh), choice.rom);

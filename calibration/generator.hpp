@@ -33,7 +33,7 @@ struct InjectedEffect {
   Eigen::Vector3d centre =
       Eigen::Vector3d::Zero();  /// heat input: area-weighted centre of its faces [m]
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  std::vector<std::string> groups;  /// heat input: the boundary groups its box covers
+  std::vector<std::string> groups{};  /// heat input: the boundary groups its box covers
   double area = 0;  /// heat input: area of the faces in the box on the generator's mesh [m^2]
   bool follows_speed = false;
   std::uint64_t seed = 0;  /// for the run-specific parts (the air signal)

@@ -85,10 +85,6 @@ json correlations_json(const studies::ResidualCorrelations& c, bool has_speed,
   return d;
 }
 
-json figures_json(const core::ErrorFigures& f) {
-  return {{"rms_um", f.rms * um}, {"mae_um", f.mae * um}, {"max_abs_um", f.max_abs * um}};
-}
-
 json runs_json(const SplitRuns& runs) {
   json splits = json::array();
   for (const auto& r : runs.runs) {

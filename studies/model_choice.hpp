@@ -23,8 +23,8 @@ namespace tt::studies {
 struct ModelRequest {
   bool full = false;
   const solvers::Twin* given = nullptr;
-  std::filesystem::path rom_file;
-  std::string built_from;
+  std::filesystem::path rom_file{};
+  std::string built_from{};
 };
 
 /// The reduced model's error indicator: the full-order residual at a few output steps of `run`.

@@ -171,7 +171,9 @@ inline void check_kind(const Study& s, EffectKind kind, std::uint64_t seed) {
 inline void check_draw(const Study& s, const InjectedEffects& effects, std::mt19937_64& rng) {
   const Outcome out = calibrated(s, effects, rng);
   EXPECT_TRUE(out.right || out.ambiguous) << claims_json(out.result).dump(1);
-  if (out.right) EXPECT_LE(out.after, 0.3 * out.before);
+  if (out.right) {
+    EXPECT_LE(out.after, 0.3 * out.before);
+  }
 }
 
 }  // namespace tt::calibration::testing

@@ -161,7 +161,9 @@ void confusion(const testing::Study& s, bool floors) {
       draws, right, ambiguous, 100.0 * (right + ambiguous) / draws, right_within,
       static_cast<int>(ratios.size()), ratios.empty() ? 0.0 : ratios[ratios.size() / 2],
       ratios.empty() ? 0.0 : ratios.back(), clean_claimed, with_clean ? 10 : 0);
-  if (draws > 0) EXPECT_GE(right + ambiguous, 0.95 * draws);
+  if (draws > 0) {
+    EXPECT_GE(right + ambiguous, 0.95 * draws);
+  }
   EXPECT_EQ(right_within, static_cast<int>(ratios.size()));
   EXPECT_LE(clean_claimed, 1);
 }
