@@ -111,6 +111,8 @@ struct ObserverOptions {
   /// with drift readings: the factor on the sigma of the filter that reads them (calibrated with
   /// the probe cycle); empty: drift_sigma_scale
   std::vector<double> probed_drift_sigma_scale;
+  /// a sigma_calibration.json (observe --train): its factors in place of the two above
+  std::filesystem::path sigma_calibration;
   double window_s = 1800, sustain_s = 900, probability = 0.999;  /// consistency test
   double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
   /// a reading held this many sigmas from the declared model's run: recalibrate (0: off)
@@ -142,7 +144,13 @@ struct CompensateArgs {
 /// observe CASE --rom DIR --data RUN --out DIR: the physics observer on a measured run
 /// (app/observe_command.cpp, docs/observer.md).
 struct ObserveArgs {
-  std::filesystem::path case_file, rom, data, out;
+  std::filesystem::path case_file, rom, out;
+  std::filesystem::path data;  /// the run to observe; empty: calibrate only
+  /// runs whose drift was measured: the sigma factors are calibrated on them
+  /// (sigma_calibration.json) and, with data, used on it
+  std::vector<std::filesystem::path> train;
+  double truth_sigma_um = 0;  /// white noise of the training runs' measured drift [um]
+  double coverage = 0.95;     /// the share of training samples the ±2 sigma band is to hold
   ObserverOptions observer;
   bool quiet = false;
 };

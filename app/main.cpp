@@ -18,6 +18,7 @@
 //                                  form
 //   observe CASE --rom DIR --data RUN --out DIR
 //                                  the physics observer: drift with its sigma, recalibrate status
+//                                  (--train RUN...: its sigma calibrated on measured drift)
 //   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
@@ -458,13 +459,36 @@ Command observe_line(CLI::App& cli) {
       ->required()
       ->check(CLI::ExistingDirectory);
   observe->add_option("--data", observe_args.data, "measured run folder (meta.json, data.csv)")
-      ->required()
       ->check(CLI::ExistingDirectory);
+  auto* train = observe
+                    ->add_option("--train", observe_args.train,
+                                 "measured runs whose drift was measured throughout (columns "
+                                 "named after targets: dx, dy, dz, ...): calibrate the factors on "
+                                 "the reported drift sigma on them (OUT/sigma_calibration.json) "
+                                 "and use them on --data")
+                    ->check(CLI::ExistingDirectory);
+  observe
+      ->add_option("--truth-sigma-um", observe_args.truth_sigma_um,
+                   "with --train: white noise of the measured drift [um]: the band that is to "
+                   "hold a measured drift is ±2 sqrt((factor sigma)^2 + this^2), so the noise does "
+                   "not widen the drift's own sigma (default 0)")
+      ->check(non_negative_number())
+      ->needs(train);
+  observe
+      ->add_option("--coverage", observe_args.coverage,
+                   "with --train: the share of training samples the ±2 sigma band is to hold "
+                   "(default 0.95)")
+      ->check(CLI::Range(0.5, 0.9999))
+      ->needs(train);
   observe->add_option("--out", observe_args.out, "output directory")->required();
   add_observer_options(*observe, observe_args.observer);
   observe->add_flag("--quiet", observe_args.quiet, "no summary on stderr");
   return {observe, [args] {
             const ObserveArgs& a = *args;
+            if (a.data.empty() && a.train.empty())
+              throw tt::core::DataError(
+                  "observe: give a run to observe (--data RUN), training runs to calibrate the "
+                  "sigma on (--train RUN ...), or both");
             return observe_command(a);
           }};
 }

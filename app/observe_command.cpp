@@ -5,57 +5,112 @@
 // innovations stop fitting the noise model (status `recalibrate`, with the time it started).
 //   1. the case and the run, the output claimed;
 //   2. the reduced model, checked against the case and its mesh;
-//   3. the study (studies/observe_run.hpp): the case under the run's inputs, the sensors
-//      (--sensors, default: every sensor of the run that is a named point of the model), the
-//      observer's set-up (app/observer_options.hpp), the run through the filter;
+//   3. with --train, the factors on the reported sigma calibrated on runs whose drift was measured
+//      (studies/observer_sigma.hpp; sigma_calibration.json); the study (studies/observe_run.hpp):
+//      the case under the run's inputs, the sensors (--sensors, default: every sensor of the run
+//      that is a named point of the model), the observer's set-up (app/observer_options.hpp, with
+//      the calibrated factors), the run through the filter;
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "app/commands.hpp"
 #include "app/observer_options.hpp"
+#include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
 #include "io/measured_data.hpp"
 #include "io/observe_out.hpp"
 #include "io/reduced_model_io.hpp"
+#include "io/reports.hpp"
+#include "io/sigma_calibration_io.hpp"
 #include "mesh/mesher.hpp"
 #include "studies/observe_run.hpp"
+#include "studies/observer_sigma.hpp"
 
 namespace tt::app {
 
-int observe_command(const ObserveArgs& args) {
-  // 1. The case and the run.
-  const core::CaseSpec declared = io::read_case(args.case_file);
-  const io::MeasuredRun run = io::read_measured_run(args.data);
-  std::vector<std::filesystem::path> inputs = io::case_input_files(declared);
-  inputs.insert(inputs.end(), {args.rom, args.data});
-  io::OutputDir out(args.out, inputs);
-  // 2. The reduced model, built for this machine and mesh.
-  const io::ReducedModelFile rom = io::read_reduced_model(args.rom);
-  const mesh::TetMesh mesh = mesh::mesh_case(declared);
-  io::check_reduced_model_fits(rom, io::reduced_model_key(declared, mesh), args.rom);
-  // 3. The study: the run's sensors read at their positions where it gives them.
-  const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors,
-                         const Eigen::MatrixXd& rows) {
-    return observer_setup(args.observer, rom.twin, spec, sensors, rows);
+namespace {
+
+/// What the observer runs on: the declared case, the reduced model, its mesh, the set-up.
+struct ObserverInputs {
+  const core::CaseSpec* declared = nullptr;
+  const solvers::Twin* twin = nullptr;
+  const mesh::TetMesh* mesh = nullptr;
+  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
+                                       const Eigen::MatrixXd&)>
+      setup;
+};
+
+std::vector<double> as_vector(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+/// The summary of a sigma calibration on stderr: the factors and the band's coverage before and
+/// after, per measured target.
+void print_calibration(const studies::SigmaCalibration& cal) {
+  const auto pass = [&](const std::string& name, const studies::SigmaPass& p) {
+    for (std::size_t t = 0; t < cal.targets.size(); ++t) {
+      const auto k = static_cast<Eigen::Index>(t);
+      if (p.pooled_before.samples(k) == 0) continue;
+      std::cerr << "thermotwin: observe: " << name << " " << cal.targets[t] << ": factor "
+                << p.drift_sigma_scale(k) << ", ±2 sigma held " << 100 * p.pooled_before.coverage(k)
+                << " % of " << p.pooled_before.samples(k) << " training samples, now "
+                << 100 * p.pooled_after.coverage(k) << " %\n";
+    }
   };
-  const studies::ObserveReport report =
-      studies::observe_run({&declared, &run, &rom.twin, args.observer.sensors, setup, &mesh,
-                            args.observer.drift_readings_every_s});
-  // 4. Outputs.
-  io::write_observe(out.path(), report,
-                    {run.run, declared.name, rom.twin.model.states(), args.rom,
-                     observer_noise_json(report.setup)});
-  out.commit();
+  pass("sigma", cal.temperatures);
+  if (cal.probed) pass("probed sigma", *cal.probed);
+}
+
+/// The sigma calibrated on the training runs (sigma_calibration.json into `dir`); `options` then
+/// carry its factors and sensors, for the run observed after it.
+void calibrate_sigma(const ObserveArgs& args, const ObserverInputs& in, ObserverOptions& options,
+                     const std::filesystem::path& dir) {
+  std::vector<io::MeasuredRun> runs;
+  for (const auto& path : args.train) runs.push_back(io::read_measured_run(path));
+  std::vector<const io::MeasuredRun*> training;
+  for (const auto& r : runs) training.push_back(&r);
+  studies::Progress progress;
+  if (!args.quiet)
+    progress = [](const std::string& line) {
+      std::cerr << "thermotwin: observe: " << line << "\n";
+    };
+  const studies::SigmaCalibrationInput input{
+      .declared = in.declared,
+      .twin = in.twin,
+      .mesh = in.mesh,
+      .setup = in.setup,
+      .runs = training,
+      .sensors = options.sensors,
+      .drift_readings_every_s = options.drift_readings_every_s,
+      .truth_sigma_m = core::kMetresPerMicrometre * args.truth_sigma_um,
+      .coverage = args.coverage,
+      .progress = progress};
+  const studies::SigmaCalibration cal = studies::calibrate_observer_sigma(input);
+  io::write_json(dir / "sigma_calibration.json",
+                 io::sigma_calibration_json(cal, {in.declared->name, in.twin->model.states(),
+                                                  args.rom, observer_noise_json(cal.setup)}));
+  options.sensors = cal.sensors;
+  options.sigma_calibration.clear();
+  options.drift_sigma_scale = as_vector(cal.temperatures.drift_sigma_scale);
+  options.probed_drift_sigma_scale.clear();
+  if (cal.probed) options.probed_drift_sigma_scale = as_vector(cal.probed->drift_sigma_scale);
+  if (!args.quiet) print_calibration(cal);
+}
+
+/// The run's summary on stderr; a faulty sensor is a warning, written even with --quiet.
+void print_observed(const studies::ObserveReport& report, bool quiet) {
   const solvers::ObserverRun& r = report.result;
-  // A faulty sensor is a warning, written even with --quiet.
   for (const solvers::HeldSensor& f : r.sensor_faults)
     std::cerr << "thermotwin: observe: warning: sensor "
               << report.sensors[static_cast<std::size_t>(f.sensor)]
               << " reads off by an offset (observer.json sensor_faults) since t = " << f.since_s
               << " s: check its mounting and calibration\n";
-  if (args.quiet) return 0;
+  if (quiet) return;
   std::cerr << "thermotwin: observe: " << r.times.size() << " samples, status "
             << (r.recalibrate
                     ? "recalibrate since t = " + std::to_string(r.recalibrate_since_s) + " s"
@@ -71,6 +126,45 @@ int observe_command(const ObserveArgs& args) {
               << report.setup.target_names[static_cast<std::size_t>(d.sensor)]
               << " departed from the model since t = " << d.since_s
               << " s (observer.json drift_readings)\n";
+}
+
+}  // namespace
+
+int observe_command(const ObserveArgs& args) {
+  // 1. The case and the run, the output claimed.
+  const core::CaseSpec declared = io::read_case(args.case_file);
+  std::optional<io::MeasuredRun> run;
+  if (!args.data.empty()) run = io::read_measured_run(args.data);
+  std::vector<std::filesystem::path> inputs = io::case_input_files(declared);
+  inputs.push_back(args.rom);
+  if (run) inputs.push_back(args.data);
+  inputs.insert(inputs.end(), args.train.begin(), args.train.end());
+  if (!args.observer.sigma_calibration.empty()) inputs.push_back(args.observer.sigma_calibration);
+  io::OutputDir out(args.out, inputs);
+  // 2. The reduced model, built for this machine and mesh.
+  const io::ReducedModelFile rom = io::read_reduced_model(args.rom);
+  const mesh::TetMesh mesh = mesh::mesh_case(declared);
+  io::check_reduced_model_fits(rom, io::reduced_model_key(declared, mesh), args.rom);
+  // 3. The sigma calibrated on the training runs, then the run observed with it: the set-up reads
+  //    `options`, which the calibration sets to its factors and sensors once it is done.
+  ObserverOptions options = args.observer;
+  const auto setup = [&](const core::CaseSpec& spec, const std::vector<std::string>& sensors,
+                         const Eigen::MatrixXd& rows) {
+    return observer_setup(options, rom.twin, spec, sensors, rows);
+  };
+  if (!args.train.empty())
+    calibrate_sigma(args, {&declared, &rom.twin, &mesh, setup}, options, out.path());
+  std::optional<studies::ObserveReport> report;
+  if (run)
+    report = studies::observe_run({&declared, &*run, &rom.twin, options.sensors, setup, &mesh,
+                                   options.drift_readings_every_s});
+  // 4. Outputs.
+  if (report)
+    io::write_observe(out.path(), *report,
+                      {run->run, declared.name, rom.twin.model.states(), args.rom,
+                       observer_noise_json(report->setup)});
+  out.commit();
+  if (report) print_observed(*report, args.quiet);
   return 0;
 }
 

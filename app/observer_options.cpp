@@ -4,6 +4,7 @@
 
 #include "app/cli_numbers.hpp"
 #include "core/errors.hpp"
+#include "io/sigma_calibration_io.hpp"
 
 namespace tt::app {
 namespace {
@@ -69,6 +70,39 @@ void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
       .add_option("--drift-reading-sigma-um", o.drift_reading_sigma_um,
                   "white noise of a drift reading [um] (default 0.3)")
       ->check(positive_number());
+}
+
+/// The factors of --sigma-calibration's file on `setup`. DataError naming the file when it was
+/// calibrated for other sensors, targets or probe cycle, or when --drift-sigma-scale or
+/// --probed-drift-sigma-scale is given too.
+void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::string>& sensors,
+                             solvers::ObserverSetup& setup) {
+  const std::string file = o.sigma_calibration.string();
+  if (!o.drift_sigma_scale.empty() || !o.probed_drift_sigma_scale.empty())
+    throw core::DataError(
+        "--sigma-calibration " + file +
+        ": give it or --drift-sigma-scale / --probed-drift-sigma-scale, not both");
+  const io::SigmaCalibrationFile f = io::read_sigma_calibration(o.sigma_calibration);
+  const auto listed = [](const std::vector<std::string>& ids) {
+    std::string out;
+    for (const auto& id : ids) out += (out.empty() ? "" : ",") + id;
+    return out;
+  };
+  if (f.sensors != sensors)
+    throw core::DataError(file + ": sensors = " + listed(f.sensors) + ": calibrated for other " +
+                          "sensors than the ones read here (" + listed(sensors) +
+                          "); calibrate again with these (--sensors)");
+  if (f.targets != setup.target_names)
+    throw core::DataError(file + ": targets = " + listed(f.targets) +
+                          ": calibrated on another reduced model (its targets are " +
+                          listed(setup.target_names) + ")");
+  if (o.drift_readings_every_s > 0 && f.probe_every_s &&
+      *f.probe_every_s != o.drift_readings_every_s)
+    throw core::DataError(file + ": probe_cycle.every_s = " + std::to_string(*f.probe_every_s) +
+                          ": calibrated with another probe cycle than --drift-readings-every-s " +
+                          std::to_string(o.drift_readings_every_s));
+  setup.noise.drift_sigma_scale = f.drift_sigma_scale;
+  if (f.probe_every_s) setup.noise.probed_drift_sigma_scale = f.probed_drift_sigma_scale;
 }
 
 }  // namespace
@@ -140,6 +174,12 @@ void add_observer_options(CLI::App& command, ObserverOptions& o) {
                   "all targets or one per target, comma-separated (default 1)")
       ->delimiter(',')
       ->check(positive_number());
+  command
+      .add_option("--sigma-calibration", o.sigma_calibration,
+                  "the factors on the reported drift sigma from a sigma_calibration.json that "
+                  "`observe --train` wrote, for the same sensors and targets (in place of "
+                  "--drift-sigma-scale and --probed-drift-sigma-scale)")
+      ->check(CLI::ExistingFile);
   add_drift_reading_options(command, o);
   add_consistency_options(command, o);
 }
@@ -202,6 +242,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   if (!o.probed_drift_sigma_scale.empty())
     setup.noise.probed_drift_sigma_scale = per_name(o.probed_drift_sigma_scale, setup.target_names,
                                                     "--probed-drift-sigma-scale", "targets");
+  if (!o.sigma_calibration.empty()) apply_sigma_calibration(o, sensors, setup);
   setup.consistency.window_s = o.window_s;
   setup.consistency.sustain_s = o.sustain_s;
   setup.consistency.probability = o.probability;

@@ -1,11 +1,16 @@
-// Keys of a fit.json read with messages that name the file, the target and the key path, e.g.
-// "fit.json: target 'dz': chosen.coefficients.terms[0].um_per_K = "x": expected a finite number".
-// Shared by the readers of fit.json (io/fit_model_in.cpp, io/cnc_model_in.cpp).
+// A JSON file read, and keys of a fit.json read with messages that name the file, the target and
+// the key path, e.g. "fit.json: target 'dz': chosen.coefficients.terms[0].um_per_K = "x":
+// expected a finite number".
+// Shared by the readers of fit.json (io/fit_model_in.cpp, io/cnc_model_in.cpp) and of
+// sigma_calibration.json (io/sigma_calibration_io.cpp).
 #pragma once
 
 #include <Eigen/Core>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,17 +24,32 @@ using nlohmann::json;
 /// "fit.json: axis.positions_m" for a key outside any target (target empty).
 struct Place {
   std::string origin, target;
+  /// what a missing key suggests
+  std::string hint = "give a fit.json written by `thermotwin fit` or `thermotwin fit --data`";
   std::string at(const std::string& key) const {
     return origin + ": " + (target.empty() ? "" : "target '" + target + "': ") + key;
   }
 };
 
+/// The parsed JSON file at `path`: IoError naming it and `expected` ("a fit.json file") when it
+/// cannot be read, DataError when it is not JSON.
+inline json read_json(const std::filesystem::path& path, const std::string& expected) {
+  std::ifstream in(path);
+  if (!in || std::filesystem::is_directory(path))
+    throw core::IoError(path.string() + ": cannot read (expected " + expected + ")");
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    return json::parse(text.str());
+  } catch (const json::parse_error& e) {
+    throw core::DataError(path.string() + ": not JSON: " + e.what());
+  }
+}
+
 inline const json& member(const json& j, const std::string& key, const Place& p,
                           const std::string& path) {
   if (!j.is_object() || !j.contains(key))
-    throw core::DataError(p.at(path + key) +
-                          " is missing; hint: give a fit.json written by "
-                          "`thermotwin fit` or `thermotwin fit --data`");
+    throw core::DataError(p.at(path + key) + " is missing; hint: " + p.hint);
   return j.at(key);
 }
 

@@ -1,8 +1,6 @@
 #include "io/fit_model_in.hpp"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "core/errors.hpp"
 #include "core/units.hpp"
@@ -212,18 +210,7 @@ fitting::FittedModel fitted_model_from_json(const json& coefficients, const std:
 }
 
 json read_fit_json(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in || std::filesystem::is_directory(path))
-    throw core::IoError(path.string() + ": cannot read (expected a fit.json file)");
-  std::stringstream text;
-  text << in.rdbuf();
-  json fit;
-  try {
-    fit = json::parse(text.str());
-  } catch (const json::parse_error& e) {
-    throw core::DataError(path.string() + ": not JSON: " + e.what());
-  }
-  return fit;
+  return fit_keys::read_json(path, "a fit.json file");
 }
 
 std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path) {

@@ -25,9 +25,14 @@ OUTPUTS = {
     "calibrate": [("calibration.json", "calibration", True),
                   ("sensor_corrections.json", "sensor_corrections", False)],
     "probes": [("summary.json", "probes_summary", True)],
-    "observe": [("observer.json", "observer", True)],
+    "observe": [("observer.json", "observer", False),
+                ("sigma_calibration.json", "sigma_calibration", False)],
     "export": [("export.json", "export", True)],
 }
+
+# command -> files of which it writes at least one (observe: the run observed, the sigma
+# calibrated on training runs, or both)
+ONE_OF = {"observe": ["observer.json", "sigma_calibration.json"]}
 
 
 def problems(command, folder):
@@ -36,6 +41,8 @@ def problems(command, folder):
     except ImportError:
         return ["python3-jsonschema is not installed (apt-get install python3-jsonschema)"]
     found = []
+    if command in ONE_OF and not any((folder / n).exists() for n in ONE_OF[command]):
+        found.append(f"{folder}: none of {', '.join(ONE_OF[command])} ({command} writes one)")
     for name, schema_name, always in OUTPUTS[command]:
         path = folder / name
         if not path.exists():

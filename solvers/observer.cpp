@@ -780,6 +780,11 @@ std::vector<std::vector<std::pair<double, double>>> errors_and_sigmas(
   return out;
 }
 
+/// The least factor f on sigma whose band ±2 sqrt((f sigma)^2 + noise^2) holds the error e.
+double band_factor(double e, double sigma, double noise) {
+  return std::sqrt(std::max(0.0, e * e / 4 - noise * noise)) / sigma;
+}
+
 }  // namespace
 
 Eigen::VectorXd mean_normalised_squared_error(const std::vector<ObserverRun>& runs,
@@ -815,10 +820,39 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
   return scale;
 }
 
+DriftBandScore drift_band_score(const std::vector<ObserverRun>& runs,
+                                const std::vector<Eigen::MatrixXd>& truths,
+                                const Eigen::VectorXd& factor, double truth_sigma_m) {
+  const auto samples = errors_and_sigmas(runs, truths);
+  const auto nt = static_cast<Eigen::Index>(samples.size());
+  if (factor.size() != 0 && factor.size() != nt)
+    throw core::SolverError("observer score: " + std::to_string(factor.size()) + " factors for " +
+                            std::to_string(nt) + " targets");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  DriftBandScore score{Eigen::VectorXi::Zero(nt), Eigen::VectorXd::Constant(nt, nan),
+                       Eigen::VectorXd::Constant(nt, nan)};
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const auto& st = samples[static_cast<std::size_t>(t)];
+    if (st.empty()) continue;
+    const double f = factor.size() != 0 ? factor(t) : 1.0;
+    double squares = 0, inside = 0;
+    for (const auto& [e, sigma] : st) {
+      squares += e * e;
+      inside += band_factor(e, sigma, truth_sigma_m) <= f;
+    }
+    const auto n = static_cast<double>(st.size());
+    score.samples(t) = static_cast<int>(st.size());
+    score.rms_error_m(t) = std::sqrt(squares / n);
+    score.coverage(t) = inside / n;
+  }
+  return score;
+}
+
 Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>& runs,
                                                  const std::vector<Eigen::MatrixXd>& truths,
                                                  double coverage,
-                                                 const Eigen::VectorXd& observed_with) {
+                                                 const Eigen::VectorXd& observed_with,
+                                                 double truth_sigma_m) {
   if (!(coverage > 0 && coverage < 1))
     throw core::SolverError("observer calibration: coverage " + number(coverage) +
                             ": expected 0 < coverage < 1");
@@ -831,7 +865,7 @@ Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>&
   for (Eigen::Index t = 0; t < nt; ++t) {
     std::vector<double> ratio;
     for (const auto& [e, sigma] : samples[static_cast<std::size_t>(t)])
-      ratio.push_back(std::abs(e) / (2 * sigma));
+      ratio.push_back(band_factor(e, sigma, truth_sigma_m));
     if (!ratio.empty()) {
       // The nearest rank: the smallest factor under which at least `coverage` of them lie.
       const auto rank = static_cast<std::size_t>(

@@ -25,29 +25,36 @@ Eigen::MatrixXd readings_of(const io::MeasuredRun& run, const std::vector<std::s
 
 }  // namespace
 
-DriftReadings drift_readings(const io::MeasuredRun& run, const std::vector<std::string>& targets,
-                             double every_s) {
+DriftReadings drift_columns(const io::MeasuredRun& run, const std::vector<std::string>& targets,
+                            const std::string& purpose) {
   const Eigen::Index n = run.time.size();
   const auto nt = static_cast<Eigen::Index>(targets.size());
   DriftReadings out;
   out.readings = Eigen::MatrixXd::Constant(n, nt, std::numeric_limits<double>::quiet_NaN());
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> columns;  // (target, displacement column)
   for (Eigen::Index t = 0; t < nt; ++t)
     for (std::size_t p = 0; p < run.displacements.size(); ++p)
       if (run.displacements[p].id == targets[static_cast<std::size_t>(t)]) {
-        columns.emplace_back(t, static_cast<Eigen::Index>(p));
+        out.readings.col(t) = run.displacement.col(static_cast<Eigen::Index>(p));
         out.targets.push_back(run.displacements[p].id);
       }
-  if (columns.empty())
-    throw core::DataError(
-        run.folder.string() +
-        ": drift readings asked for, but no displacement column of the run is "
-        "named after a target of the observer (dx, dy, dz, <axis point>_dy, ...)");
+  if (out.targets.empty())
+    throw core::DataError(run.folder.string() + ": " + purpose +
+                          ", but no displacement column of the run is named after a target of "
+                          "the observer (dx, dy, dz, <axis point>_dy, ...)");
+  out.samples = static_cast<int>(n);
+  return out;
+}
+
+DriftReadings drift_readings(const io::MeasuredRun& run, const std::vector<std::string>& targets,
+                             double every_s) {
+  DriftReadings out = drift_columns(run, targets, "drift readings asked for");
+  out.samples = 0;
   solvers::ProbeCycle cycle(every_s);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (!cycle.due(run.time(i))) continue;
-    for (const auto& [t, p] : columns) out.readings(i, t) = run.displacement(i, p);
-    ++out.samples;
+  for (Eigen::Index i = 0; i < run.time.size(); ++i) {
+    if (cycle.due(run.time(i)))
+      ++out.samples;
+    else
+      out.readings.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
   }
   return out;
 }

@@ -93,6 +93,12 @@ struct DriftReadings {
   int samples = 0;                   /// the samples that read them
 };
 
+/// Every sample of `run`'s displacement columns whose ids name the observer's `targets` (its true
+/// drift, where it was measured throughout), NaN for a target no column names; samples: the run's.
+/// Throws DataError naming the run and saying `purpose` when no displacement column names a target.
+DriftReadings drift_columns(const io::MeasuredRun& run, const std::vector<std::string>& targets,
+                            const std::string& purpose);
+
 /// The drift readings of `run` for the observer's `targets`: each displacement column whose id
 /// names a target, at the first sample at or after each multiple of every_s (a probe cycle), NaN
 /// elsewhere. Throws DataError naming the run when no displacement column names a target.

@@ -317,6 +317,32 @@ TEST_F(Observer, CoverageCalibrationAndWideningOnInconsistency) {
   for (Eigen::Index d = 0; d < scale.size(); ++d)
     EXPECT_NEAR(twice(d), 2 * scale(d) * scale(d), 1e-12);
   EXPECT_THROW(solvers::drift_sigma_coverage_calibration(runs, {truth}, 1.0), core::SolverError);
+  // A truth measured with white noise: the factor puts 95 % of the samples within ±2
+  // sqrt((factor sigma)^2 + noise^2), which drift_band_score scores; 1 % less, it does not. The
+  // noise takes part of the band, so the factor is smaller than without it.
+  const Eigen::Index n_err = truth.rows() - 1;
+  const double noise = 0.2 *
+                       (runs[0].drift.block(1, 0, n_err, 3) - truth.block(1, 0, n_err, 3))
+                           .colwise()
+                           .norm()
+                           .minCoeff() /
+                       std::sqrt(static_cast<double>(n_err));
+  const Eigen::VectorXd noisy =
+      solvers::drift_sigma_coverage_calibration(runs, {truth}, 0.95, {}, noise);
+  const solvers::DriftBandScore held = solvers::drift_band_score(runs, {truth}, noisy, noise);
+  const solvers::DriftBandScore less =
+      solvers::drift_band_score(runs, {truth}, 0.99 * noisy, noise);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_LT(noisy(d), scale(d)) << "direction " << d;
+    EXPECT_GE(held.coverage(d), 0.95) << "direction " << d;
+    EXPECT_LT(less.coverage(d), 0.95) << "direction " << d;
+    EXPECT_EQ(held.samples(d), truth.rows() - 1) << "direction " << d;
+  }
+  Eigen::MatrixXd no_dz = truth;
+  no_dz.col(2).setConstant(std::numeric_limits<double>::quiet_NaN());
+  const solvers::DriftBandScore unscored = solvers::drift_band_score(runs, {no_dz});
+  EXPECT_EQ(unscored.samples(2), 0);
+  EXPECT_TRUE(std::isnan(unscored.coverage(2)) && std::isnan(unscored.rms_error_m(2)));
 
   // Widening: on the run with an undeclared heat input, where the innovations outgrow the noise
   // model, the reported sigma is sqrt(window NIS / dof) times the plain one when that is above

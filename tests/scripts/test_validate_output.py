@@ -89,6 +89,11 @@ with tempfile.TemporaryDirectory() as tmp:
     code, out = check("fit", d)
     expect(code == 1 and "fit.json: missing" in out, f"a missing file: exit {code}: {out}")
 
+    (d / "observer.json").unlink()
+    code, out = check("observe", d)
+    expect(code == 1 and "none of observer.json, sigma_calibration.json" in out,
+           f"an observe folder with neither file: exit {code}: {out}")
+
     code, out = check("no-such-command", d)
     expect(code == 2, f"an unknown command: exit {code}")
 

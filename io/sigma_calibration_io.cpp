@@ -1,0 +1,117 @@
+#include "io/sigma_calibration_io.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/units.hpp"
+#include "io/fit_json_keys.hpp"
+#include "io/reports.hpp"
+
+namespace tt::io {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kFormat = "thermotwin-sigma-calibration/1";
+
+std::vector<double> as_vector(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+/// Per target: samples, rms_error_um and coverage (null where no sample had a measured drift).
+json score_json(const solvers::DriftBandScore& s, const std::vector<std::string>& targets) {
+  json out = json::object();
+  for (std::size_t t = 0; t < targets.size(); ++t) {
+    const auto k = static_cast<Eigen::Index>(t);
+    out[targets[t]] = {
+        {"samples", s.samples(k)},
+        {"rms_error_um", finite_or_null(s.rms_error_m(k), core::kMicrometresPerMetre)},
+        {"coverage", finite_or_null(s.coverage(k))}};
+  }
+  return out;
+}
+
+json pass_json(const studies::SigmaPass& pass, const studies::SigmaCalibration& c) {
+  json runs = json::array();
+  for (std::size_t k = 0; k < c.runs.size(); ++k)
+    runs.push_back({{"run", c.runs[k]},
+                    {"before", score_json(pass.before[k], c.targets)},
+                    {"after", score_json(pass.after[k], c.targets)}});
+  return {{"drift_sigma_scale", as_vector(pass.drift_sigma_scale)},
+          {"nees_drift_sigma_scale", as_vector(pass.nees_drift_sigma_scale)},
+          {"observed_with", as_vector(pass.observed_with)},
+          {"before", score_json(pass.pooled_before, c.targets)},
+          {"after", score_json(pass.pooled_after, c.targets)},
+          {"runs", runs}};
+}
+
+/// "a,b,c": the factors as a flag's value.
+std::string flag_value(const Eigen::VectorXd& v) {
+  std::ostringstream s;
+  s.precision(6);
+  for (Eigen::Index i = 0; i < v.size(); ++i) s << (i ? "," : "") << v(i);
+  return s.str();
+}
+
+/// Factors at `key`: one per target, each finite and above 0.
+Eigen::VectorXd factors_at(const json& j, const std::string& key, const fit_keys::Place& p,
+                           const std::string& path, std::size_t targets) {
+  const Eigen::VectorXd v = fit_keys::vector_at(j, key, p, path);
+  if (static_cast<std::size_t>(v.size()) != targets)
+    throw core::DataError(p.at(path + key) + " has " + std::to_string(v.size()) +
+                          " factors; expected one per target (" + std::to_string(targets) + ")");
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!(v(i) > 0))
+      throw core::DataError(p.at(path + key) + "[" + std::to_string(i) +
+                            "] = " + std::to_string(v(i)) + ": expected a factor above 0");
+  return v;
+}
+
+}  // namespace
+
+json sigma_calibration_json(const studies::SigmaCalibration& c,
+                            const SigmaCalibrationSource& source) {
+  std::string flags = "--drift-sigma-scale " + flag_value(c.temperatures.drift_sigma_scale);
+  json out = {{"format", kFormat},
+              {"case", source.case_name},
+              {"reduced_model", {{"dir", source.rom.string()}, {"order", source.order}}},
+              {"training_runs", c.runs},
+              {"sensors", c.sensors},
+              {"targets", c.targets},
+              {"measured_targets", c.measured_targets},
+              {"coverage", c.coverage},
+              {"truth_sigma_um", c.truth_sigma_m * core::kMicrometresPerMetre},
+              {"noise", source.noise},
+              {"drift_sigma_scale", as_vector(c.temperatures.drift_sigma_scale)},
+              {"temperatures", pass_json(c.temperatures, c)},
+              {"probe_cycle", nullptr}};
+  if (c.probed) {
+    out["probe_cycle"] = pass_json(*c.probed, c);
+    out["probe_cycle"]["every_s"] = c.drift_readings_every_s;
+    out["probed_drift_sigma_scale"] = as_vector(c.probed->drift_sigma_scale);
+    flags += " --probed-drift-sigma-scale " + flag_value(c.probed->drift_sigma_scale);
+  }
+  out["flags"] = flags;
+  return out;
+}
+
+SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
+  const json j = fit_keys::read_json(path, "a sigma_calibration.json file");
+  const fit_keys::Place p{path.string(), "",
+                          "give a sigma_calibration.json written by `thermotwin observe --train`"};
+  const json& format = fit_keys::member(j, "format", p, "");
+  if (format != kFormat)
+    throw core::DataError(p.at("format") + " = " + format.dump() + ": expected \"" + kFormat +
+                          "\"");
+  SigmaCalibrationFile f;
+  f.sensors = fit_keys::names_at(j, "sensors", p, "");
+  f.targets = fit_keys::names_at(j, "targets", p, "");
+  f.drift_sigma_scale = factors_at(j, "drift_sigma_scale", p, "", f.targets.size());
+  if (!fit_keys::member(j, "probe_cycle", p, "").is_null()) {
+    f.probe_every_s = fit_keys::number_at(j["probe_cycle"], "every_s", p, "probe_cycle.");
+    f.probed_drift_sigma_scale = factors_at(j, "probed_drift_sigma_scale", p, "", f.targets.size());
+  }
+  return f;
+}
+
+}  // namespace tt::io

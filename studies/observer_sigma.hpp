@@ -1,0 +1,70 @@
+// The physics observer's reported sigma calibrated on a user's training runs (docs/observer.md,
+// "Calibrating the sigma"): runs whose tool drift was measured throughout (displacement columns
+// named after the observer's targets) are observed as `observe` observes a run, and the factor on
+// each target's sigma is chosen that puts the share `coverage` of their samples within ±2 sigma of
+// the measured drift (solvers::drift_sigma_coverage_calibration). With a probe cycle the runs are
+// also observed reading their drift every so often, and that filter gets its own factor, scored
+// on the samples between readings. SI units.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/measured_data.hpp"
+#include "studies/observe_run.hpp"
+#include "studies/progress.hpp"
+
+namespace tt::studies {
+
+struct SigmaCalibrationInput {
+  /// the declared case, the twin (checked against it), its mesh, the set-up: as ObserveInput's
+  const core::CaseSpec* declared = nullptr;
+  const solvers::Twin* twin = nullptr;
+  const mesh::TetMesh* mesh = nullptr;
+  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
+                                       const Eigen::MatrixXd&)>
+      setup;
+  std::vector<const io::MeasuredRun*> runs;  /// the training runs, at least one
+  /// the sensors read; empty: the first run's readable sensors (observe_run's default), which
+  /// every other run must have
+  std::vector<std::string> sensors;
+  /// > 0: also calibrate the filter that reads a probe cycle of this period [s]
+  double drift_readings_every_s = 0;
+  /// white noise of the measured drift [m]: both rules take it out (the band that is to hold a
+  /// measured drift is ±2 sqrt((factor sigma)^2 + truth_sigma_m^2))
+  double truth_sigma_m = 0;
+  double coverage = 0.95;  /// the share of samples the ±2 sigma band is to hold
+  Progress progress;       /// a line per run observed; may be empty
+};
+
+/// One filter's calibration (temperatures only, or with the probe cycle).
+struct SigmaPass {
+  /// per target: the factor on the reported sigma (the coverage rule), the factor by the mean
+  /// normalised squared error (NEES = 1), the scale the runs were observed with; 1 where no
+  /// sample had a measured drift
+  Eigen::VectorXd drift_sigma_scale, nees_drift_sigma_scale, observed_with;
+  /// per run, then pooled over the runs: RMS error and the band's coverage of the measured drift
+  /// before (the sigma observed with) and after (times drift_sigma_scale / observed_with), the
+  /// band widened by truth_sigma_m
+  std::vector<solvers::DriftBandScore> before, after;
+  solvers::DriftBandScore pooled_before, pooled_after;
+};
+
+struct SigmaCalibration {
+  std::vector<std::string> runs;              /// the training runs' names
+  std::vector<std::string> sensors;           /// read, in order
+  std::vector<std::string> targets;           /// the observer's, in order
+  std::vector<std::string> measured_targets;  /// those some run measured
+  solvers::ObserverSetup setup;               /// the first run's (its noise model, for a report)
+  double coverage = 0.95, truth_sigma_m = 0;
+  SigmaPass temperatures;
+  double drift_readings_every_s = 0;
+  std::optional<SigmaPass> probed;  /// with a probe cycle
+};
+
+/// Throws DataError naming the run when a run has no displacement column named after a target, or
+/// lacks a sensor the first run gives; what observe_run throws.
+SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input);
+
+}  // namespace tt::studies
