@@ -32,6 +32,7 @@
 #include "io/fit_model_in.hpp"
 #include "io/reduced_model_io.hpp"
 #include "io/sample_stream.hpp"
+#include "io/sigma_calibration_io.hpp"
 #include "mesh/mesher.hpp"
 #include "solvers/observer_live.hpp"
 #include "studies/observe_run.hpp"
@@ -119,6 +120,8 @@ Binder observed_model(const CompensateArgs& args) {
     mesh.reset();  // no positions: every sensor at its named point
   }
   const ObserverOptions options = args.observer;
+  // A malformed --sigma-calibration is the file's fault, not the header's: read before the stream.
+  if (!options.sigma_calibration.empty()) io::read_sigma_calibration(options.sigma_calibration);
   const std::string source = args.meta.empty() ? "the stream" : args.meta.string();
   return [rom, spec, mesh, meta, options, source](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;

@@ -25,8 +25,12 @@ std::string observer_csv(const solvers::ObserverRun& r,
     for (const auto& t : target_names)
       csv << "," << t << "_drift_innovation_um," << t << "_drift_innovation_sigma_um";
   csv << ",nis,readings,window_nis,window_bound,status\n";
+  // Empty where there is no reading; else in um with the file's 9 significant digits.
   const auto um = [](double v) {
-    return std::isfinite(v) ? std::to_string(v * core::kMicrometresPerMetre) : std::string();
+    if (!std::isfinite(v)) return std::string();
+    std::ostringstream cell;
+    cell << std::setprecision(9) << v * core::kMicrometresPerMetre;
+    return cell.str();
   };
   for (Eigen::Index i = 0; i < r.times.size(); ++i) {
     csv << r.times(i);

@@ -63,7 +63,8 @@ Eigen::VectorXd factors_at(const json& j, const std::string& key, const fit_keys
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (!(v(i) > 0))
       throw core::DataError(p.at(path + key) + "[" + std::to_string(i) +
-                            "] = " + std::to_string(v(i)) + ": expected a factor above 0");
+                            "] = " + j[key][static_cast<std::size_t>(i)].dump() +
+                            ": expected a factor above 0");
   return v;
 }
 

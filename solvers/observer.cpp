@@ -207,9 +207,11 @@ double InnovationMonitor::change_start() const {
   return t_[std::min(after, t_.size() - 1)];
 }
 
-void HeldBeyondMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
-                            const Eigen::Ref<const Eigen::VectorXd>& sigma) {
-  if (!(sigmas_ > 0)) return;
+std::vector<HeldSensor> HeldBeyondMonitor::add(double t,
+                                               const Eigen::Ref<const Eigen::VectorXd>& value,
+                                               const Eigen::Ref<const Eigen::VectorXd>& sigma) {
+  std::vector<HeldSensor> now;
+  if (!(sigmas_ > 0)) return now;
   const auto n = static_cast<std::size_t>(value.size());
   beyond_since_.resize(n, std::numeric_limits<double>::quiet_NaN());
   within_onset_.resize(n, t);
@@ -236,9 +238,11 @@ void HeldBeyondMonitor::add(double t, const Eigen::Ref<const Eigen::VectorXd>& v
       raised_[k] = true;
       const double onset =
           onset_sigmas_ > 0 ? std::min(within_onset_[k], beyond_since_[k]) : beyond_since_[k];
-      held_.push_back({static_cast<int>(k), beyond_since_[k], t, onset});
+      now.push_back({static_cast<int>(k), beyond_since_[k], t, onset});
     }
   }
+  held_.insert(held_.end(), now.begin(), now.end());
+  return now;
 }
 
 namespace {
@@ -565,15 +569,12 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
     const Eigen::Index o = r_ + offsets_;
     offset = x_.segment(o, m);
     offset_sigma = p_.diagonal().segment(o, m).cwiseMax(0.0).cwiseSqrt();
-    const std::size_t before = faults_.raised().size();
-    faults_.add(t, offset, offset_sigma);
     // An offset that appears after the first consistency window was not there from the start:
     // the sensor may have failed, or the machine changed beside it (heat near one sensor is
     // followed by its offset state and leaves the innovations consistent); the filter cannot
     // tell, so it also says recalibrate, dated from the offset's crossing.
-    for (std::size_t k = before; k < faults_.raised().size(); ++k)
-      if (faults_.raised()[k].since_s > setup_.consistency.window_s)
-        earliest(faults_.raised()[k].since_s);
+    for (const HeldSensor& f : faults_.add(t, offset, offset_sigma))
+      if (f.since_s > setup_.consistency.window_s) earliest(f.since_s);
   }
   if (setup_.consistency.model_residual_sigmas > 0) {
     // Each reading against the declared model's own run, less the sensor's estimated offset; a
@@ -583,10 +584,8 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
     for (Eigen::Index k = 0; k < m; ++k)
       if (fault > 0 && std::abs(offset(k)) > fault * offset_sigma(k))
         residual(k) = std::numeric_limits<double>::quiet_NaN();
-    const std::size_t before = departures_.raised().size();
-    departures_.add(t, residual, setup_.noise.sensor_sigma_k);
-    for (std::size_t k = before; k < departures_.raised().size(); ++k)
-      earliest(departures_.raised()[k].onset_s);
+    for (const HeldSensor& d : departures_.add(t, residual, setup_.noise.sensor_sigma_k))
+      earliest(d.onset_s);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
@@ -662,11 +661,9 @@ double DriftReadingTest::add(double t, const Eigen::VectorXd& readings,
     if (std::isfinite(drift(j)))
       z(j) = (drift(j) - e.drift(j)) /
              std::sqrt(e.drift_sigma(j) * e.drift_sigma(j) + reading_sigma_m_ * reading_sigma_m_);
-  const std::size_t before = held_.raised().size();
-  held_.add(t, z, Eigen::VectorXd::Ones(drift.size()));
   double since = nan;
-  for (std::size_t k = before; k < held_.raised().size(); ++k)
-    if (std::isnan(since) || held_.raised()[k].since_s < since) since = held_.raised()[k].since_s;
+  for (const HeldSensor& h : held_.add(t, z, Eigen::VectorXd::Ones(drift.size())))
+    if (std::isnan(since) || h.since_s < since) since = h.since_s;
   return since;
 }
 

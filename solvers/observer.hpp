@@ -219,9 +219,10 @@ class HeldBeyondMonitor {
         sustain_s_(sustain_s),
         onset_sigmas_(onset_sigmas),
         exclusive_(exclusive) {}
-  /// The values and their standard deviations at time t, one per sensor.
-  void add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
-           const Eigen::Ref<const Eigen::VectorXd>& sigma);
+  /// The values and their standard deviations at time t, one per sensor; returns the sensors
+  /// raised at t (also appended to raised()).
+  std::vector<HeldSensor> add(double t, const Eigen::Ref<const Eigen::VectorXd>& value,
+                              const Eigen::Ref<const Eigen::VectorXd>& sigma);
   /// The sensors raised so far, in the order they were raised.
   const std::vector<HeldSensor>& raised() const { return held_; }
 
