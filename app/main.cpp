@@ -469,9 +469,10 @@ Command observe_line(CLI::App& cli) {
                     ->check(CLI::ExistingDirectory);
   observe
       ->add_option("--truth-sigma-um", observe_args.truth_sigma_um,
-                   "with --train: white noise of the measured drift [um]: the band that is to "
-                   "hold a measured drift is ±2 sqrt((factor sigma)^2 + this^2), so the noise does "
-                   "not widen the drift's own sigma (default 0)")
+                   "with --train: white noise of the measured drift [um]: where the errors are "
+                   "above it, the factor makes the mean normalised squared error 1 with it taken "
+                   "out (default 0: the noise counted as error, which errs wide; "
+                   "docs/observer.md)")
       ->check(non_negative_number())
       ->needs(train);
   observe

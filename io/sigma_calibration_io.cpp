@@ -31,6 +31,14 @@ json score_json(const solvers::DriftBandScore& s, const std::vector<std::string>
   return out;
 }
 
+/// Per target, which rule gave the factor written: "nees" or "coverage".
+std::vector<std::string> rules(const studies::SigmaPass& pass) {
+  std::vector<std::string> out;
+  for (const studies::SigmaRule r : pass.rules)
+    out.push_back(r == studies::SigmaRule::nees ? "nees" : "coverage");
+  return out;
+}
+
 json pass_json(const studies::SigmaPass& pass, const studies::SigmaCalibration& c) {
   json runs = json::array();
   for (std::size_t k = 0; k < c.runs.size(); ++k)
@@ -38,6 +46,8 @@ json pass_json(const studies::SigmaPass& pass, const studies::SigmaCalibration& 
                     {"before", score_json(pass.before[k], c.targets)},
                     {"after", score_json(pass.after[k], c.targets)}});
   return {{"drift_sigma_scale", as_vector(pass.drift_sigma_scale)},
+          {"rules", rules(pass)},
+          {"coverage_drift_sigma_scale", as_vector(pass.coverage_drift_sigma_scale)},
           {"nees_drift_sigma_scale", as_vector(pass.nees_drift_sigma_scale)},
           {"observed_with", as_vector(pass.observed_with)},
           {"before", score_json(pass.pooled_before, c.targets)},

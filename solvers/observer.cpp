@@ -848,8 +848,7 @@ DriftBandScore drift_band_score(const std::vector<ObserverRun>& runs,
 Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>& runs,
                                                  const std::vector<Eigen::MatrixXd>& truths,
                                                  double coverage,
-                                                 const Eigen::VectorXd& observed_with,
-                                                 double truth_sigma_m) {
+                                                 const Eigen::VectorXd& observed_with) {
   if (!(coverage > 0 && coverage < 1))
     throw core::SolverError("observer calibration: coverage " + number(coverage) +
                             ": expected 0 < coverage < 1");
@@ -862,7 +861,7 @@ Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>&
   for (Eigen::Index t = 0; t < nt; ++t) {
     std::vector<double> ratio;
     for (const auto& [e, sigma] : samples[static_cast<std::size_t>(t)])
-      ratio.push_back(band_factor(e, sigma, truth_sigma_m));
+      ratio.push_back(band_factor(e, sigma, 0));
     if (!ratio.empty()) {
       // The nearest rank: the smallest factor under which at least `coverage` of them lie.
       const auto rank = static_cast<std::size_t>(

@@ -434,7 +434,7 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
 /// How the reported drift and its band did over runs whose true drift is known, per target: the
 /// samples counted (those mean_normalised_squared_error counts), the RMS of estimate - truth [m],
 /// and the share of them within ±2 sqrt((factor sigma)^2 + truth_sigma_m^2) (factor empty: 1;
-/// truth_sigma_m the measured truth's white noise, as drift_sigma_coverage_calibration takes it);
+/// truth_sigma_m the measured truth's white noise);
 /// NaN where none counted. Same runs, truths and errors as mean_normalised_squared_error.
 struct DriftBandScore {
   Eigen::VectorXi samples;
@@ -448,16 +448,12 @@ DriftBandScore drift_band_score(const std::vector<ObserverRun>& runs,
 /// within ±2 sigma of their true drift: per target the `coverage` quantile of |estimate - truth| /
 /// (2 sigma) times `observed_with` (empty: 1); 1 where no sample counted. Unlike
 /// drift_sigma_calibration it aims at the band's coverage itself, which errors with heavier
-/// tails than a Gaussian's miss at a mean normalised squared error of 1. With truth_sigma_m (a
-/// measured truth's white noise) the band that is to hold the measured truth is ±2 sqrt((factor
-/// sigma)^2 + truth_sigma_m^2), so that the noise does not widen the sigma of the drift itself:
-/// per sample the factor sqrt(max(0, (e / 2)^2 - truth_sigma_m^2)) / sigma; 1 where the quantile
-/// is 0 (the noise alone holds the errors). Same runs and truths, same sizes and errors as
-/// mean_normalised_squared_error; throws SolverError for a coverage outside (0, 1).
+/// tails than a Gaussian's miss at a mean normalised squared error of 1. Same runs and truths,
+/// same sizes and errors as mean_normalised_squared_error; throws SolverError for a coverage
+/// outside (0, 1).
 Eigen::VectorXd drift_sigma_coverage_calibration(const std::vector<ObserverRun>& runs,
                                                  const std::vector<Eigen::MatrixXd>& truths,
                                                  double coverage = 0.95,
-                                                 const Eigen::VectorXd& observed_with = {},
-                                                 double truth_sigma_m = 0);
+                                                 const Eigen::VectorXd& observed_with = {});
 
 }  // namespace tt::solvers

@@ -23,10 +23,24 @@ Eigen::VectorXd scale_or_ones(const Eigen::VectorXd& scale, Eigen::Index targets
 SigmaPass calibrate_pass(const Observed& o, const SigmaCalibrationInput& input) {
   SigmaPass pass;
   pass.observed_with = o.observed_with;
-  pass.drift_sigma_scale = solvers::drift_sigma_coverage_calibration(
-      o.runs, o.truths, input.coverage, o.observed_with, input.truth_sigma_m);
+  pass.coverage_drift_sigma_scale =
+      solvers::drift_sigma_coverage_calibration(o.runs, o.truths, input.coverage, o.observed_with);
   pass.nees_drift_sigma_scale =
       solvers::drift_sigma_calibration(o.runs, o.truths, input.truth_sigma_m, o.observed_with);
+  pass.drift_sigma_scale = pass.coverage_drift_sigma_scale;
+  pass.rules.assign(static_cast<std::size_t>(pass.drift_sigma_scale.size()), SigmaRule::coverage);
+  if (input.truth_sigma_m > 0) {
+    // The NEES rule with the noise taken out, where the errors are above the noise; where they
+    // are not, the measured drift cannot place the band under its noise, and the coverage rule
+    // (the noise counted as error) errs wide.
+    const Eigen::VectorXd nees =
+        solvers::mean_normalised_squared_error(o.runs, o.truths, input.truth_sigma_m);
+    for (Eigen::Index t = 0; t < nees.size(); ++t)
+      if (nees(t) > 0) {
+        pass.drift_sigma_scale(t) = pass.nees_drift_sigma_scale(t);
+        pass.rules[static_cast<std::size_t>(t)] = SigmaRule::nees;
+      }
+  }
   const Eigen::VectorXd factor = pass.drift_sigma_scale.cwiseQuotient(o.observed_with);
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(factor.size());
   const double noise = input.truth_sigma_m;

@@ -2,9 +2,13 @@
 // "Calibrating the sigma"): runs whose tool drift was measured throughout (displacement columns
 // named after the observer's targets) are observed as `observe` observes a run, and the factor on
 // each target's sigma is chosen that puts the share `coverage` of their samples within ±2 sigma of
-// the measured drift (solvers::drift_sigma_coverage_calibration). With a probe cycle the runs are
-// also observed reading their drift every so often, and that filter gets its own factor, scored
-// on the samples between readings. SI units.
+// the measured drift (solvers::drift_sigma_coverage_calibration). When the measured drift's own
+// noise is declared, the factor is instead the one that makes the mean normalised squared error 1
+// with that noise taken out (solvers::drift_sigma_calibration), where the errors are above the
+// noise: subtracting the noise sample by sample under the quantile made the band too narrow on
+// held-out runs (docs/observer.md). With a
+// probe cycle the runs are also observed reading their drift every so often, and that filter gets
+// its own factor, scored on the samples between readings. SI units.
 #pragma once
 
 #include <optional>
@@ -31,19 +35,27 @@ struct SigmaCalibrationInput {
   std::vector<std::string> sensors;
   /// > 0: also calibrate the filter that reads a probe cycle of this period [s]
   double drift_readings_every_s = 0;
-  /// white noise of the measured drift [m]: both rules take it out (the band that is to hold a
-  /// measured drift is ±2 sqrt((factor sigma)^2 + truth_sigma_m^2))
+  /// white noise of the measured drift [m] (0: counted as error): where the errors are above it,
+  /// the NEES rule with it taken out gives the factor; the scores' band for the measured drift is
+  /// ±2 sqrt((factor sigma)^2 + truth_sigma_m^2)
   double truth_sigma_m = 0;
   double coverage = 0.95;  /// the share of samples the ±2 sigma band is to hold
   Progress progress;       /// a line per run observed; may be empty
 };
 
+/// Which rule gave a target's factor.
+enum class SigmaRule { coverage, nees };
+
 /// One filter's calibration (temperatures only, or with the probe cycle).
 struct SigmaPass {
-  /// per target: the factor on the reported sigma (the coverage rule), the factor by the mean
-  /// normalised squared error (NEES = 1), the scale the runs were observed with; 1 where no
+  /// per target: the factor on the reported sigma (the coverage rule's; with truth_sigma_m the
+  /// NEES rule's where the errors are above that noise), the coverage rule's (the quantile, the
+  /// noise counted as error), the NEES rule's (mean normalised squared error 1, the noise taken
+  /// out; 1 where the errors are within it), the scale the runs were observed with; 1 where no
   /// sample had a measured drift
-  Eigen::VectorXd drift_sigma_scale, nees_drift_sigma_scale, observed_with;
+  Eigen::VectorXd drift_sigma_scale, coverage_drift_sigma_scale, nees_drift_sigma_scale,
+      observed_with;
+  std::vector<SigmaRule> rules;  /// per target: the rule of drift_sigma_scale
   /// per run, then pooled over the runs: RMS error and the band's coverage of the measured drift
   /// before (the sigma observed with) and after (times drift_sigma_scale / observed_with), the
   /// band widened by truth_sigma_m

@@ -574,6 +574,28 @@ double band_quantile(const std::vector<fs::path>& observed,
   return ratio[static_cast<std::size_t>(std::ceil(coverage * ratio.size() - 1e-9)) - 1];
 }
 
+/// Per target, sqrt of the mean of ((predicted - measured)^2 - noise^2) / sigma^2 over the samples
+/// of observer.csv files (sigma > 0), or 0 when that mean is not above 0: the NEES rule's factor
+/// with the measured drift's noise taken out, worked out here from the written columns [um].
+double nees_factor(const std::vector<fs::path>& observed, const std::vector<io::MeasuredRun>& runs,
+                   const std::string& target, double noise_um) {
+  double sum = 0, n = 0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const auto rows = tt::test::csv_rows(observed[r] / "observer.csv");
+    const auto& d = runs[r].displacements;
+    const auto p = std::find_if(d.begin(), d.end(), [&](const auto& x) { return x.id == target; });
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const double sigma = std::stod(rows[i].at(target + "_sigma_um"));
+      const double e = std::stod(rows[i].at(target + "_predicted_um")) -
+                       1e6 * runs[r].displacement(static_cast<Eigen::Index>(i), p - d.begin());
+      if (!(sigma > 0)) continue;
+      sum += (e * e - noise_um * noise_um) / (sigma * sigma);
+      n += 1;
+    }
+  }
+  return sum > 0 ? std::sqrt(sum / n) : 0.0;
+}
+
 /// The share of a run's samples whose measured drift lies within ±2 sigma of observer.csv's.
 double band_coverage(const fs::path& observed, const io::MeasuredRun& run,
                      const std::string& target) {
@@ -644,9 +666,9 @@ TEST(ObserveCli, TheSigmaIsCalibratedOnTrainingRunsWhoseDriftWasMeasured) {
     EXPECT_NEAR(cal["drift_sigma_scale"][t].get<double>(), expected, 1e-6 * expected) << targets[t];
     EXPECT_GE(cal["temperatures"]["after"][targets[t]]["coverage"].get<double>(), 0.95);
   }
-  // The generator's 0.08 um probe noise declared (--truth-sigma-um): the noise takes its part of
-  // the band, so each factor is smaller (dx, whose drift is near 0, most); a probe cycle gets its
-  // own factors, scored between its readings.
+  // The generator's 0.08 um probe noise declared (--truth-sigma-um): the factor is the NEES
+  // rule's with the noise taken out, worked out here too, where the errors are above the noise,
+  // else the coverage rule's; a probe cycle gets its own factors, scored between its readings.
   ASSERT_EQ(
       observe({"--train", run_a, "--train", run_b, "--truth-sigma-um", "0.08",
                "--drift-readings-every-s", "1800", "--out", (dir / "noisy").string(), "--quiet"}),
@@ -655,12 +677,17 @@ TEST(ObserveCli, TheSigmaIsCalibratedOnTrainingRunsWhoseDriftWasMeasured) {
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "noisy"));
   const auto noisy = nlohmann::json::parse(std::ifstream(dir / "noisy" / "sigma_calibration.json"));
   EXPECT_EQ(noisy["truth_sigma_um"], 0.08);
-  for (std::size_t t = 0; t < targets.size(); ++t)
-    EXPECT_LT(noisy["drift_sigma_scale"][t].get<double>(),
-              cal["drift_sigma_scale"][t].get<double>())
+  EXPECT_EQ(cal["temperatures"]["rules"], nlohmann::json({"coverage", "coverage", "coverage"}));
+  EXPECT_EQ(noisy["temperatures"]["coverage_drift_sigma_scale"], cal["drift_sigma_scale"]);
+  for (std::size_t t = 0; t < targets.size(); ++t) {
+    // The NEES rule where the errors are above the noise (0: within it), else the coverage rule.
+    const double nees =
+        nees_factor({dir / "plain_a", dir / "plain_b"}, {runs[0], runs[1]}, targets[t], 0.08);
+    const double expected = nees > 0 ? nees : cal["drift_sigma_scale"][t].get<double>();
+    EXPECT_EQ(noisy["temperatures"]["rules"][t], nees > 0 ? "nees" : "coverage") << targets[t];
+    EXPECT_NEAR(noisy["drift_sigma_scale"][t].get<double>(), expected, 1e-6 * expected)
         << targets[t];
-  EXPECT_LT(noisy["drift_sigma_scale"][0].get<double>(),
-            0.5 * cal["drift_sigma_scale"][0].get<double>());
+  }
   const auto& probe = noisy["probe_cycle"];
   ASSERT_TRUE(probe.is_object());
   EXPECT_EQ(probe["every_s"], 1800.0);

@@ -1,0 +1,250 @@
+// The observer's sigma calibrated as `observe --train` calibrates it (studies::
+// calibrate_observer_sigma), judged on held-out runs of the calibration generator: the ±2 sigma
+// band's coverage of the true drift and of the measured one, before (the observer's own sigma)
+// and after (times the calibrated factor), on clean held-out runs and on runs with an undeclared
+// effect (one of each kind of the generator's catalogue). The reference is the uncalibrated
+// sigma of the same runs, measured in the same run of the bench.
+//
+//   bench_studies_observer_sigma CASE SENSORS TRAIN HELD HOURS SEED [PROBE_EVERY_S]
+//
+// SENSORS: comma-separated named points the generator reads and the observer reads; TRAIN and
+// HELD: how many clean runs train and are held out; HOURS: each run's random duty cycle;
+// PROBE_EVERY_S > 0: also a probe cycle (the runs' TCP probes read every so often, their noise
+// declared: --drift-reading-sigma-um 0.08), its own factors, scored between its readings. The
+// training runs' probes carry the generator's 0.08 um noise, declared as --truth-sigma-um declares
+// it (and, beside it, not declared).
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calibration/effects.hpp"
+#include "calibration/generator.hpp"
+#include "calibration/model.hpp"
+#include "core/rng.hpp"
+#include "io/case_reader.hpp"
+#include "mesh/mesher.hpp"
+#include "solvers/observer.hpp"
+#include "solvers/twin.hpp"
+#include "studies/observer_sigma.hpp"
+
+namespace {
+
+using namespace tt;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream s(text);
+  for (std::string item; std::getline(s, item, ',');) out.push_back(item);
+  return out;
+}
+
+/// The command line's noise model (app/observer_options: ObserverOptions' defaults).
+solvers::ObserverSetup cli_setup(const solvers::Twin& twin, const core::CaseSpec& spec,
+                                 const std::vector<std::string>& sensors,
+                                 const Eigen::MatrixXd& rows, const Eigen::VectorXd& scale) {
+  solvers::ObserverNoise n;
+  n.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.05);
+  n.heat_walk_w = 4;
+  n.heat_initial_w = 2;
+  n.air_walk_k = 0.5;
+  n.air_initial_k = 0.3;
+  n.sensor_offset_initial_k = 0.5;
+  n.sensor_offset_walk_k = 0.05;
+  n.drift_relative_sigma = 0.04;
+  n.drift_reading_sigma_m = 0.08e-6;  // the generator's probes, as a user declares them
+  solvers::ObserverSetup s = solvers::twin_observer_setup(twin, spec, sensors, n, rows);
+  s.noise.drift_sigma_scale = scale;
+  return s;
+}
+
+/// A generated run: what the sensors and probes read, and the true drift (noise-free).
+struct Generated {
+  std::string kind;
+  io::MeasuredRun measured;
+  Eigen::MatrixXd truth;  /// #samples x the observer's targets [m], NaN where not known
+};
+
+/// The coverage of held-out runs, pooled: per target before and after.
+struct Pooled {
+  std::vector<solvers::ObserverRun> runs;
+  std::vector<Eigen::MatrixXd> truths, measured;
+};
+
+void report(const std::string& what, const Pooled& p, const Eigen::VectorXd& factor, double noise_m,
+            const std::vector<std::string>& targets) {
+  if (p.runs.empty()) return;
+  const auto before = solvers::drift_band_score(p.runs, p.truths);
+  const auto after = solvers::drift_band_score(p.runs, p.truths, factor);
+  const auto measured_after = solvers::drift_band_score(p.runs, p.measured, factor, noise_m);
+  for (std::size_t t = 0; t < targets.size(); ++t) {
+    const auto k = static_cast<Eigen::Index>(t);
+    if (before.samples(k) == 0) continue;
+    std::printf("%s | %s | %d | %.4f | %.1f %% | %.1f %% | %.1f %% | %.3f\n", what.c_str(),
+                targets[t].c_str(), before.samples(k), 1e6 * before.rms_error_m(k),
+                100 * before.coverage(k), 100 * after.coverage(k), 100 * measured_after.coverage(k),
+                factor(k));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    if (argc < 7) {
+      std::cerr << "usage: bench_studies_observer_sigma CASE SENSORS TRAIN HELD HOURS SEED "
+                   "[PROBE_EVERY_S]\n";
+      return 2;
+    }
+    const auto t_all = Clock::now();
+    const core::CaseSpec spec = io::read_case(argv[1]);
+    const std::vector<std::string> sensors = split(argv[2]);
+    const int train = std::stoi(argv[3]), held = std::stoi(argv[4]);
+    const double hours = std::stod(argv[5]);
+    const auto seed = static_cast<std::uint64_t>(std::stoull(argv[6]));
+    const double probe_every_s = argc > 7 ? std::stod(argv[7]) : 0;
+    const mesh::TetMesh mesh = mesh::mesh_case(spec);
+    const solvers::FullThermalSystem full = solvers::thermal_system(mesh, spec);
+    const solvers::Twin twin = solvers::case_twin(mesh, spec, full);
+    std::printf("case %s: %ld nodes, twin order %ld (%.0f s)\n", argv[1],
+                static_cast<long>(mesh.nodes.rows()), static_cast<long>(twin.model.states()),
+                seconds_since(t_all));
+
+    // The generator's runs: TRAIN + HELD clean, then one of each effect kind.
+    const auto t_gen = Clock::now();
+    calibration::GeneratorOptions gopt;
+    const core::CaseSpec gen = calibration::generator_case(spec, gopt);
+    const mesh::TetMesh gmesh = mesh::mesh_case(gen);
+    calibration::Instrumentation inst;
+    inst.sensor_points = sensors;
+    std::mt19937_64 rng = core::generator(seed, 0);
+    std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
+    for (int k = 0; k < train + held; ++k)
+      plan.emplace_back("clean", calibration::InjectedEffect{});
+    for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
+      const auto kind = static_cast<calibration::EffectKind>(k);
+      plan.emplace_back(calibration::kind_name(kind),
+                        calibration::random_effect(kind, spec, gmesh, sensors, rng));
+    }
+    std::vector<Generated> runs;
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+      const auto& [kind, effect] = plan[k];
+      const core::DutyCycle duty = calibration::random_duty_cycle(hours, rng);
+      const core::CaseSpec truth_spec =
+          calibration::truth_case(gen, effect, duty, static_cast<int>(k));
+      const std::string name = "gen_" + std::to_string(k);
+      const io::MeasuredRun clean =
+          calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
+      Generated g{kind, calibration::with_noise(clean, gopt, rng), clean.displacement};
+      g.measured.folder = name;
+      runs.push_back(std::move(g));
+      std::printf("%s: %s (%.0f s)\n", name.c_str(), kind.c_str(), seconds_since(t_gen));
+      std::fflush(stdout);
+    }
+
+    // The calibration on the training runs, as observe --train runs it.
+    const auto setup_with = [&](const Eigen::VectorXd& scale) {
+      return [&twin, scale](const core::CaseSpec& c, const std::vector<std::string>& s,
+                            const Eigen::MatrixXd& rows) {
+        return cli_setup(twin, c, s, rows, scale);
+      };
+    };
+    studies::SigmaCalibrationInput input{.declared = &spec,
+                                         .twin = &twin,
+                                         .mesh = &mesh,
+                                         .setup = setup_with({}),
+                                         .runs = {},
+                                         .sensors = sensors,
+                                         .drift_readings_every_s = probe_every_s,
+                                         .truth_sigma_m = gopt.noise_displacement_m,
+                                         .coverage = 0.95,
+                                         .progress = {}};
+    for (int k = 0; k < train; ++k)
+      input.runs.push_back(&runs[static_cast<std::size_t>(k)].measured);
+    const auto t_cal = Clock::now();
+    const studies::SigmaCalibration cal = studies::calibrate_observer_sigma(input);
+    studies::SigmaCalibrationInput undeclared = input;
+    undeclared.truth_sigma_m = 0;
+    const studies::SigmaCalibration cal_plain = studies::calibrate_observer_sigma(undeclared);
+    std::printf("calibration on %d training runs (%.0f s): factors", train, seconds_since(t_cal));
+    for (Eigen::Index t = 0; t < cal.temperatures.drift_sigma_scale.size(); ++t)
+      std::printf(" %s %.4g", cal.targets[static_cast<std::size_t>(t)].c_str(),
+                  cal.temperatures.drift_sigma_scale(t));
+    std::printf(" (noise not declared:");
+    for (Eigen::Index t = 0; t < cal_plain.temperatures.drift_sigma_scale.size(); ++t)
+      std::printf(" %.4g", cal_plain.temperatures.drift_sigma_scale(t));
+    std::printf(")\n");
+    if (cal.probed) {
+      std::printf("with a probe cycle every %g s: factors", probe_every_s);
+      for (Eigen::Index t = 0; t < cal.probed->drift_sigma_scale.size(); ++t)
+        std::printf(" %.4g", cal.probed->drift_sigma_scale(t));
+      std::printf("\n");
+    }
+
+    // The held-out runs, observed as observe --data observes them, scored before and after.
+    Pooled clean, effect, clean_probed, effect_probed;
+    const auto t_obs = Clock::now();
+    for (std::size_t k = static_cast<std::size_t>(train); k < runs.size(); ++k) {
+      const Generated& g = runs[k];
+      studies::ObserveInput in{&spec, &g.measured, &twin, sensors, setup_with({}), &mesh, 0.0};
+      const studies::ObserveReport r = studies::observe_run(in);
+      Eigen::MatrixXd truth = Eigen::MatrixXd::Constant(
+          r.result.drift.rows(), r.result.drift.cols(), std::numeric_limits<double>::quiet_NaN());
+      truth.leftCols(3) = g.truth.leftCols(3);
+      const Eigen::MatrixXd measured =
+          studies::drift_columns(g.measured, r.setup.target_names, "scored").readings;
+      Pooled& p = g.kind == "clean" ? clean : effect;
+      p.runs.push_back(r.result);
+      p.truths.push_back(truth);
+      p.measured.push_back(measured);
+      if (probe_every_s > 0) {
+        in.drift_readings_every_s = probe_every_s;
+        const studies::ObserveReport rp = studies::observe_run(in);
+        // Scored between readings, as the calibration scores them.
+        const studies::DriftReadings read =
+            studies::drift_readings(g.measured, rp.setup.target_names, probe_every_s);
+        Eigen::MatrixXd between = truth, between_measured = measured;
+        for (Eigen::Index i = 0; i < truth.rows(); ++i)
+          if (read.readings.row(i).array().isFinite().any()) {
+            between.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+            between_measured.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+          }
+        Pooled& pp = g.kind == "clean" ? clean_probed : effect_probed;
+        pp.runs.push_back(rp.result);
+        pp.truths.push_back(between);
+        pp.measured.push_back(between_measured);
+      }
+    }
+    std::printf("observed %zu held-out runs (%.0f s)\n\n", runs.size() - train,
+                seconds_since(t_obs));
+    std::printf(
+        "runs | target | samples | RMS error [um] | true drift in ±2σ, uncalibrated | "
+        "calibrated | measured drift in the calibrated band (noise added) | factor\n");
+    report("held-out clean, noise declared", clean, cal.temperatures.drift_sigma_scale,
+           gopt.noise_displacement_m, cal.targets);
+    report("held-out clean, noise not declared", clean, cal_plain.temperatures.drift_sigma_scale, 0,
+           cal.targets);
+    report("effect runs, noise declared", effect, cal.temperatures.drift_sigma_scale,
+           gopt.noise_displacement_m, cal.targets);
+    report("effect runs, noise not declared", effect, cal_plain.temperatures.drift_sigma_scale, 0,
+           cal.targets);
+    if (cal.probed) {
+      report("held-out clean, probe cycle, noise declared", clean_probed,
+             cal.probed->drift_sigma_scale, gopt.noise_displacement_m, cal.targets);
+      report("effect runs, probe cycle, noise declared", effect_probed,
+             cal.probed->drift_sigma_scale, gopt.noise_displacement_m, cal.targets);
+    }
+    std::printf("total %.0f s\n", seconds_since(t_all));
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_studies_observer_sigma: " << e.what() << "\n";
+    return 1;
+  }
+}
