@@ -3,7 +3,7 @@
 // speed (its speed_rpm column) as the duty cycle and its sensors' readings, that predicts the
 // drift at the tool (and the axis points) with its standard deviation and says when the
 // innovations stop fitting the noise model (status `recalibrate`, with the time it started).
-//   1. the case and the run, the output claimed;
+//   1. the case, the run and the training runs, the output claimed;
 //   2. the reduced model, checked against the case and its mesh;
 //   3. with --train, the factors on the reported sigma calibrated on runs whose drift was measured
 //      (studies/observer_sigma.hpp; sigma_calibration.json); the study (studies/observe_run.hpp):
@@ -68,10 +68,9 @@ void print_calibration(const studies::SigmaCalibration& cal) {
 
 /// The sigma calibrated on the training runs (sigma_calibration.json into `dir`); `options` then
 /// carry its factors and sensors, for the run observed after it.
-void calibrate_sigma(const ObserveArgs& args, const ObserverInputs& in, ObserverOptions& options,
+void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>& runs,
+                     const ObserverInputs& in, ObserverOptions& options,
                      const std::filesystem::path& dir) {
-  std::vector<io::MeasuredRun> runs;
-  for (const auto& path : args.train) runs.push_back(io::read_measured_run(path));
   std::vector<const io::MeasuredRun*> training;
   for (const auto& r : runs) training.push_back(&r);
   studies::Progress progress;
@@ -131,10 +130,12 @@ void print_observed(const studies::ObserveReport& report, bool quiet) {
 }  // namespace
 
 int observe_command(const ObserveArgs& args) {
-  // 1. The case and the run, the output claimed.
+  // 1. The case, the run and the training runs, the output claimed.
   const core::CaseSpec declared = io::read_case(args.case_file);
   std::optional<io::MeasuredRun> run;
   if (!args.data.empty()) run = io::read_measured_run(args.data);
+  std::vector<io::MeasuredRun> training;
+  for (const auto& path : args.train) training.push_back(io::read_measured_run(path));
   std::vector<std::filesystem::path> inputs = io::case_input_files(declared);
   inputs.push_back(args.rom);
   if (run) inputs.push_back(args.data);
@@ -152,8 +153,8 @@ int observe_command(const ObserveArgs& args) {
                          const Eigen::MatrixXd& rows) {
     return observer_setup(options, rom.twin, spec, sensors, rows);
   };
-  if (!args.train.empty())
-    calibrate_sigma(args, {&declared, &rom.twin, &mesh, setup}, options, out.path());
+  if (!training.empty())
+    calibrate_sigma(args, training, {&declared, &rom.twin, &mesh, setup}, options, out.path());
   std::optional<studies::ObserveReport> report;
   if (run)
     report = studies::observe_run({&declared, &*run, &rom.twin, options.sensors, setup, &mesh,
