@@ -208,14 +208,10 @@ int main(int argc, char** argv) {
         in.drift_readings_every_s = probe_every_s;
         const studies::ObserveReport rp = studies::observe_run(in);
         // Scored between readings, as the calibration scores them.
-        const studies::DriftReadings read =
-            studies::drift_readings(g.measured, rp.setup.target_names, probe_every_s);
-        Eigen::MatrixXd between = truth, between_measured = measured;
-        for (Eigen::Index i = 0; i < truth.rows(); ++i)
-          if (read.readings.row(i).array().isFinite().any()) {
-            between.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-            between_measured.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-          }
+        const Eigen::MatrixXd read =
+            studies::drift_readings(g.measured, rp.setup.target_names, probe_every_s).readings;
+        const Eigen::MatrixXd between = studies::between_readings(truth, read);
+        const Eigen::MatrixXd between_measured = studies::between_readings(measured, read);
         Pooled& pp = g.kind == "clean" ? clean_probed : effect_probed;
         pp.runs.push_back(rp.result);
         pp.truths.push_back(between);

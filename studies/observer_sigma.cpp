@@ -55,6 +55,14 @@ SigmaPass calibrate_pass(const Observed& o, const SigmaCalibrationInput& input) 
 
 }  // namespace
 
+Eigen::MatrixXd between_readings(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& read) {
+  Eigen::MatrixXd between = truth;
+  for (Eigen::Index i = 0; i < between.rows(); ++i)
+    if (read.row(i).array().isFinite().any())
+      between.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+  return between;
+}
+
 SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input) {
   if (input.runs.empty())
     throw core::DataError("sigma calibration: no training run (give at least one)");
@@ -97,13 +105,8 @@ SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input) {
     if (input.drift_readings_every_s <= 0) continue;
     in.drift_readings_every_s = input.drift_readings_every_s;
     probed.runs.push_back(observe_run(in).result);
-    // Scored between readings: at a reading the filter is pulled to the very value it is scored on.
-    Eigen::MatrixXd between = truth.readings;
-    const DriftReadings read = drift_readings(*run, targets, input.drift_readings_every_s);
-    for (Eigen::Index i = 0; i < between.rows(); ++i)
-      if (read.readings.row(i).array().isFinite().any())
-        between.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-    probed.truths.push_back(between);
+    probed.truths.push_back(between_readings(
+        truth.readings, drift_readings(*run, targets, input.drift_readings_every_s).readings));
   }
   for (std::size_t t = 0; t < cal.targets.size(); ++t)
     if (measured[t]) cal.measured_targets.push_back(cal.targets[t]);

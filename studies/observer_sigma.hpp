@@ -75,6 +75,11 @@ struct SigmaCalibration {
   std::optional<SigmaPass> probed;  /// with a probe cycle
 };
 
+/// `truth` (#samples x #targets) with NaN at every sample where `read` (drift readings of the same
+/// samples, NaN where none) holds a reading: a probe-cycle filter is scored between its readings,
+/// since at a reading it is pulled to the very value it would be scored on.
+Eigen::MatrixXd between_readings(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& read);
+
 /// Throws DataError naming the run when a run has no displacement column named after a target, or
 /// lacks a sensor the first run gives; what observe_run throws.
 SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input);
