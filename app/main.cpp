@@ -398,7 +398,11 @@ Command compensate_line(CLI::App& cli) {
                    "--initial-temperature-c says otherwise")
       ->check(CLI::ExistingFile)
       ->needs(compensate_rom);
+  // The observer's options need a reduced model: with a fitted model they would be ignored.
+  const std::size_t before_observer = compensate->get_options().size();
   add_observer_options(*compensate, compensate_args.observer);
+  const std::vector<CLI::Option*> options = compensate->get_options();
+  for (std::size_t k = before_observer; k < options.size(); ++k) options[k]->needs(compensate_rom);
   add_stream_options(*compensate, compensate_args);
   return {compensate, [args] {
             const CompensateArgs& a = *args;

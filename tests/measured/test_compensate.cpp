@@ -1,7 +1,8 @@
 // thermotwin compensate end to end: a measured run fitted with fit --data --quick, then a held-out
 // run replayed through compensate, from a finished file and from one that grows while it is
 // followed, must give compensation.csv's predictions; a blank cell is held and flagged, and a
-// stream that lacks a model's column is refused with the column named.
+// stream that lacks a model's column is refused with the column named, and the observer's options
+// with a fitted model are refused.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -203,4 +204,19 @@ TEST(Compensate, StreamLackingAModelColumnIsRefusedNamingIt) {
             0);
   EXPECT_NE(read_text(log).find("column 'b' is missing"), std::string::npos) << read_text(log);
   EXPECT_FALSE(fs::exists(out));
+  // The physics observer's options need a reduced model: with a fitted model they are refused,
+  // not ignored.
+  for (const std::vector<std::string> flag :
+       {std::vector<std::string>{"--sigma-calibration", stream.string()},
+        std::vector<std::string>{"--widen-on-inconsistency"},
+        std::vector<std::string>{"--drift-readings-every-s", "1800"}}) {
+    std::vector<std::string> args{"compensate", "--model",       (f.fit / "fit.json").string(),
+                                  "--in",       stream.string(), "--until-eof",
+                                  "--out",      out.string()};
+    args.insert(args.end(), flag.begin(), flag.end());
+    EXPECT_NE(run(args, {}, log), 0) << flag.front();
+    EXPECT_NE(read_text(log).find(flag.front() + " requires --rom"), std::string::npos)
+        << read_text(log);
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
