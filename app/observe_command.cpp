@@ -11,7 +11,6 @@
 //      that is a named point of the model), the observer's set-up (app/observer_options.hpp, with
 //      the calibrated factors), the run through the filter;
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
-#include <functional>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -35,20 +34,6 @@ namespace tt::app {
 
 namespace {
 
-/// What the observer runs on: the declared case, the reduced model, its mesh, the set-up.
-struct ObserverInputs {
-  const core::CaseSpec* declared = nullptr;
-  const solvers::Twin* twin = nullptr;
-  const mesh::TetMesh* mesh = nullptr;
-  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
-                                       const Eigen::MatrixXd&)>
-      setup;
-};
-
-std::vector<double> as_vector(const Eigen::VectorXd& v) {
-  return std::vector<double>(v.data(), v.data() + v.size());
-}
-
 /// The summary of a sigma calibration on stderr: the factors and the band's coverage before and
 /// after, per measured target.
 void print_calibration(const studies::SigmaCalibration& cal) {
@@ -66,38 +51,30 @@ void print_calibration(const studies::SigmaCalibration& cal) {
   if (cal.probed) pass("probed sigma", *cal.probed);
 }
 
-/// The sigma calibrated on the training runs (sigma_calibration.json into `dir`); `options` then
-/// carry its factors and sensors, for the run observed after it.
+/// The sigma calibrated on the training runs (sigma_calibration.json into `dir`), `input` holding
+/// the case, the reduced model, its mesh and the set-up; `options` then carry its factors and
+/// sensors, for the run observed after it.
 void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>& runs,
-                     const ObserverInputs& in, ObserverOptions& options,
+                     studies::SigmaCalibrationInput input, ObserverOptions& options,
                      const std::filesystem::path& dir) {
-  std::vector<const io::MeasuredRun*> training;
-  for (const auto& r : runs) training.push_back(&r);
-  studies::Progress progress;
+  for (const auto& r : runs) input.runs.push_back(&r);
+  input.sensors = options.sensors;
+  input.drift_readings_every_s = options.drift_readings_every_s;
+  input.truth_sigma_m = core::kMetresPerMicrometre * args.truth_sigma_um;
+  input.coverage = args.coverage;
   if (!args.quiet)
-    progress = [](const std::string& line) {
+    input.progress = [](const std::string& line) {
       std::cerr << "thermotwin: observe: " << line << "\n";
     };
-  const studies::SigmaCalibrationInput input{
-      .declared = in.declared,
-      .twin = in.twin,
-      .mesh = in.mesh,
-      .setup = in.setup,
-      .runs = training,
-      .sensors = options.sensors,
-      .drift_readings_every_s = options.drift_readings_every_s,
-      .truth_sigma_m = core::kMetresPerMicrometre * args.truth_sigma_um,
-      .coverage = args.coverage,
-      .progress = progress};
   const studies::SigmaCalibration cal = studies::calibrate_observer_sigma(input);
   io::write_json(dir / "sigma_calibration.json",
-                 io::sigma_calibration_json(cal, {in.declared->name, in.twin->model.states(),
+                 io::sigma_calibration_json(cal, {input.declared->name, input.twin->model.states(),
                                                   args.rom, observer_noise_json(cal.setup)}));
   options.sensors = cal.sensors;
   options.sigma_calibration.clear();
-  options.drift_sigma_scale = as_vector(cal.temperatures.drift_sigma_scale);
+  options.drift_sigma_scale = io::as_vector(cal.temperatures.drift_sigma_scale);
   options.probed_drift_sigma_scale.clear();
-  if (cal.probed) options.probed_drift_sigma_scale = as_vector(cal.probed->drift_sigma_scale);
+  if (cal.probed) options.probed_drift_sigma_scale = io::as_vector(cal.probed->drift_sigma_scale);
   if (!args.quiet) print_calibration(cal);
 }
 
@@ -153,8 +130,14 @@ int observe_command(const ObserveArgs& args) {
                          const Eigen::MatrixXd& rows) {
     return observer_setup(options, rom.twin, spec, sensors, rows);
   };
-  if (!training.empty())
-    calibrate_sigma(args, training, {&declared, &rom.twin, &mesh, setup}, options, out.path());
+  if (!training.empty()) {
+    studies::SigmaCalibrationInput input;
+    input.declared = &declared;
+    input.twin = &rom.twin;
+    input.mesh = &mesh;
+    input.setup = setup;
+    calibrate_sigma(args, training, input, options, out.path());
+  }
   std::optional<studies::ObserveReport> report;
   if (run)
     report = studies::observe_run({&declared, &*run, &rom.twin, options.sensors, setup, &mesh,

@@ -4,10 +4,18 @@
 
 #include "app/cli_numbers.hpp"
 #include "core/errors.hpp"
+#include "io/reports.hpp"
 #include "io/sigma_calibration_io.hpp"
 
 namespace tt::app {
 namespace {
+
+/// "a,b,c".
+std::string comma_joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& s : names) out += (out.empty() ? "" : ",") + s;
+  return out;
+}
 
 /// One value per name from an option: one value for all, or one each.
 Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<std::string>& names,
@@ -15,10 +23,8 @@ Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<st
   const auto n = static_cast<Eigen::Index>(names.size());
   if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
   if (values.size() == names.size()) return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
-  std::string ids;
-  for (const auto& s : names) ids += (ids.empty() ? "" : ",") + s;
   throw core::DataError(option + ": " + std::to_string(values.size()) + " values for " +
-                        std::to_string(names.size()) + " " + what + " (" + ids +
+                        std::to_string(names.size()) + " " + what + " (" + comma_joined(names) +
                         "); expected one value for all or one per " + what + " in that order");
 }
 
@@ -33,10 +39,6 @@ Eigen::VectorXd expansion_sigmas(const std::vector<double>& values,
         "--expansion-relative-sigma: the reduced model keeps no drift rows per material (written "
         "before they were); rebuild it with `thermotwin reduce`");
   return per_name(values, setup.expansion_materials, "--expansion-relative-sigma", "materials");
-}
-
-std::vector<double> as_vector(const Eigen::VectorXd& v) {
-  return std::vector<double>(v.data(), v.data() + v.size());
 }
 
 /// Each material's expansion relative sigma by name ({} when none).
@@ -83,19 +85,14 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
         "--sigma-calibration " + file +
         ": give it or --drift-sigma-scale / --probed-drift-sigma-scale, not both");
   const io::SigmaCalibrationFile f = io::read_sigma_calibration(o.sigma_calibration);
-  const auto listed = [](const std::vector<std::string>& ids) {
-    std::string out;
-    for (const auto& id : ids) out += (out.empty() ? "" : ",") + id;
-    return out;
-  };
   if (f.sensors != sensors)
-    throw core::DataError(file + ": sensors = " + listed(f.sensors) + ": calibrated for other " +
-                          "sensors than the ones read here (" + listed(sensors) +
-                          "); calibrate again with these (--sensors)");
+    throw core::DataError(file + ": sensors = " + comma_joined(f.sensors) +
+                          ": calibrated for other " + "sensors than the ones read here (" +
+                          comma_joined(sensors) + "); calibrate again with these (--sensors)");
   if (f.targets != setup.target_names)
-    throw core::DataError(file + ": targets = " + listed(f.targets) +
+    throw core::DataError(file + ": targets = " + comma_joined(f.targets) +
                           ": calibrated on another reduced model (its targets are " +
-                          listed(setup.target_names) + ")");
+                          comma_joined(setup.target_names) + ")");
   if (o.drift_readings_every_s > 0 && f.probe_every_s &&
       *f.probe_every_s != o.drift_readings_every_s)
     throw core::DataError(file + ": probe_cycle.every_s = " + std::to_string(*f.probe_every_s) +
@@ -256,7 +253,7 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
   const Eigen::VectorXd scale = n.drift_sigma_scale.size() != 0
                                     ? n.drift_sigma_scale
                                     : Eigen::VectorXd::Ones(setup.target_rows.rows());
-  nlohmann::json out = {{"sensor_sigma_K", as_vector(n.sensor_sigma_k)},
+  nlohmann::json out = {{"sensor_sigma_K", io::as_vector(n.sensor_sigma_k)},
                         {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
                         {"heat_initial_W", n.heat_initial_w},
                         {"air_walk_K_per_sqrt_h", n.air_walk_k},
@@ -267,10 +264,10 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
                         {"drift_relative_sigma", n.drift_relative_sigma},
                         {"correction_relative_sigma", n.correction_relative_sigma},
                         {"expansion_relative_sigma", expansion_json(setup)},
-                        {"drift_sigma_scale", as_vector(scale)},
+                        {"drift_sigma_scale", io::as_vector(scale)},
                         {"widen_on_inconsistency", n.widen_on_inconsistency}};
   if (n.probed_drift_sigma_scale.size() != 0)
-    out["probed_drift_sigma_scale"] = as_vector(n.probed_drift_sigma_scale);
+    out["probed_drift_sigma_scale"] = io::as_vector(n.probed_drift_sigma_scale);
   return out;
 }
 

@@ -876,19 +876,13 @@ int main(int argc, char** argv) {
       gen_noise.sensor_sigma_k.setConstant(std::sqrt(0.03 * 0.03 + 0.01 * 0.01 + 0.01 * 0.01 / 12));
       std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
       for (int k = 0; k < clean_runs; ++k) plan.emplace_back("none", calibration::InjectedEffect{});
-      for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
-        const auto kind = static_cast<calibration::EffectKind>(k);
-        plan.emplace_back(calibration::kind_name(kind),
-                          calibration::random_effect(kind, spec, gmesh, sensors, rng));
-      }
+      for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, rng))
+        plan.emplace_back(calibration::kind_name(e.kind), e);
       const std::size_t scored_runs = plan.size();
       if (changed_training) {
         std::mt19937_64 other = core::generator(seed, 1);
-        for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
-          const auto kind = static_cast<calibration::EffectKind>(k);
-          plan.emplace_back(calibration::kind_name(kind),
-                            calibration::random_effect(kind, spec, gmesh, sensors, other));
-        }
+        for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, other))
+          plan.emplace_back(calibration::kind_name(e.kind), e);
       }
       for (std::size_t k = 0; k < plan.size(); ++k) {
         const auto& [kind, effect] = plan[k];

@@ -46,16 +46,13 @@ std::vector<std::string> split(const std::string& text) {
   return out;
 }
 
-/// The command line's noise model (app/observer_options: ObserverOptions' defaults).
+/// The command line's noise model (app/observer_options: ObserverOptions' defaults), set where
+/// it differs from solvers::ObserverNoise's (the walks of heat and air are the same).
 solvers::ObserverSetup cli_setup(const solvers::Twin& twin, const core::CaseSpec& spec,
                                  const std::vector<std::string>& sensors,
                                  const Eigen::MatrixXd& rows, const Eigen::VectorXd& scale) {
   solvers::ObserverNoise n;
   n.sensor_sigma_k = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(sensors.size()), 0.05);
-  n.heat_walk_w = 4;
-  n.heat_initial_w = 2;
-  n.air_walk_k = 0.5;
-  n.air_initial_k = 0.3;
   n.sensor_offset_initial_k = 0.5;
   n.sensor_offset_walk_k = 0.05;
   n.drift_relative_sigma = 0.04;
@@ -128,11 +125,8 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, calibration::InjectedEffect>> plan;
     for (int k = 0; k < train + held; ++k)
       plan.emplace_back("clean", calibration::InjectedEffect{});
-    for (int k = 0; k <= static_cast<int>(calibration::EffectKind::sensor_lag); ++k) {
-      const auto kind = static_cast<calibration::EffectKind>(k);
-      plan.emplace_back(calibration::kind_name(kind),
-                        calibration::random_effect(kind, spec, gmesh, sensors, rng));
-    }
+    for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, rng))
+      plan.emplace_back(calibration::kind_name(e.kind), e);
     std::vector<Generated> runs;
     for (std::size_t k = 0; k < plan.size(); ++k) {
       const auto& [kind, effect] = plan[k];

@@ -132,6 +132,16 @@ void draw_heat_box(InjectedEffect& e, const core::CaseSpec& declared, const mesh
 
 }  // namespace
 
+InjectedEffects random_effect_of_each_kind(const core::CaseSpec& declared,
+                                           const mesh::TetMesh& mesh,
+                                           const std::vector<std::string>& sensor_ids,
+                                           std::mt19937_64& rng) {
+  InjectedEffects out;
+  for (int k = 0; k <= static_cast<int>(EffectKind::sensor_lag); ++k)
+    out.push_back(random_effect(static_cast<EffectKind>(k), declared, mesh, sensor_ids, rng));
+  return out;
+}
+
 InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
                              const mesh::TetMesh& m, const std::vector<std::string>& sensors,
                              std::mt19937_64& rng) {

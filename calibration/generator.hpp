@@ -67,6 +67,13 @@ InjectedEffect random_effect(EffectKind kind, const core::CaseSpec& declared,
                              const mesh::TetMesh& mesh, const std::vector<std::string>& sensor_ids,
                              std::mt19937_64& rng);
 
+/// One random_effect of each kind of the catalogue, in the kinds' order (ambient_temperature to
+/// sensor_lag), drawn in that order from `rng`.
+InjectedEffects random_effect_of_each_kind(const core::CaseSpec& declared,
+                                           const mesh::TetMesh& mesh,
+                                           const std::vector<std::string>& sensor_ids,
+                                           std::mt19937_64& rng);
+
 /// One mechanism in several places at once, each with its own size and law, in forms the
 /// calibrator's candidates (one place, or every place by one share of its h) cannot match one to
 /// one: heat inputs on two patches of the housing, one constant and one following speed; two or

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "core/case_spec.hpp"
 #include "mesh/mesher.hpp"
@@ -18,6 +19,11 @@ nlohmann::json mesh_report_json(const mesh::TetMesh& mesh, const mesh::MeshRepor
 /// valid JSON that says "not defined".
 inline nlohmann::json finite_or_null(double value, double scale = 1.0) {
   return std::isfinite(value) ? nlohmann::json(value * scale) : nlohmann::json(nullptr);
+}
+
+/// A vector's values in a std::vector, as a JSON array takes them.
+inline std::vector<double> as_vector(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
 }
 
 /// Writes a JSON value (pretty, via a temporary file and a rename).

@@ -14,10 +14,6 @@ using nlohmann::json;
 
 constexpr const char* kFormat = "thermotwin-sigma-calibration/1";
 
-std::vector<double> as_vector(const Eigen::VectorXd& v) {
-  return std::vector<double>(v.data(), v.data() + v.size());
-}
-
 /// Per target: samples, rms_error_um and coverage (null where no sample had a measured drift).
 json score_json(const solvers::DriftBandScore& s, const std::vector<std::string>& targets) {
   json out = json::object();

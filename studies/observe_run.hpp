@@ -22,6 +22,11 @@ namespace tt::studies {
 std::vector<std::string> named_by_twin(const solvers::TwinOutputs& outputs,
                                        const std::vector<std::string>& ids);
 
+/// The observer's set-up on the case under a run, for the chosen sensors read through the given
+/// rows (#sensors x the twin's states: sensor_readout's): the noise model and consistency test.
+using ObserverSetupFor = std::function<solvers::ObserverSetup(
+    const core::CaseSpec&, const std::vector<std::string>&, const Eigen::MatrixXd&)>;
+
 struct ObserveInput {
   const core::CaseSpec* declared = nullptr;
   const io::MeasuredRun* run = nullptr;
@@ -30,11 +35,7 @@ struct ObserveInput {
   /// the run's columns to observe; empty: every sensor of the run (not its ambient sensor) that
   /// has a position (with `mesh`) or that the twin names
   std::vector<std::string> sensors;
-  /// the observer's noise and consistency test on the case under the run and the chosen sensors,
-  /// read through the given rows (#sensors x the twin's states: sensor_readout's)
-  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
-                                       const Eigen::MatrixXd&)>
-      setup;
+  ObserverSetupFor setup;
   /// the case's mesh (the twin's): a sensor the run locates (its position in meta.json) is read
   /// there, interpolated on the twin's basis, as the measured-data format says a sensor need not
   /// sit at a mesh vertex; nullptr: every sensor at the named point of its id

@@ -26,9 +26,7 @@ struct SigmaCalibrationInput {
   const core::CaseSpec* declared = nullptr;
   const solvers::Twin* twin = nullptr;
   const mesh::TetMesh* mesh = nullptr;
-  std::function<solvers::ObserverSetup(const core::CaseSpec&, const std::vector<std::string>&,
-                                       const Eigen::MatrixXd&)>
-      setup;
+  ObserverSetupFor setup;
   std::vector<const io::MeasuredRun*> runs;  /// the training runs, at least one
   /// the sensors read; empty: the first run's readable sensors (observe_run's default), which
   /// every other run must have
