@@ -149,6 +149,9 @@ struct ObserveArgs {
   /// runs whose drift was measured: the sigma factors are calibrated on them
   /// (sigma_calibration.json) and, with data, used on it
   std::vector<std::filesystem::path> train;
+  /// with train: runs of a machine that has changed, drift measured: the correction's and the
+  /// expansion's relative sigma are chosen on them
+  std::vector<std::filesystem::path> changed;
   double truth_sigma_um = 0;  /// white noise of the training runs' measured drift [um]
   double coverage = 0.95;     /// the share of training samples the ±2 sigma band is to hold
   ObserverOptions observer;

@@ -18,7 +18,8 @@
 //                                  form
 //   observe CASE --rom DIR --data RUN --out DIR
 //                                  the physics observer: drift with its sigma, recalibrate status
-//                                  (--train RUN...: its sigma calibrated on measured drift)
+//                                  (--train RUN...: its sigma calibrated on measured drift;
+//                                  --changed RUN...: c and e chosen on a changed machine)
 //   --version                      the version, and git describe of the source it was built from
 // Errors print one line on stderr and exit non-zero; no partial output directory is left. --out
 // replaces only an earlier result of thermotwin (docs/reliability.md), one command at a time.
@@ -471,6 +472,14 @@ Command observe_line(CLI::App& cli) {
                                  "the reported drift sigma on them (OUT/sigma_calibration.json) "
                                  "and use them on --data")
                     ->check(CLI::ExistingDirectory);
+  observe
+      ->add_option("--changed", observe_args.changed,
+                   "with --train: measured runs of the machine changed (an effect the declared "
+                   "model lacks), their drift measured as the training runs' is: choose "
+                   "--correction-relative-sigma and --expansion-relative-sigma on them "
+                   "(sigma_calibration.json changed_machine; docs/observer.md)")
+      ->check(CLI::ExistingDirectory)
+      ->needs(train);
   observe
       ->add_option("--truth-sigma-um", observe_args.truth_sigma_um,
                    "with --train: white noise of the measured drift [um]: where the errors are "

@@ -6,11 +6,13 @@
 //   1. the case, the run and the training runs, the output claimed;
 //   2. the reduced model, checked against the case and its mesh;
 //   3. with --train, the factors on the reported sigma calibrated on runs whose drift was measured
-//      (studies/observer_sigma.hpp; sigma_calibration.json); the study (studies/observe_run.hpp):
-//      the case under the run's inputs, the sensors (--sensors, default: every sensor of the run
-//      that is a named point of the model), the observer's set-up (app/observer_options.hpp, with
-//      the calibrated factors), the run through the filter;
+//      (studies/observer_sigma.hpp; sigma_calibration.json), and with --changed the correction's
+//      and the expansion's relative sigma chosen on runs of a changed machine; the study
+//      (studies/observe_run.hpp): the case under the run's inputs, the sensors (--sensors, default:
+//      every sensor of the run that is a named point of the model), the observer's set-up
+//      (app/observer_options.hpp, with the calibrated factors), the run through the filter;
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
+#include <algorithm>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -18,6 +20,7 @@
 
 #include "app/commands.hpp"
 #include "app/observer_options.hpp"
+#include "core/errors.hpp"
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/case_reader.hpp"
@@ -49,15 +52,34 @@ void print_calibration(const studies::SigmaCalibration& cal) {
   };
   pass("sigma", cal.temperatures);
   if (cal.probed) pass("probed sigma", *cal.probed);
+  if (!cal.changed) return;
+  const studies::ChangedMachineSigma& ch = *cal.changed;
+  const studies::SigmaTermsCandidate& pick = ch.grid.at(ch.chosen);
+  std::cerr << "thermotwin: observe: on the changed runs, correction relative sigma "
+            << pick.correction_relative_sigma << " and expansion relative sigma "
+            << pick.expansion_relative_sigma << "\n";
+  for (std::size_t t = 0; t < cal.targets.size(); ++t) {
+    const auto k = static_cast<Eigen::Index>(t);
+    if (ch.grid.front().score.samples(k) == 0) continue;
+    std::cerr << "thermotwin: observe:   " << cal.targets[t] << ": ±2 sigma held "
+              << 100 * ch.grid.front().score.coverage(k) << " % of the changed runs' samples, now "
+              << 100 * pick.score.coverage(k) << " %"
+              << (ch.goal(k) < cal.coverage ? " (out of the terms' reach: at most " +
+                                                  std::to_string(100 * ch.goal(k)) + " %)"
+                                            : "")
+              << "\n";
+  }
 }
 
 /// The sigma calibrated on the training runs (sigma_calibration.json into `dir`), `input` holding
 /// the case, the reduced model, its mesh and the set-up; `options` then carry its factors and
 /// sensors, for the run observed after it.
 void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>& runs,
+                     const std::vector<io::MeasuredRun>& changed,
                      studies::SigmaCalibrationInput input, ObserverOptions& options,
                      const std::filesystem::path& dir) {
   for (const auto& r : runs) input.runs.push_back(&r);
+  for (const auto& r : changed) input.changed.push_back(&r);
   input.sensors = options.sensors;
   input.drift_readings_every_s = options.drift_readings_every_s;
   input.truth_sigma_m = core::kMetresPerMicrometre * args.truth_sigma_um;
@@ -75,6 +97,11 @@ void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>
   options.drift_sigma_scale = io::as_vector(cal.temperatures.drift_sigma_scale);
   options.probed_drift_sigma_scale.clear();
   if (cal.probed) options.probed_drift_sigma_scale = io::as_vector(cal.probed->drift_sigma_scale);
+  if (cal.changed) {
+    const studies::SigmaTermsCandidate& pick = cal.changed->grid.at(cal.changed->chosen);
+    options.correction_relative_sigma = pick.correction_relative_sigma;
+    options.expansion_relative_sigma = {pick.expansion_relative_sigma};
+  }
   if (!args.quiet) print_calibration(cal);
 }
 
@@ -111,12 +138,26 @@ int observe_command(const ObserveArgs& args) {
   const core::CaseSpec declared = io::read_case(args.case_file);
   std::optional<io::MeasuredRun> run;
   if (!args.data.empty()) run = io::read_measured_run(args.data);
-  std::vector<io::MeasuredRun> training;
+  io::require_distinct_runs(args.train, "--train");
+  io::require_distinct_runs(args.changed, "--changed");
+  io::require_disjoint_runs(
+      args.changed, args.train, "--changed", "--train",
+      "a run is either of the machine the model declares or of a changed one");
+  if (!args.changed.empty() &&
+      (args.observer.correction_relative_sigma > 0 ||
+       std::any_of(args.observer.expansion_relative_sigma.begin(),
+                   args.observer.expansion_relative_sigma.end(), [](double e) { return e > 0; })))
+    throw core::DataError(
+        "observe: --changed chooses --correction-relative-sigma and --expansion-relative-sigma; "
+        "give it or them, not both");
+  std::vector<io::MeasuredRun> training, changed;
   for (const auto& path : args.train) training.push_back(io::read_measured_run(path));
+  for (const auto& path : args.changed) changed.push_back(io::read_measured_run(path));
   std::vector<std::filesystem::path> inputs = io::case_input_files(declared);
   inputs.push_back(args.rom);
   if (run) inputs.push_back(args.data);
   inputs.insert(inputs.end(), args.train.begin(), args.train.end());
+  inputs.insert(inputs.end(), args.changed.begin(), args.changed.end());
   if (!args.observer.sigma_calibration.empty()) inputs.push_back(args.observer.sigma_calibration);
   io::OutputDir out(args.out, inputs);
   // 2. The reduced model, built for this machine and mesh.
@@ -136,7 +177,7 @@ int observe_command(const ObserveArgs& args) {
     input.twin = &rom.twin;
     input.mesh = &mesh;
     input.setup = setup;
-    calibrate_sigma(args, training, input, options, out.path());
+    calibrate_sigma(args, training, changed, input, options, out.path());
   }
   std::optional<studies::ObserveReport> report;
   if (run)

@@ -74,9 +74,10 @@ void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
       ->check(positive_number());
 }
 
-/// The factors of --sigma-calibration's file on `setup`. DataError naming the file when it was
-/// calibrated for other sensors, targets or probe cycle, or when --drift-sigma-scale or
-/// --probed-drift-sigma-scale is given too.
+/// The factors of --sigma-calibration's file on `setup`, and the relative sigmas it chose on
+/// changed runs. DataError naming the file when it was calibrated for other sensors, targets or
+/// probe cycle, or when --drift-sigma-scale or --probed-drift-sigma-scale is given too (or
+/// --correction-relative-sigma or --expansion-relative-sigma, when it chose those).
 void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::string>& sensors,
                              solvers::ObserverSetup& setup) {
   const std::string file = o.sigma_calibration.string();
@@ -100,6 +101,15 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           std::to_string(o.drift_readings_every_s));
   setup.noise.drift_sigma_scale = f.drift_sigma_scale;
   if (f.probe_every_s) setup.noise.probed_drift_sigma_scale = f.probed_drift_sigma_scale;
+  if (!f.correction_relative_sigma) return;
+  if (o.correction_relative_sigma > 0 || setup.noise.expansion_relative_sigma.size() != 0)
+    throw core::DataError("--sigma-calibration " + file +
+                          ": its changed_machine chose the correction's and the expansion's "
+                          "relative sigma; give it or --correction-relative-sigma / "
+                          "--expansion-relative-sigma, not both");
+  setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
+  setup.noise.expansion_relative_sigma =
+      expansion_sigmas({f.expansion_relative_sigma.value_or(0.0)}, setup);
 }
 
 }  // namespace

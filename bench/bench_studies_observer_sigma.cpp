@@ -3,7 +3,10 @@
 // band's coverage of the true drift and of the measured one, before (the observer's own sigma)
 // and after (times the calibrated factor), on clean held-out runs and on runs with an undeclared
 // effect (one of each kind of the generator's catalogue). The reference is the uncalibrated
-// sigma of the same runs, measured in the same run of the bench.
+// sigma of the same runs, measured in the same run of the bench. A second draw of one run of each
+// kind plays the changed-machine runs (observe --changed) that choose the correction's and the
+// expansion's relative sigma; the held-out runs are scored with them too. (With c and e the
+// "uncalibrated" column is the factors' alone, c = e = 0.)
 //
 //   bench_studies_observer_sigma CASE SENSORS TRAIN HELD HOURS SEED [PROBE_EVERY_S]
 //
@@ -84,10 +87,10 @@ void report(const std::string& what, const Pooled& p, const Eigen::VectorXd& fac
   for (std::size_t t = 0; t < targets.size(); ++t) {
     const auto k = static_cast<Eigen::Index>(t);
     if (before.samples(k) == 0) continue;
-    std::printf("%s | %s | %d | %.4f | %.1f %% | %.1f %% | %.1f %% | %.3f\n", what.c_str(),
+    std::printf("%s | %s | %d | %.4f | %.1f %% | %.1f %% | %.1f %% | %.3f | %.2f\n", what.c_str(),
                 targets[t].c_str(), before.samples(k), 1e6 * before.rms_error_m(k),
                 100 * before.coverage(k), 100 * after.coverage(k), 100 * measured_after.coverage(k),
-                factor(k));
+                factor(k), after.rms_sigma_m(k) / after.rms_error_m(k));
   }
 }
 
@@ -127,6 +130,13 @@ int main(int argc, char** argv) {
       plan.emplace_back("clean", calibration::InjectedEffect{});
     for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, rng))
       plan.emplace_back(calibration::kind_name(e.kind), e);
+    // A second draw of each kind, from a stream of its own and simulated last (the runs before
+    // are those of before, to the digit): the changed-machine runs that choose c and e (observe
+    // --changed).
+    const std::size_t first_changed = plan.size();
+    std::mt19937_64 changed_rng = core::generator(seed, 1);
+    for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, changed_rng))
+      plan.emplace_back("changed " + std::string(calibration::kind_name(e.kind)), e);
     std::vector<Generated> runs;
     for (std::size_t k = 0; k < plan.size(); ++k) {
       const auto& [kind, effect] = plan[k];
@@ -166,6 +176,8 @@ int main(int argc, char** argv) {
     const studies::SigmaCalibration cal = studies::calibrate_observer_sigma(input);
     studies::SigmaCalibrationInput undeclared = input;
     undeclared.truth_sigma_m = 0;
+    for (std::size_t k = first_changed; k < runs.size(); ++k)
+      undeclared.changed.push_back(&runs[k].measured);
     const studies::SigmaCalibration cal_plain = studies::calibrate_observer_sigma(undeclared);
     std::printf("calibration on %d training runs (%.0f s): factors", train, seconds_since(t_cal));
     for (Eigen::Index t = 0; t < cal.temperatures.drift_sigma_scale.size(); ++t)
@@ -175,6 +187,17 @@ int main(int argc, char** argv) {
     for (Eigen::Index t = 0; t < cal_plain.temperatures.drift_sigma_scale.size(); ++t)
       std::printf(" %.4g", cal_plain.temperatures.drift_sigma_scale(t));
     std::printf(")\n");
+    const studies::ChangedMachineSigma& changed = *cal_plain.changed;
+    const studies::SigmaTermsCandidate& pick = changed.grid[changed.chosen];
+    std::printf("chosen on %zu changed runs (noise not declared): c %g, e %g; goal",
+                changed.runs.size(), pick.correction_relative_sigma, pick.expansion_relative_sigma);
+    for (Eigen::Index t = 0; t < changed.goal.size(); ++t)
+      std::printf(" %s %.3f", cal.targets[static_cast<std::size_t>(t)].c_str(), changed.goal(t));
+    std::printf("; their coverage at c = e = 0 and at the choice:");
+    for (Eigen::Index t = 0; t < changed.goal.size(); ++t)
+      std::printf(" %s %.1f -> %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
+                  100 * changed.grid.front().score.coverage(t), 100 * pick.score.coverage(t));
+    std::printf("\n");
     if (cal.probed) {
       std::printf("with a probe cycle every %g s: factors", probe_every_s);
       for (Eigen::Index t = 0; t < cal.probed->drift_sigma_scale.size(); ++t)
@@ -185,7 +208,7 @@ int main(int argc, char** argv) {
     // The held-out runs, observed as observe --data observes them, scored before and after.
     Pooled clean, effect, clean_probed, effect_probed;
     const auto t_obs = Clock::now();
-    for (std::size_t k = static_cast<std::size_t>(train); k < runs.size(); ++k) {
+    for (std::size_t k = static_cast<std::size_t>(train); k < first_changed; ++k) {
       const Generated& g = runs[k];
       studies::ObserveInput in{&spec, &g.measured, &twin, sensors, setup_with({}), &mesh, 0.0};
       const studies::ObserveReport r = studies::observe_run(in);
@@ -212,11 +235,13 @@ int main(int argc, char** argv) {
         pp.measured.push_back(between_measured);
       }
     }
-    std::printf("observed %zu held-out runs (%.0f s)\n\n", runs.size() - train,
+    std::printf("observed %zu held-out runs (%.0f s)\n\n", first_changed - train,
                 seconds_since(t_obs));
     std::printf(
         "runs | target | samples | RMS error [um] | true drift in ±2σ, uncalibrated | "
-        "calibrated | measured drift in the calibrated band (noise added) | factor\n");
+        "calibrated | measured drift in the calibrated band (noise added) | factor | calibrated "
+        "RMS "
+        "sigma / RMS error\n");
     report("held-out clean, noise declared", clean, cal.temperatures.drift_sigma_scale,
            gopt.noise_displacement_m, cal.targets);
     report("held-out clean, noise not declared", clean, cal_plain.temperatures.drift_sigma_scale, 0,
@@ -225,6 +250,19 @@ int main(int argc, char** argv) {
            gopt.noise_displacement_m, cal.targets);
     report("effect runs, noise not declared", effect, cal_plain.temperatures.drift_sigma_scale, 0,
            cal.targets);
+    // c and e chosen on the changed runs, on the factors of the noise not declared.
+    const auto with_choice = [&](const Pooled& p) {
+      Pooled out = p;
+      for (solvers::ObserverRun& r : out.runs)
+        r = studies::with_sigma(r, cal_plain.temperatures.drift_sigma_scale,
+                                pick.correction_relative_sigma, pick.expansion_relative_sigma);
+      return out;
+    };
+    const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cal.temperatures.drift_sigma_scale.size());
+    report("held-out clean, noise not declared, c and e of the changed runs", with_choice(clean),
+           ones, 0, cal.targets);
+    report("effect runs, noise not declared, c and e of the changed runs", with_choice(effect),
+           ones, 0, cal.targets);
     if (cal.probed) {
       report("held-out clean, probe cycle, noise declared", clean_probed,
              cal.probed->drift_sigma_scale, gopt.noise_displacement_m, cal.targets);

@@ -1,5 +1,6 @@
 #include "io/sigma_calibration_io.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -22,6 +23,7 @@ json score_json(const solvers::DriftBandScore& s, const std::vector<std::string>
     out[targets[t]] = {
         {"samples", s.samples(k)},
         {"rms_error_um", finite_or_null(s.rms_error_m(k), core::kMicrometresPerMetre)},
+        {"rms_sigma_um", finite_or_null(s.rms_sigma_m(k), core::kMicrometresPerMetre)},
         {"coverage", finite_or_null(s.coverage(k))}};
   }
   return out;
@@ -49,6 +51,36 @@ json pass_json(const studies::SigmaPass& pass, const studies::SigmaCalibration& 
           {"before", score_json(pass.pooled_before, c.targets)},
           {"after", score_json(pass.pooled_after, c.targets)},
           {"runs", runs}};
+}
+
+json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCalibration& c) {
+  json grid = json::array();
+  for (const studies::SigmaTermsCandidate& pair : ch.grid)
+    grid.push_back({{"correction_relative_sigma", pair.correction_relative_sigma},
+                    {"expansion_relative_sigma", pair.expansion_relative_sigma},
+                    {"score", score_json(pair.score, c.targets)},
+                    {"width", pair.width},
+                    {"reaches_goal", pair.reaches_goal}});
+  json runs = json::array();
+  for (std::size_t k = 0; k < ch.runs.size(); ++k)
+    runs.push_back({{"run", ch.runs[k]},
+                    {"before", score_json(ch.before[k], c.targets)},
+                    {"after", score_json(ch.after[k], c.targets)}});
+  const studies::SigmaTermsCandidate& pick = ch.grid.at(ch.chosen);
+  json goal = json::object();
+  std::vector<std::string> short_of;
+  for (std::size_t t = 0; t < c.targets.size(); ++t) {
+    const double g = ch.goal(static_cast<Eigen::Index>(t));
+    goal[c.targets[t]] = finite_or_null(g);
+    if (std::isfinite(g) && g < c.coverage) short_of.push_back(c.targets[t]);
+  }
+  return {{"runs", ch.runs},
+          {"correction_relative_sigma", pick.correction_relative_sigma},
+          {"expansion_relative_sigma", pick.expansion_relative_sigma},
+          {"goal", goal},
+          {"out_of_reach", short_of},
+          {"grid", grid},
+          {"per_run", runs}};
 }
 
 /// "a,b,c": the factors as a flag's value.
@@ -98,6 +130,18 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
     out["probed_drift_sigma_scale"] = as_vector(c.probed->drift_sigma_scale);
     flags += " --probed-drift-sigma-scale " + flag_value(c.probed->drift_sigma_scale);
   }
+  out["changed_machine"] = nullptr;
+  if (c.changed) {
+    out["changed_machine"] = changed_json(*c.changed, c);
+    const studies::SigmaTermsCandidate& pick = c.changed->grid.at(c.changed->chosen);
+    out["correction_relative_sigma"] = pick.correction_relative_sigma;
+    out["expansion_relative_sigma"] = pick.expansion_relative_sigma;
+    std::ostringstream more;
+    more << " --correction-relative-sigma " << pick.correction_relative_sigma;
+    if (pick.expansion_relative_sigma > 0)
+      more << " --expansion-relative-sigma " << pick.expansion_relative_sigma;
+    flags += more.str();
+  }
   out["flags"] = flags;
   return out;
 }
@@ -117,6 +161,18 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
   if (!fit_keys::member(j, "probe_cycle", p, "").is_null()) {
     f.probe_every_s = fit_keys::number_at(j["probe_cycle"], "every_s", p, "probe_cycle.");
     f.probed_drift_sigma_scale = factors_at(j, "probed_drift_sigma_scale", p, "", f.targets.size());
+  }
+  // Written from session 18 on: a file of before has no changed_machine.
+  if (j.contains("changed_machine") && !j["changed_machine"].is_null()) {
+    const auto relative = [&](const std::string& key) {
+      const double v = fit_keys::number_at(j["changed_machine"], key, p, "changed_machine.");
+      if (!(v >= 0))
+        throw core::DataError(p.at("changed_machine." + key) + " = " +
+                              j["changed_machine"][key].dump() + ": expected a value >= 0");
+      return v;
+    };
+    f.correction_relative_sigma = relative("correction_relative_sigma");
+    f.expansion_relative_sigma = relative("expansion_relative_sigma");
   }
   return f;
 }

@@ -32,11 +32,14 @@ struct SigmaCalibrationFile {
   /// with a probe cycle: its period [s] and the factor of the filter that reads it
   std::optional<double> probe_every_s;
   Eigen::VectorXd probed_drift_sigma_scale;
+  /// with changed runs (changed_machine): the correction's relative sigma, and the expansion
+  /// relative sigma of every material
+  std::optional<double> correction_relative_sigma, expansion_relative_sigma;
 };
 
 /// Reads a sigma_calibration.json. IoError when it cannot be read; DataError naming the file and
-/// the key for one that is missing or malformed, a factor that is not above 0, or factors that
-/// are not one per target.
+/// the key for one that is missing or malformed, a factor that is not above 0, factors that are
+/// not one per target, or a relative sigma below 0.
 SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path);
 
 }  // namespace tt::io

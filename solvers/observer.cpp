@@ -53,10 +53,16 @@ Eigen::MatrixXd unknown_heat_columns(const ReducedThermalSystem& system, const c
   return columns;
 }
 
-/// ObserverNoise::expansion_relative_sigma: one finite value >= 0 per material, and the
-/// per-material target rows, of the target rows' shape, when one is above 0; SolverError
-/// otherwise.
+/// The per-material target rows of the target rows' shape; ObserverNoise::expansion_relative_sigma
+/// (when given) one finite value >= 0 per material, and the per-material rows there when one is
+/// above 0; SolverError otherwise.
 void check_expansion_rows(const ObserverSetup& s) {
+  for (const Eigen::MatrixXd& part : s.target_expansion)
+    if (part.rows() != s.target_rows.rows() || part.cols() != s.target_rows.cols())
+      throw core::SolverError("observer: drift rows per material of " +
+                              std::to_string(part.rows()) + " x " + std::to_string(part.cols()) +
+                              ", the target rows " + std::to_string(s.target_rows.rows()) + " x " +
+                              std::to_string(s.target_rows.cols()));
   const Eigen::VectorXd& e = s.noise.expansion_relative_sigma;
   if (!e.allFinite() || (e.array() < 0).any())
     throw core::SolverError("observer: an expansion relative sigma is negative or not finite");
@@ -66,12 +72,6 @@ void check_expansion_rows(const ObserverSetup& s) {
         "observer: an expansion relative sigma needs the drift rows per material, which this "
         "reduced model does not keep (written before they were); rebuild it with `thermotwin "
         "reduce`");
-  for (const Eigen::MatrixXd& part : s.target_expansion)
-    if (part.rows() != s.target_rows.rows() || part.cols() != s.target_rows.cols())
-      throw core::SolverError("observer: drift rows per material of " +
-                              std::to_string(part.rows()) + " x " + std::to_string(part.cols()) +
-                              ", the target rows " + std::to_string(s.target_rows.rows()) + " x " +
-                              std::to_string(s.target_rows.cols()));
   if (static_cast<std::size_t>(e.size()) != s.target_expansion.size())
     throw core::SolverError("observer: " + std::to_string(e.size()) +
                             " expansion relative sigmas for " +
@@ -277,7 +277,7 @@ void check_setup(const ReducedThermalSystem& system, const core::CaseSpec& spec,
     if (!(bound >= 0) || !std::isfinite(bound))
       fail("sensor fault, model residual or departure onset bound " + number(bound) +
            " sigma: expected a finite value >= 0");
-  if (n.expansion_relative_sigma.size() != 0) check_expansion_rows(setup);
+  check_expansion_rows(setup);
   for (const Eigen::VectorXd* scale : {&n.drift_sigma_scale, &n.probed_drift_sigma_scale})
     if (scale->size() != 0 && (scale->size() != setup.target_rows.rows() ||
                                !(scale->array() > 0).all() || !scale->allFinite()))
@@ -337,8 +337,7 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
                           ? spec.thermal.initial_temperature_c + core::kCelsiusOffset
                           : setup_.initial_temperature_k;
   z0_ = t0_k * system.uniform;
-  if (n.correction_relative_sigma > 0 || setup_.consistency.model_residual_sigmas > 0)
-    z_open_ = z0_;
+  z_open_ = z0_;
   x_ = Eigen::VectorXd::Zero(r_ + nb_);
   x_.head(r_) = z0_;
   p_ = Eigen::MatrixXd::Zero(r_ + nb_, r_ + nb_);
@@ -406,7 +405,7 @@ void KalmanObserver::step(double t1) {
     add_process_noise(map_->process, dt);
   }
   x_.head(r_) = std::move(z);
-  if (z_open_.size() != 0) z_open_ = (phi * z_open_ + a.input).eval();
+  z_open_ = (phi * z_open_ + a.input).eval();
   t_ = t1;
   prev_speed_ = a.speed;
 }
@@ -494,10 +493,13 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   e.time = t;
   update(t, readings, drift_readings, e);
   e.drift = setup_.target_rows * (x_.head(r_) - z0_);
-  e.drift_sigma = drift_sigma(e.drift);
+  e.sigma_terms = drift_sigma_terms(e.drift);
   e.recalibrate = monitor_.add(t, e.nis, e.dof);
   if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
-    e.drift_sigma *= std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
+    e.sigma_terms.widening =
+        std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
+  e.drift_sigma = drift_sigma(e.sigma_terms, setup_.noise.correction_relative_sigma,
+                              setup_.noise.expansion_relative_sigma);
   e.recalibrate_since_s = monitor_.since_s();
   test_departures(t, readings, e);
   return e;
@@ -594,26 +596,32 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
   }
 }
 
-Eigen::VectorXd KalmanObserver::drift_sigma(const Eigen::VectorXd& drift) const {
+DriftSigmaTerms KalmanObserver::drift_sigma_terms(const Eigen::VectorXd& drift) const {
   const Eigen::MatrixXd& l = setup_.target_rows;
   const ObserverNoise& n = setup_.noise;
+  DriftSigmaTerms terms;
   Eigen::ArrayXd var = (l.lazyProduct(p_.topLeftCorner(r_, r_)).lazyProduct(l.transpose()))
                            .diagonal()
                            .cwiseMax(0.0)
                            .array() +
                        (n.drift_relative_sigma * drift.array()).square();
   if (n.drift_sigma_scale.size() != 0) var *= n.drift_sigma_scale.array().square();
-  if (n.correction_relative_sigma > 0)
-    var += (n.correction_relative_sigma * (l * (x_.head(r_) - z_open_)).array()).square();
-  if (n.expansion_relative_sigma.size() != 0) {
-    const Eigen::VectorXd dz = x_.head(r_) - z0_;  // the states' change: the drift's, per material
-    for (Eigen::Index m = 0; m < n.expansion_relative_sigma.size(); ++m)
-      if (n.expansion_relative_sigma(m) > 0)
-        var += (n.expansion_relative_sigma(m) *
-                (setup_.target_expansion[static_cast<std::size_t>(m)] * dz).array())
-                   .square();
-  }
-  return var.sqrt().matrix();
+  terms.model = var.sqrt().matrix();
+  terms.correction = l.lazyProduct(x_.head(r_) - z_open_);
+  const Eigen::VectorXd dz = x_.head(r_) - z0_;  // the states' change: the drift's, per material
+  for (const Eigen::MatrixXd& rows : setup_.target_expansion)
+    terms.expansion.push_back(rows.lazyProduct(dz));
+  return terms;
+}
+
+Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
+                            const Eigen::VectorXd& expansion) {
+  Eigen::ArrayXd var = terms.model.array().square();
+  if (correction > 0) var += (correction * terms.correction.array()).square();
+  for (Eigen::Index m = 0; m < expansion.size(); ++m)
+    if (expansion(m) > 0)
+      var += (expansion(m) * terms.expansion[static_cast<std::size_t>(m)].array()).square();
+  return terms.widening * var.sqrt().matrix();
 }
 
 CovarianceMap KalmanObserver::advance(double t) {
@@ -682,6 +690,7 @@ void record(const KalmanObserver& kf, const ObserverEstimate& e, Eigen::Index i,
   const auto nb = static_cast<Eigen::Index>(kf.unknown_inputs().size());
   run.drift.row(i) = e.drift.transpose();
   run.drift_sigma.row(i) = e.drift_sigma.transpose();
+  run.sigma_terms[static_cast<std::size_t>(i)] = e.sigma_terms;
   run.innovation.row(i) = e.innovation.transpose();
   run.nis(i) = e.nis;
   run.dof(i) = e.dof;
@@ -710,6 +719,7 @@ ObserverRun observe(const ReducedThermalSystem& system, const core::CaseSpec& sp
   run.times = times;
   run.drift.resize(n, nt);
   run.drift_sigma.resize(n, nt);
+  run.sigma_terms.resize(static_cast<std::size_t>(n));
   run.innovation.resize(n, readings.cols());
   run.nis.resize(n);
   run.window_nis.resize(n);
@@ -827,19 +837,21 @@ DriftBandScore drift_band_score(const std::vector<ObserverRun>& runs,
                             std::to_string(nt) + " targets");
   const double nan = std::numeric_limits<double>::quiet_NaN();
   DriftBandScore score{Eigen::VectorXi::Zero(nt), Eigen::VectorXd::Constant(nt, nan),
-                       Eigen::VectorXd::Constant(nt, nan)};
+                       Eigen::VectorXd::Constant(nt, nan), Eigen::VectorXd::Constant(nt, nan)};
   for (Eigen::Index t = 0; t < nt; ++t) {
     const auto& st = samples[static_cast<std::size_t>(t)];
     if (st.empty()) continue;
     const double f = factor.size() != 0 ? factor(t) : 1.0;
-    double squares = 0, inside = 0;
+    double squares = 0, sigma_squares = 0, inside = 0;
     for (const auto& [e, sigma] : st) {
       squares += e * e;
+      sigma_squares += f * f * sigma * sigma;
       inside += band_factor(e, sigma, truth_sigma_m) <= f;
     }
     const auto n = static_cast<double>(st.size());
     score.samples(t) = static_cast<int>(st.size());
     score.rms_error_m(t) = std::sqrt(squares / n);
+    score.rms_sigma_m(t) = std::sqrt(sigma_squares / n);
     score.coverage(t) = inside / n;
   }
   return score;

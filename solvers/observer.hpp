@@ -59,7 +59,7 @@ struct ObserverNoise {
   /// shape or spread over a film's surface, the air on the sinks), which an undeclared effect
   /// need not have: added to the drift's variance as (c d_c)^2, after drift_sigma_scale (which is
   /// calibrated where the declared model holds and the corrections are small) and before the
-  /// widening. 0: none, and z_open is not stepped. (z_open takes each step's affine map as the
+  /// widening. 0: none. (z_open takes each step's affine map as the
   /// filter does, at the filtered state: the same map unless the case's heat depends on
   /// temperature.)
   double correction_relative_sigma = 0;
@@ -236,11 +236,32 @@ class HeldBeyondMonitor {
   std::vector<HeldSensor> held_;
 };
 
+/// The terms of the reported drift sigma at one time (docs/observer.md, "Drift"): sigma^2 =
+/// widening^2 (model^2 + (c correction)^2 + sum over materials m of (e_m expansion_m)^2), c the
+/// noise's correction_relative_sigma and e its expansion_relative_sigma. Kept per sample
+/// (ObserverRun::sigma_terms), so that other c and e are scored without observing again: the
+/// estimate does not depend on them.
+struct DriftSigmaTerms {
+  /// #targets: the estimate's and the drift rows' sigma, times drift_sigma_scale [m]
+  Eigen::VectorXd model;
+  Eigen::VectorXd correction;  /// #targets: d_c = L (z - z_open) [m]
+  /// per material (ObserverSetup::target_expansion's order), #targets: the drift its thermal
+  /// strain makes [m]
+  std::vector<Eigen::VectorXd> expansion;
+  double widening = 1;  /// the widening on inconsistency's factor, >= 1 (1: none)
+};
+
+/// The reported sigma (#targets [m]) of `terms` under a correction sigma c and, per material,
+/// an expansion sigma (`expansion`: empty or one per material).
+Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
+                            const Eigen::VectorXd& expansion);
+
 /// What the observer says after one assimilation.
 struct ObserverEstimate {
   double time = 0;              /// [s]
   Eigen::VectorXd drift;        /// #targets [m], relative to t = 0
   Eigen::VectorXd drift_sigma;  /// #targets standard deviation [m]
+  DriftSigmaTerms sigma_terms;  /// what drift_sigma is made of
   Eigen::VectorXd innovation;   /// #sensors reading minus prediction [K], NaN where missing
   /// #targets drift reading minus prediction [m], and its standard deviation under the noise
   /// model [m]; NaN where there is none (empty: no drift reading)
@@ -302,9 +323,10 @@ class KalmanObserver {
   void advance_to(double t);
   void step(double t1);
   void add_process_noise(Eigen::MatrixXd& p, double dt) const;
-  /// The drift's standard deviation at the current estimate, `drift` = L (z - z(0)): the
-  /// filter's, the drift rows' relative error, the scale, the correction's error (ObserverNoise).
-  Eigen::VectorXd drift_sigma(const Eigen::VectorXd& drift) const;
+  /// The terms of the drift's standard deviation at the current estimate, `drift` = L (z - z(0)):
+  /// the filter's and the drift rows' relative error times the scale, the correction, the
+  /// materials' drifts (ObserverNoise); the widening is the caller's.
+  DriftSigmaTerms drift_sigma_terms(const Eigen::VectorXd& drift) const;
   /// The tests beside the NIS's after an assimilation at t (the offsets' faults, the readings
   /// against the declared model's run): raises `e.recalibrate` where they say so.
   void test_departures(double t, const Eigen::VectorXd& readings, ObserverEstimate& e);
@@ -322,7 +344,7 @@ class KalmanObserver {
   Eigen::Index offsets_ = 0;             /// the sensor offsets' first index in b (-1: none)
   Eigen::VectorXd bias_walk_;            /// per bias: variance per second
   Eigen::VectorXd x_, z0_;
-  Eigen::VectorXd z_open_;  /// the declared model's own run (empty when no test uses it)
+  Eigen::VectorXd z_open_;  /// the declared model's own run
   Eigen::MatrixXd p_;
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
@@ -359,6 +381,7 @@ struct ObserverRun {
   /// drift test; HeldSensor::sensor: the target's index), in the order raised; each says
   /// recalibrate.
   std::vector<HeldSensor> drift_departures;
+  std::vector<DriftSigmaTerms> sigma_terms;  /// per sample: what drift_sigma is made of
 };
 
 /// `setup` for a filter that assimilates drift readings: its reported sigma scaled by
@@ -433,12 +456,12 @@ Eigen::VectorXd drift_sigma_calibration(const std::vector<ObserverRun>& runs,
 
 /// How the reported drift and its band did over runs whose true drift is known, per target: the
 /// samples counted (those mean_normalised_squared_error counts), the RMS of estimate - truth [m],
-/// and the share of them within ±2 sqrt((factor sigma)^2 + truth_sigma_m^2) (factor empty: 1;
-/// truth_sigma_m the measured truth's white noise);
+/// the RMS of the sigma (times the factor) [m], and the share of them within ±2 sqrt((factor
+/// sigma)^2 + truth_sigma_m^2) (factor empty: 1; truth_sigma_m the measured truth's white noise);
 /// NaN where none counted. Same runs, truths and errors as mean_normalised_squared_error.
 struct DriftBandScore {
   Eigen::VectorXi samples;
-  Eigen::VectorXd rms_error_m, coverage;
+  Eigen::VectorXd rms_error_m, coverage, rms_sigma_m;
 };
 DriftBandScore drift_band_score(const std::vector<ObserverRun>& runs,
                                 const std::vector<Eigen::MatrixXd>& truths,

@@ -53,7 +53,97 @@ SigmaPass calibrate_pass(const Observed& o, const SigmaCalibrationInput& input) 
   return pass;
 }
 
+SigmaTermsCandidate score_pair(const Observed& o, double c, double e, double noise) {
+  SigmaTermsCandidate pair{c, e};
+  std::vector<solvers::ObserverRun> runs;
+  for (const solvers::ObserverRun& run : o.runs) runs.push_back(with_sigma(run, {}, c, e));
+  pair.score = solvers::drift_band_score(runs, o.truths, {}, noise);
+  for (Eigen::Index t = 0; t < pair.score.samples.size(); ++t)
+    if (pair.score.samples(t) > 0)  // measured
+      pair.width += pair.score.rms_sigma_m(t) / pair.score.rms_error_m(t);
+  return pair;
+}
+
+/// The pair chosen on the changed runs (ChangedMachineSigma's rule), `o` observed with the
+/// calibrated factors.
+ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std::string>& names,
+                                       const SigmaCalibrationInput& input) {
+  const bool materials = !o.runs.empty() && !o.runs.front().sigma_terms.empty() &&
+                         !o.runs.front().sigma_terms.front().expansion.empty();
+  ChangedMachineSigma out;
+  out.runs = names;
+  for (const double e : {0.0, 0.05, 0.1, 0.15, 0.2, 0.3}) {
+    if (e > 0 && !materials) break;
+    for (const double c : {0.0, 0.25, 0.5, 1.0, 2.0, 4.0})
+      out.grid.push_back(score_pair(o, c, e, input.truth_sigma_m));
+  }
+  const solvers::DriftBandScore& widest = out.grid.back().score;  // the largest c and e
+  out.goal = widest.coverage.cwiseMin(input.coverage);
+  std::optional<std::size_t> pick;
+  for (std::size_t k = 0; k < out.grid.size(); ++k) {
+    SigmaTermsCandidate& pair = out.grid[k];
+    pair.reaches_goal = true;
+    for (Eigen::Index t = 0; t < out.goal.size(); ++t)
+      if (widest.samples(t) > 0 && pair.score.coverage(t) < out.goal(t)) pair.reaches_goal = false;
+    if (pair.reaches_goal && (!pick || pair.width < out.grid[*pick].width)) pick = k;
+  }
+  out.chosen = pick.value_or(out.grid.size() - 1);  // the widest reaches it by construction
+  const SigmaTermsCandidate& chosen = out.grid[out.chosen];
+  for (std::size_t k = 0; k < o.runs.size(); ++k) {
+    out.before.push_back(solvers::drift_band_score({with_sigma(o.runs[k], {}, 0, 0)}, {o.truths[k]},
+                                                   {}, input.truth_sigma_m));
+    out.after.push_back(
+        solvers::drift_band_score({with_sigma(o.runs[k], {}, chosen.correction_relative_sigma,
+                                              chosen.expansion_relative_sigma)},
+                                  {o.truths[k]}, {}, input.truth_sigma_m));
+  }
+  return out;
+}
+
+/// The changed runs observed with the factors calibrated in `cal` (its sensors), and c and e
+/// chosen on them.
+ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input,
+                                    const SigmaCalibration& cal) {
+  const Eigen::VectorXd factors = cal.temperatures.drift_sigma_scale;
+  const ObserverSetupFor calibrated = [&](const core::CaseSpec& spec,
+                                          const std::vector<std::string>& sensors,
+                                          const Eigen::MatrixXd& rows) {
+    solvers::ObserverSetup setup = input.setup(spec, sensors, rows);
+    setup.noise.drift_sigma_scale = factors;
+    return setup;
+  };
+  Observed o;
+  std::vector<std::string> names;
+  for (const io::MeasuredRun* run : input.changed) {
+    const ObserveInput in{input.declared, run,        input.twin, cal.sensors,
+                          calibrated,     input.mesh, 0.0};
+    o.runs.push_back(observe_run(in).result);
+    o.truths.push_back(
+        drift_columns(*run, cal.targets, "a changed-machine run of the sigma calibration")
+            .readings);
+    names.push_back(run->run);
+    if (input.progress)
+      input.progress("sigma calibration: changed run " + run->run + " observed (" +
+                     std::to_string(names.size()) + " of " + std::to_string(input.changed.size()) +
+                     ")");
+  }
+  return choose_sigma_terms(o, names, input);
+}
+
 }  // namespace
+
+solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
+                                double c, double e) {
+  solvers::ObserverRun out = run;
+  for (std::size_t i = 0; i < run.sigma_terms.size(); ++i) {
+    solvers::DriftSigmaTerms terms = run.sigma_terms[i];
+    if (factor.size() != 0) terms.model = terms.model.cwiseProduct(factor);
+    const auto materials = static_cast<Eigen::Index>(terms.expansion.size());
+    out.drift_sigma.row(static_cast<Eigen::Index>(i)) =
+        solvers::drift_sigma(terms, c, Eigen::VectorXd::Constant(materials, e)).transpose();
+  }
+  return out;
+}
 
 Eigen::MatrixXd between_readings(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& read) {
   Eigen::MatrixXd between = truth;
@@ -112,6 +202,7 @@ SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input) {
     if (measured[t]) cal.measured_targets.push_back(cal.targets[t]);
   cal.temperatures = calibrate_pass(blind, input);
   if (input.drift_readings_every_s > 0) cal.probed = calibrate_pass(probed, input);
+  if (!input.changed.empty()) cal.changed = observe_changed(input, cal);
   return cal;
 }
 

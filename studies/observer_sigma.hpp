@@ -38,7 +38,11 @@ struct SigmaCalibrationInput {
   /// ±2 sqrt((factor sigma)^2 + truth_sigma_m^2)
   double truth_sigma_m = 0;
   double coverage = 0.95;  /// the share of samples the ±2 sigma band is to hold
-  Progress progress;       /// a line per run observed; may be empty
+  /// runs of a machine that has changed (an effect the declared model lacks), their drift measured
+  /// as the training runs' is: with one or more, the correction's and the materials' expansion
+  /// relative sigma are chosen on them (ChangedMachineSigma)
+  std::vector<const io::MeasuredRun*> changed;
+  Progress progress;  /// a line per run observed; may be empty
 };
 
 /// Which rule gave a target's factor.
@@ -61,6 +65,35 @@ struct SigmaPass {
   solvers::DriftBandScore pooled_before, pooled_after;
 };
 
+/// One pair of the correction's relative sigma c
+/// (solvers::ObserverNoise::correction_relative_sigma) and an expansion relative sigma e for every
+/// material (expansion_relative_sigma), scored on the changed runs.
+struct SigmaTermsCandidate {
+  double correction_relative_sigma = 0, expansion_relative_sigma = 0;
+  solvers::DriftBandScore score;  /// pooled over the changed runs
+  double width = 0;               /// over the measured targets: the sum of RMS sigma / RMS error
+  bool reaches_goal = false;      /// the goal's coverage reached in every measured target
+};
+
+/// c and e chosen on runs of a changed machine (docs/observer.md, "A machine that has changed"):
+/// the sigma calibrated where the model holds (the factors) with (c d_c)^2 and the sum over the
+/// materials of (e d_m)^2 added (solvers::DriftSigmaTerms). The sigma grows with c and e sample by
+/// sample, so the grid's widest pair covers the most in every target. Per measured target the goal
+/// is `coverage`, or what that widest pair covers where it covers less (a drift no term reaches:
+/// a heat input off the unknown inputs' shapes moves dx, which neither term follows). Rule: the
+/// narrowest pair (least width) that reaches the goal in every measured target. The grid: c over
+/// 0, 0.25, 0.5, 1, 2, 4 and e over 0, 0.05, 0.1, 0.15, 0.2, 0.3 (e 0 only when the reduced model
+/// keeps no drift rows per material).
+struct ChangedMachineSigma {
+  std::vector<std::string> runs;  /// the changed runs' names
+  std::vector<SigmaTermsCandidate> grid;
+  /// per target: the coverage aimed at (NaN where no changed run measured the target)
+  Eigen::VectorXd goal;
+  std::size_t chosen = 0;  /// the chosen pair's index in grid
+  /// per changed run: the score at c = e = 0 and at the chosen pair
+  std::vector<solvers::DriftBandScore> before, after;
+};
+
 struct SigmaCalibration {
   std::vector<std::string> runs;              /// the training runs' names
   std::vector<std::string> sensors;           /// read, in order
@@ -71,15 +104,23 @@ struct SigmaCalibration {
   SigmaPass temperatures;
   double drift_readings_every_s = 0;
   std::optional<SigmaPass> probed;  /// with a probe cycle
+  /// with changed runs: c and e chosen on them, for the filter that reads temperatures only
+  std::optional<ChangedMachineSigma> changed;
 };
+
+/// `run` with the sigma that its terms (solvers::DriftSigmaTerms) make with `factor` on the sigma
+/// it was observed with (per target; empty: 1), the correction's relative sigma c and an expansion
+/// relative sigma e for every material: as the observer would have reported it with them.
+solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
+                                double c, double e);
 
 /// `truth` (#samples x #targets) with NaN at every sample where `read` (drift readings of the same
 /// samples, NaN where none) holds a reading: a probe-cycle filter is scored between its readings,
 /// since at a reading it is pulled to the very value it would be scored on.
 Eigen::MatrixXd between_readings(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& read);
 
-/// Throws DataError naming the run when a run has no displacement column named after a target, or
-/// lacks a sensor the first run gives; what observe_run throws.
+/// Throws DataError naming the run when a training or changed run has no displacement column
+/// named after a target, or lacks a sensor the first run gives; what observe_run throws.
 SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input);
 
 }  // namespace tt::studies

@@ -583,6 +583,42 @@ TEST_F(Observer, CorrectionSigmaFollowsWhatTheFilterMovedFromTheDeclaredRun) {
   EXPECT_THROW(solvers::KalmanObserver(sys, c, bad), core::SolverError);
 }
 
+TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
+  // The run keeps per sample what its sigma is made of (DriftSigmaTerms), so that `observe
+  // --changed` scores other c and e without observing again: the terms of a run observed with
+  // c = e = 0 give, through solvers::drift_sigma, the sigma of a run observed with c = 0.7 and
+  // e = (0.1, 0.2, ...), widening on inconsistency included; and the terms do not depend on c, e.
+  const core::CaseSpec c = run_spec();
+  const auto& sys = s_->twin.model.system;
+  solvers::ObserverNoise plain_noise = default_noise();
+  plain_noise.widen_on_inconsistency = true;
+  const solvers::ObserverSetup plain_setup = setup(plain_noise);
+  ASSERT_FALSE(plain_setup.target_expansion.empty());
+  solvers::ObserverNoise wide_noise = plain_noise;
+  wide_noise.correction_relative_sigma = 0.7;
+  wide_noise.expansion_relative_sigma = Eigen::VectorXd::LinSpaced(
+      static_cast<Eigen::Index>(plain_setup.target_expansion.size()), 0.1,
+      0.1 * static_cast<double>(plain_setup.target_expansion.size()));
+  const auto& run = s_->heat;
+  const solvers::ObserverRun plain =
+      solvers::observe(sys, c, plain_setup, run.time, run.temperature);
+  const solvers::ObserverRun wide =
+      solvers::observe(sys, c, setup(wide_noise), run.time, run.temperature);
+  ASSERT_EQ(plain.sigma_terms.size(), static_cast<std::size_t>(plain.times.size()));
+  EXPECT_EQ(wide.drift, plain.drift);
+  double widened = 1;
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    const solvers::DriftSigmaTerms& t = plain.sigma_terms[static_cast<std::size_t>(i)];
+    widened = std::max(widened, t.widening);
+    EXPECT_EQ(plain.drift_sigma.row(i).transpose(), solvers::drift_sigma(t, 0, {})) << i;
+    const Eigen::VectorXd expected =
+        solvers::drift_sigma(t, 0.7, wide_noise.expansion_relative_sigma);
+    for (int d = 0; d < 3; ++d)
+      EXPECT_NEAR(wide.drift_sigma(i, d), expected(d), 1e-12 * expected(d)) << i << " " << d;
+  }
+  EXPECT_GT(widened, 1.0);  // the heat run's innovations widen the sigma somewhere
+}
+
 TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
   // ObserverNoise::expansion_relative_sigma e: sigma^2 = sigma_0^2 + sum_m (e d_m)^2, d_m the
   // part of the drift material m's thermal strain makes. Checked against the full-order model:
