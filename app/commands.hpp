@@ -94,14 +94,16 @@ struct ObserverOptions {
   std::vector<std::string> sensors;  /// empty: every sensor of the run the model names
   /// white noise per reading [K]: one value for every sensor, or one per sensor in their order
   std::vector<double> sensor_sigma_k{0.05};
-  double heat_walk_w = 4.0;              /// random walk of each unknown heat input [W/sqrt(h)]
-  double heat_initial_w = 2.0;           /// each unknown heat input's spread at t = 0 [W]
-  double air_walk_k = 0.5;               /// random walk of the air offset [K/sqrt(h)]
-  double air_initial_k = 0.3;            /// the air offset's spread at t = 0 [K]
-  double state_walk_k = 0;               /// white noise on every reduced state [K/sqrt(h)]
-  double sensor_offset_k = 0.5;          /// per-sensor offset state: spread at t = 0 [K]
-  double sensor_offset_walk_k = 0.05;    /// per-sensor offset state: random walk [K/sqrt(h)]
-  bool widen_on_inconsistency = false;   /// widen sigma by sqrt(window NIS / readings) when > 1
+  double heat_walk_w = 4.0;             /// random walk of each unknown heat input [W/sqrt(h)]
+  double heat_initial_w = 2.0;          /// each unknown heat input's spread at t = 0 [W]
+  double air_walk_k = 0.5;              /// random walk of the air offset [K/sqrt(h)]
+  double air_initial_k = 0.3;           /// the air offset's spread at t = 0 [K]
+  double state_walk_k = 0;              /// white noise on every reduced state [K/sqrt(h)]
+  double sensor_offset_k = 0.5;         /// per-sensor offset state: spread at t = 0 [K]
+  double sensor_offset_walk_k = 0.05;   /// per-sensor offset state: random walk [K/sqrt(h)]
+  bool widen_on_inconsistency = false;  /// widen sigma by sqrt(window NIS / readings) when > 1
+  /// the correction's and expansion's terms only once the filter says recalibrate
+  bool changed_terms_after_alarm = false;
   double drift_relative_sigma = 0.04;    /// the drift rows' own error, relative to the drift [-]
   double correction_relative_sigma = 0;  /// the corrections' error, relative to them [-]
   /// each material's expansion error, relative [-]: one value for all or one per material

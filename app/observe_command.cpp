@@ -64,9 +64,10 @@ void print_calibration(const studies::SigmaCalibration& cal) {
     std::cerr << "thermotwin: observe:   " << cal.targets[t] << ": ±2 sigma held "
               << 100 * ch.grid.front().score.coverage(k) << " % of the changed runs' samples, now "
               << 100 * pick.score.coverage(k) << " %"
-              << (ch.goal(k) < cal.coverage ? " (out of the terms' reach: at most " +
-                                                  std::to_string(100 * ch.goal(k)) + " %)"
-                                            : "")
+              << (ch.in_reach[t]
+                      ? ""
+                      : " (out of the terms' reach: the widest pair holds " +
+                            std::to_string(100 * ch.grid.back().score.coverage(k)) + " %)")
               << "\n";
   }
 }

@@ -108,6 +108,7 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           "relative sigma; give it or --correction-relative-sigma / "
                           "--expansion-relative-sigma, not both");
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
+  setup.noise.changed_terms_after_alarm = f.changed_terms_after_alarm;
   setup.noise.expansion_relative_sigma =
       expansion_sigmas({f.expansion_relative_sigma.value_or(0.0)}, setup);
 }
@@ -221,6 +222,10 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
                    "noise model is off (default: off)");
+  command.add_flag("--changed-terms-after-alarm", o.changed_terms_after_alarm,
+                   "add --correction-relative-sigma's and --expansion-relative-sigma's terms only "
+                   "once the filter says recalibrate: the band stays as calibrated until the "
+                   "machine is seen to have changed (default: off, always)");
 }
 
 solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
@@ -240,6 +245,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.drift_reading_sigma_m = 1e-6 * o.drift_reading_sigma_um;
   noise.correction_relative_sigma = o.correction_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
+  noise.changed_terms_after_alarm = o.changed_terms_after_alarm;
   solvers::ObserverSetup setup =
       solvers::twin_observer_setup(twin, spec, sensors, noise, sensor_rows);
   setup.noise.expansion_relative_sigma = expansion_sigmas(o.expansion_relative_sigma, setup);
@@ -275,7 +281,8 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
                         {"correction_relative_sigma", n.correction_relative_sigma},
                         {"expansion_relative_sigma", expansion_json(setup)},
                         {"drift_sigma_scale", io::as_vector(scale)},
-                        {"widen_on_inconsistency", n.widen_on_inconsistency}};
+                        {"widen_on_inconsistency", n.widen_on_inconsistency},
+                        {"changed_terms_after_alarm", n.changed_terms_after_alarm}};
   if (n.probed_drift_sigma_scale.size() != 0)
     out["probed_drift_sigma_scale"] = io::as_vector(n.probed_drift_sigma_scale);
   return out;

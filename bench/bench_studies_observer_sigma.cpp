@@ -179,6 +179,17 @@ int main(int argc, char** argv) {
     for (std::size_t k = first_changed; k < runs.size(); ++k)
       undeclared.changed.push_back(&runs[k].measured);
     const studies::SigmaCalibration cal_plain = studies::calibrate_observer_sigma(undeclared);
+    // The same with the terms acting only once the filter says recalibrate
+    // (--changed-terms-after-alarm): chosen so, and scored so.
+    studies::SigmaCalibrationInput gated = undeclared;
+    gated.setup = [&twin](const core::CaseSpec& c, const std::vector<std::string>& s,
+                          const Eigen::MatrixXd& rows) {
+      solvers::ObserverSetup setup = cli_setup(twin, c, s, rows, {});
+      setup.noise.changed_terms_after_alarm = true;
+      return setup;
+    };
+    const studies::ChangedMachineSigma after_alarm =
+        *studies::calibrate_observer_sigma(gated).changed;
     std::printf("calibration on %d training runs (%.0f s): factors", train, seconds_since(t_cal));
     for (Eigen::Index t = 0; t < cal.temperatures.drift_sigma_scale.size(); ++t)
       std::printf(" %s %.4g", cal.targets[static_cast<std::size_t>(t)].c_str(),
@@ -189,14 +200,21 @@ int main(int argc, char** argv) {
     std::printf(")\n");
     const studies::ChangedMachineSigma& changed = *cal_plain.changed;
     const studies::SigmaTermsCandidate& pick = changed.grid[changed.chosen];
-    std::printf("chosen on %zu changed runs (noise not declared): c %g, e %g; goal",
+    std::printf("chosen on %zu changed runs (noise not declared): c %g, e %g; in reach",
                 changed.runs.size(), pick.correction_relative_sigma, pick.expansion_relative_sigma);
-    for (Eigen::Index t = 0; t < changed.goal.size(); ++t)
-      std::printf(" %s %.3f", cal.targets[static_cast<std::size_t>(t)].c_str(), changed.goal(t));
+    for (std::size_t t = 0; t < changed.in_reach.size(); ++t)
+      std::printf(" %s %s", cal.targets[t].c_str(), changed.in_reach[t] ? "yes" : "no");
     std::printf("; their coverage at c = e = 0 and at the choice:");
-    for (Eigen::Index t = 0; t < changed.goal.size(); ++t)
+    for (Eigen::Index t = 0; t < changed.grid.front().score.coverage.size(); ++t)
       std::printf(" %s %.1f -> %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
                   100 * changed.grid.front().score.coverage(t), 100 * pick.score.coverage(t));
+    std::printf("\n");
+    const studies::SigmaTermsCandidate& gated_pick = after_alarm.grid[after_alarm.chosen];
+    std::printf("with the terms after the alarm: c %g, e %g; their coverage at the choice:",
+                gated_pick.correction_relative_sigma, gated_pick.expansion_relative_sigma);
+    for (Eigen::Index t = 0; t < gated_pick.score.coverage.size(); ++t)
+      std::printf(" %s %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
+                  100 * gated_pick.score.coverage(t));
     std::printf("\n");
     if (cal.probed) {
       std::printf("with a probe cycle every %g s: factors", probe_every_s);
@@ -251,18 +269,24 @@ int main(int argc, char** argv) {
     report("effect runs, noise not declared", effect, cal_plain.temperatures.drift_sigma_scale, 0,
            cal.targets);
     // c and e chosen on the changed runs, on the factors of the noise not declared.
-    const auto with_choice = [&](const Pooled& p) {
+    const auto with_choice = [&](const Pooled& p, const studies::SigmaTermsCandidate& choice,
+                                 bool gate) {
       Pooled out = p;
       for (solvers::ObserverRun& r : out.runs)
         r = studies::with_sigma(r, cal_plain.temperatures.drift_sigma_scale,
-                                pick.correction_relative_sigma, pick.expansion_relative_sigma);
+                                choice.correction_relative_sigma, choice.expansion_relative_sigma,
+                                gate);
       return out;
     };
     const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cal.temperatures.drift_sigma_scale.size());
-    report("held-out clean, noise not declared, c and e of the changed runs", with_choice(clean),
-           ones, 0, cal.targets);
-    report("effect runs, noise not declared, c and e of the changed runs", with_choice(effect),
-           ones, 0, cal.targets);
+    report("held-out clean, noise not declared, c and e of the changed runs",
+           with_choice(clean, pick, false), ones, 0, cal.targets);
+    report("effect runs, noise not declared, c and e of the changed runs",
+           with_choice(effect, pick, false), ones, 0, cal.targets);
+    report("held-out clean, noise not declared, c and e after the alarm",
+           with_choice(clean, gated_pick, true), ones, 0, cal.targets);
+    report("effect runs, noise not declared, c and e after the alarm",
+           with_choice(effect, gated_pick, true), ones, 0, cal.targets);
     if (cal.probed) {
       report("held-out clean, probe cycle, noise declared", clean_probed,
              cal.probed->drift_sigma_scale, gopt.noise_displacement_m, cal.targets);

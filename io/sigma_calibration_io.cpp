@@ -1,6 +1,5 @@
 #include "io/sigma_calibration_io.hpp"
 
-#include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -67,18 +66,15 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
                     {"before", score_json(ch.before[k], c.targets)},
                     {"after", score_json(ch.after[k], c.targets)}});
   const studies::SigmaTermsCandidate& pick = ch.grid.at(ch.chosen);
-  json goal = json::object();
-  std::vector<std::string> short_of;
-  for (std::size_t t = 0; t < c.targets.size(); ++t) {
-    const double g = ch.goal(static_cast<Eigen::Index>(t));
-    goal[c.targets[t]] = finite_or_null(g);
-    if (std::isfinite(g) && g < c.coverage) short_of.push_back(c.targets[t]);
-  }
+  std::vector<std::string> out_of_reach;
+  for (std::size_t t = 0; t < c.targets.size(); ++t)
+    if (!ch.in_reach[t] && ch.grid.back().score.samples(static_cast<Eigen::Index>(t)) > 0)
+      out_of_reach.push_back(c.targets[t]);
   return {{"runs", ch.runs},
           {"correction_relative_sigma", pick.correction_relative_sigma},
           {"expansion_relative_sigma", pick.expansion_relative_sigma},
-          {"goal", goal},
-          {"out_of_reach", short_of},
+          {"after_alarm", ch.after_alarm},
+          {"out_of_reach", out_of_reach},
           {"grid", grid},
           {"per_run", runs}};
 }
@@ -140,6 +136,7 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
     more << " --correction-relative-sigma " << pick.correction_relative_sigma;
     if (pick.expansion_relative_sigma > 0)
       more << " --expansion-relative-sigma " << pick.expansion_relative_sigma;
+    if (c.changed->after_alarm) more << " --changed-terms-after-alarm";
     flags += more.str();
   }
   out["flags"] = flags;
@@ -173,6 +170,11 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
     };
     f.correction_relative_sigma = relative("correction_relative_sigma");
     f.expansion_relative_sigma = relative("expansion_relative_sigma");
+    const json& gate = fit_keys::member(j["changed_machine"], "after_alarm", p, "changed_machine.");
+    if (!gate.is_boolean())
+      throw core::DataError(p.at("changed_machine.after_alarm") + " = " + gate.dump() +
+                            ": expected true or false");
+    f.changed_terms_after_alarm = gate.get<bool>();
   }
   return f;
 }

@@ -35,6 +35,7 @@ struct SigmaCalibrationFile {
   /// with changed runs (changed_machine): the correction's relative sigma, and the expansion
   /// relative sigma of every material
   std::optional<double> correction_relative_sigma, expansion_relative_sigma;
+  bool changed_terms_after_alarm = false;  /// and whether they act only after the alarm
 };
 
 /// Reads a sigma_calibration.json. IoError when it cannot be read; DataError naming the file and

@@ -498,10 +498,12 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   if (setup_.noise.widen_on_inconsistency && monitor_.window_dof() > 0)
     e.sigma_terms.widening =
         std::sqrt(std::max(1.0, monitor_.window_nis() / monitor_.window_dof()));
-  e.drift_sigma = drift_sigma(e.sigma_terms, setup_.noise.correction_relative_sigma,
-                              setup_.noise.expansion_relative_sigma);
   e.recalibrate_since_s = monitor_.since_s();
   test_departures(t, readings, e);
+  e.sigma_terms.alarm = e.recalibrate;
+  e.drift_sigma =
+      drift_sigma(e.sigma_terms, setup_.noise.correction_relative_sigma,
+                  setup_.noise.expansion_relative_sigma, setup_.noise.changed_terms_after_alarm);
   return e;
 }
 
@@ -615,8 +617,9 @@ DriftSigmaTerms KalmanObserver::drift_sigma_terms(const Eigen::VectorXd& drift) 
 }
 
 Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
-                            const Eigen::VectorXd& expansion) {
+                            const Eigen::VectorXd& expansion, bool after_alarm) {
   Eigen::ArrayXd var = terms.model.array().square();
+  if (after_alarm && !terms.alarm) return terms.widening * var.sqrt().matrix();
   if (correction > 0) var += (correction * terms.correction.array()).square();
   for (Eigen::Index m = 0; m < expansion.size(); ++m)
     if (expansion(m) > 0)

@@ -89,6 +89,12 @@ struct ObserverNoise {
   /// the filter (gain, innovations, alarm) as it is, like drift_sigma_scale, on top of which it
   /// acts: a sigma calibrated where the model holds does not stay narrow where it no longer does.
   bool widen_on_inconsistency = false;
+  /// Add the correction's and the expansion's terms (correction_relative_sigma,
+  /// expansion_relative_sigma) only from the sample at which the filter says recalibrate (its NIS
+  /// test, a model departure, a late offset): the band stays as calibrated on a machine that has
+  /// not changed and widens once the filter sees that it has. A change no reading shows (a wrong
+  /// expansion coefficient without a probe cycle) raises nothing and is then not covered.
+  bool changed_terms_after_alarm = false;
 };
 
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
@@ -249,12 +255,14 @@ struct DriftSigmaTerms {
   /// strain makes [m]
   std::vector<Eigen::VectorXd> expansion;
   double widening = 1;  /// the widening on inconsistency's factor, >= 1 (1: none)
+  bool alarm = false;   /// the filter says recalibrate at this time
 };
 
 /// The reported sigma (#targets [m]) of `terms` under a correction sigma c and, per material,
-/// an expansion sigma (`expansion`: empty or one per material).
+/// an expansion sigma (`expansion`: empty or one per material); with `after_alarm`, neither
+/// before terms.alarm (ObserverNoise::changed_terms_after_alarm).
 Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
-                            const Eigen::VectorXd& expansion);
+                            const Eigen::VectorXd& expansion, bool after_alarm = false);
 
 /// What the observer says after one assimilation.
 struct ObserverEstimate {

@@ -72,23 +72,30 @@ struct SigmaTermsCandidate {
   double correction_relative_sigma = 0, expansion_relative_sigma = 0;
   solvers::DriftBandScore score;  /// pooled over the changed runs
   double width = 0;               /// over the measured targets: the sum of RMS sigma / RMS error
-  bool reaches_goal = false;      /// the goal's coverage reached in every measured target
+  bool reaches_goal = false;      /// the coverage reached in every measured target within reach
 };
 
 /// c and e chosen on runs of a changed machine (docs/observer.md, "A machine that has changed"):
 /// the sigma calibrated where the model holds (the factors) with (c d_c)^2 and the sum over the
 /// materials of (e d_m)^2 added (solvers::DriftSigmaTerms). The sigma grows with c and e sample by
-/// sample, so the grid's widest pair covers the most in every target. Per measured target the goal
-/// is `coverage`, or what that widest pair covers where it covers less (a drift no term reaches:
-/// a heat input off the unknown inputs' shapes moves dx, which neither term follows). Rule: the
-/// narrowest pair (least width) that reaches the goal in every measured target. The grid: c over
+/// sample, so the grid's widest pair covers the most in every target. A measured target where even
+/// that pair covers less than `coverage` is out of the terms' reach (a drift no term follows: a
+/// heat input off the unknown inputs' shapes moves dx on SB-1) and left out of the rule: the
+/// terms widen it by a little at most, and asking for that little would take the widest pair
+/// every time. Rule: the narrowest pair (least width) that covers `coverage` in every measured
+/// target within reach. The grid: c over
 /// 0, 0.25, 0.5, 1, 2, 4 and e over 0, 0.05, 0.1, 0.15, 0.2, 0.3 (e 0 only when the reduced model
 /// keeps no drift rows per material).
 struct ChangedMachineSigma {
   std::vector<std::string> runs;  /// the changed runs' names
+  /// the terms act only once the filter says recalibrate (the set-up's
+  /// ObserverNoise::changed_terms_after_alarm): the changed runs are then scored on their samples
+  /// from the alarm on, where the terms act (a run that raises nothing counts no sample)
+  bool after_alarm = false;
   std::vector<SigmaTermsCandidate> grid;
-  /// per target: the coverage aimed at (NaN where no changed run measured the target)
-  Eigen::VectorXd goal;
+  /// per target: whether the widest pair covers `coverage` of it (false where no changed run
+  /// measured it)
+  std::vector<bool> in_reach;
   std::size_t chosen = 0;  /// the chosen pair's index in grid
   /// per changed run: the score at c = e = 0 and at the chosen pair
   std::vector<solvers::DriftBandScore> before, after;
@@ -110,9 +117,10 @@ struct SigmaCalibration {
 
 /// `run` with the sigma that its terms (solvers::DriftSigmaTerms) make with `factor` on the sigma
 /// it was observed with (per target; empty: 1), the correction's relative sigma c and an expansion
-/// relative sigma e for every material: as the observer would have reported it with them.
+/// relative sigma e for every material (with `after_alarm`, only from the alarm on): as the
+/// observer would have reported it with them.
 solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
-                                double c, double e);
+                                double c, double e, bool after_alarm = false);
 
 /// `truth` (#samples x #targets) with NaN at every sample where `read` (drift readings of the same
 /// samples, NaN where none) holds a reading: a probe-cycle filter is scored between its readings,

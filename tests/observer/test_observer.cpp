@@ -588,6 +588,7 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
   // --changed` scores other c and e without observing again: the terms of a run observed with
   // c = e = 0 give, through solvers::drift_sigma, the sigma of a run observed with c = 0.7 and
   // e = (0.1, 0.2, ...), widening on inconsistency included; and the terms do not depend on c, e.
+  // With changed_terms_after_alarm the terms act from the alarm on.
   const core::CaseSpec c = run_spec();
   const auto& sys = s_->twin.model.system;
   solvers::ObserverNoise plain_noise = default_noise();
@@ -617,6 +618,20 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
       EXPECT_NEAR(wide.drift_sigma(i, d), expected(d), 1e-12 * expected(d)) << i << " " << d;
   }
   EXPECT_GT(widened, 1.0);  // the heat run's innovations widen the sigma somewhere
+  // With the terms after the alarm (changed_terms_after_alarm): the plain sigma until the filter
+  // says recalibrate, the wide one from then on.
+  ASSERT_TRUE(plain.recalibrate);
+  wide_noise.changed_terms_after_alarm = true;
+  const solvers::ObserverRun gated =
+      solvers::observe(sys, c, setup(wide_noise), run.time, run.temperature);
+  EXPECT_EQ(gated.recalibrate_at_s, plain.recalibrate_at_s);
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    const bool alarm = plain.times(i) >= plain.recalibrate_at_s;
+    EXPECT_EQ(plain.sigma_terms[static_cast<std::size_t>(i)].alarm, alarm) << i;
+    const Eigen::MatrixXd& expected = alarm ? wide.drift_sigma : plain.drift_sigma;
+    for (int d = 0; d < 3; ++d)
+      EXPECT_NEAR(gated.drift_sigma(i, d), expected(i, d), 1e-12 * expected(i, d)) << i << " " << d;
+  }
 }
 
 TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
