@@ -908,8 +908,11 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   // The terms after the alarm (--changed-terms-after-alarm): chosen and applied so.
   ASSERT_EQ(observe({"--train", path("a"), "--train", path("b"), "--changed", path("heat"),
                      "--changed", path("expansion"), "--changed-terms-after-alarm", "--data",
-                     path("held"), "--out", (dir / "gated").string(), "--quiet"}),
+                     path("held"), "--out", (dir / "gated").string()}),
             0)
+      << rt::read_text(log);
+  // A wrong expansion coefficient changes no temperature: no alarm, so nothing to score there.
+  EXPECT_NE(rt::read_text(log).find("changed run expansion raised no alarm"), std::string::npos)
       << rt::read_text(log);
   const auto gated = nlohmann::json::parse(std::ifstream(dir / "gated" / "sigma_calibration.json"));
   EXPECT_EQ(gated["changed_machine"]["after_alarm"], true);
