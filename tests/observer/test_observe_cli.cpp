@@ -920,6 +920,25 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
             std::string::npos);
   const auto gated_held = nlohmann::json::parse(std::ifstream(dir / "gated" / "observer.json"));
   EXPECT_EQ(gated_held["noise"]["changed_terms_after_alarm"], true);
+  // compensate --rom takes the same file: the held-out run streamed gives observe's sigmas, the
+  // terms switched on at the same alarm.
+  ASSERT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
+                     "--meta", (dir / "run_held" / "meta.json").string(), "--in",
+                     (dir / "run_held" / "data.csv").string(), "--until-eof", "--out",
+                     (dir / "live.csv").string(), "--sigma-calibration",
+                     (dir / "gated" / "sigma_calibration.json").string()},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  {
+    const auto offline = tt::test::csv_rows(dir / "gated" / "observer.csv");
+    const auto streamed = tt::test::csv_rows(dir / "live.csv");
+    ASSERT_EQ(streamed.size(), offline.size());
+    for (std::size_t i = 0; i < offline.size(); ++i)
+      for (const char* column : {"dy_sigma_um", "dz_sigma_um"})
+        EXPECT_NEAR(std::stod(streamed[i].at(column)), std::stod(offline[i].at(column)), 1e-6)
+            << i << " " << column;
+  }
   std::printf("[changed sigma] after the alarm: c %.2f, e %.2f; held-out run raised at %s s\n",
               gated["correction_relative_sigma"].get<double>(),
               gated["expansion_relative_sigma"].get<double>(),
