@@ -77,7 +77,8 @@ void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
 /// The factors of --sigma-calibration's file on `setup`, and the relative sigmas it chose on
 /// changed runs. DataError naming the file when it was calibrated for other sensors, targets or
 /// probe cycle, or when --drift-sigma-scale or --probed-drift-sigma-scale is given too (or
-/// --correction-relative-sigma or --expansion-relative-sigma, when it chose those).
+/// --correction-relative-sigma or --expansion-relative-sigma, when it chose those, or
+/// --changed-terms-after-alarm, when it chose them with the terms always on).
 void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::string>& sensors,
                              solvers::ObserverSetup& setup) {
   const std::string file = o.sigma_calibration.string();
@@ -107,6 +108,11 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           ": its changed_machine chose the correction's and the expansion's "
                           "relative sigma; give it or --correction-relative-sigma / "
                           "--expansion-relative-sigma, not both");
+  if (o.changed_terms_after_alarm && !f.changed_terms_after_alarm)
+    throw core::DataError("--sigma-calibration " + file +
+                          ": changed_machine.after_alarm = false: its relative sigmas were chosen "
+                          "with the terms always on; choose them again with "
+                          "--changed-terms-after-alarm, or leave the flag out");
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
   setup.noise.changed_terms_after_alarm = f.changed_terms_after_alarm;
   setup.noise.expansion_relative_sigma =

@@ -950,6 +950,8 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
        "give it or them, not both"},
       {{"--data", path("held"), "--sigma-calibration", file, "--expansion-relative-sigma", "0.1"},
        "its changed_machine chose"},
+      {{"--data", path("held"), "--sigma-calibration", file, "--changed-terms-after-alarm"},
+       "changed_machine.after_alarm = false"},
       {{"--train", path("a"), "--changed", path("a")}, "--changed"},
       {{"--data", path("held"), "--changed", path("heat")}, "--changed requires --train"}};
   for (const auto& [flags, message] : refused) {
