@@ -12,7 +12,6 @@
 //      every sensor of the run that is a named point of the model), the observer's set-up
 //      (app/observer_options.hpp, with the calibrated factors), the run through the filter;
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
-#include <algorithm>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -54,7 +53,7 @@ void print_calibration(const studies::SigmaCalibration& cal) {
   if (cal.probed) pass("probed sigma", *cal.probed);
   if (!cal.changed) return;
   const studies::ChangedMachineSigma& ch = *cal.changed;
-  const studies::SigmaTermsCandidate& pick = ch.grid.at(ch.chosen);
+  const studies::SigmaTermsCandidate& pick = ch.pick();
   std::cerr << "thermotwin: observe: on the changed runs, correction relative sigma "
             << pick.correction_relative_sigma << " and expansion relative sigma "
             << pick.expansion_relative_sigma << "\n";
@@ -69,10 +68,10 @@ void print_calibration(const studies::SigmaCalibration& cal) {
     std::cerr << "thermotwin: observe:   " << cal.targets[t] << ": ±2 sigma held "
               << 100 * ch.grid.front().score.coverage(k) << " % of the changed runs' samples, now "
               << 100 * pick.score.coverage(k) << " %"
-              << (ch.in_reach[t]
-                      ? ""
-                      : " (out of the terms' reach: the widest pair holds " +
-                            std::to_string(100 * ch.grid.back().score.coverage(k)) + " %)")
+              << (ch.out_of_reach[t]
+                      ? " (out of the terms' reach: the widest pair holds " +
+                            std::to_string(100 * ch.grid.back().score.coverage(k)) + " %)"
+                      : "")
               << "\n";
   }
 }
@@ -104,7 +103,7 @@ void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>
   options.probed_drift_sigma_scale.clear();
   if (cal.probed) options.probed_drift_sigma_scale = io::as_vector(cal.probed->drift_sigma_scale);
   if (cal.changed) {
-    const studies::SigmaTermsCandidate& pick = cal.changed->grid.at(cal.changed->chosen);
+    const studies::SigmaTermsCandidate& pick = cal.changed->pick();
     options.correction_relative_sigma = pick.correction_relative_sigma;
     options.expansion_relative_sigma = {pick.expansion_relative_sigma};
   }
@@ -149,10 +148,7 @@ int observe_command(const ObserveArgs& args) {
   io::require_disjoint_runs(
       args.changed, args.train, "--changed", "--train",
       "a run is either of the machine the model declares or of a changed one");
-  if (!args.changed.empty() &&
-      (args.observer.correction_relative_sigma > 0 ||
-       std::any_of(args.observer.expansion_relative_sigma.begin(),
-                   args.observer.expansion_relative_sigma.end(), [](double e) { return e > 0; })))
+  if (!args.changed.empty() && gives_changed_terms(args.observer))
     throw core::DataError(
         "observe: --changed chooses --correction-relative-sigma and --expansion-relative-sigma; "
         "give it or them, not both");

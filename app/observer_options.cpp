@@ -103,7 +103,7 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
   setup.noise.drift_sigma_scale = f.drift_sigma_scale;
   if (f.probe_every_s) setup.noise.probed_drift_sigma_scale = f.probed_drift_sigma_scale;
   if (!f.correction_relative_sigma) return;
-  if (o.correction_relative_sigma > 0 || setup.noise.expansion_relative_sigma.size() != 0)
+  if (gives_changed_terms(o))
     throw core::DataError("--sigma-calibration " + file +
                           ": its changed_machine chose the correction's and the expansion's "
                           "relative sigma; give it or --correction-relative-sigma / "
@@ -268,6 +268,12 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   setup.consistency.sensor_fault_sigmas = o.sensor_fault_sigmas;
   setup.consistency.model_residual_sigmas = o.model_residual_sigmas;
   return setup;
+}
+
+bool gives_changed_terms(const ObserverOptions& o) {
+  return o.correction_relative_sigma > 0 ||
+         std::any_of(o.expansion_relative_sigma.begin(), o.expansion_relative_sigma.end(),
+                     [](double e) { return e > 0; });
 }
 
 nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {

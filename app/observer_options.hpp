@@ -37,4 +37,8 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& options, const solv
 /// The noise model and consistency test of a set-up, for a result file.
 nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup);
 
+/// Whether --correction-relative-sigma or --expansion-relative-sigma gives a term (a value above
+/// 0): what `observe --changed` and a --sigma-calibration file that chose them refuse beside them.
+bool gives_changed_terms(const ObserverOptions& options);
+
 }  // namespace tt::app

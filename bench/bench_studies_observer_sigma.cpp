@@ -199,17 +199,17 @@ int main(int argc, char** argv) {
       std::printf(" %.4g", cal_plain.temperatures.drift_sigma_scale(t));
     std::printf(")\n");
     const studies::ChangedMachineSigma& changed = *cal_plain.changed;
-    const studies::SigmaTermsCandidate& pick = changed.grid[changed.chosen];
-    std::printf("chosen on %zu changed runs (noise not declared): c %g, e %g; in reach",
+    const studies::SigmaTermsCandidate& pick = changed.pick();
+    std::printf("chosen on %zu changed runs (noise not declared): c %g, e %g; out of reach:",
                 changed.runs.size(), pick.correction_relative_sigma, pick.expansion_relative_sigma);
-    for (std::size_t t = 0; t < changed.in_reach.size(); ++t)
-      std::printf(" %s %s", cal.targets[t].c_str(), changed.in_reach[t] ? "yes" : "no");
+    for (std::size_t t = 0; t < changed.out_of_reach.size(); ++t)
+      if (changed.out_of_reach[t]) std::printf(" %s", cal.targets[t].c_str());
     std::printf("; their coverage at c = e = 0 and at the choice:");
     for (Eigen::Index t = 0; t < changed.grid.front().score.coverage.size(); ++t)
       std::printf(" %s %.1f -> %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
                   100 * changed.grid.front().score.coverage(t), 100 * pick.score.coverage(t));
     std::printf("\n");
-    const studies::SigmaTermsCandidate& gated_pick = after_alarm.grid[after_alarm.chosen];
+    const studies::SigmaTermsCandidate& gated_pick = after_alarm.pick();
     std::printf("with the terms after the alarm: c %g, e %g; their coverage at the choice:",
                 gated_pick.correction_relative_sigma, gated_pick.expansion_relative_sigma);
     for (Eigen::Index t = 0; t < gated_pick.score.coverage.size(); ++t)

@@ -65,11 +65,10 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
     runs.push_back({{"run", ch.runs[k]},
                     {"before", score_json(ch.before[k], c.targets)},
                     {"after", score_json(ch.after[k], c.targets)}});
-  const studies::SigmaTermsCandidate& pick = ch.grid.at(ch.chosen);
+  const studies::SigmaTermsCandidate& pick = ch.pick();
   std::vector<std::string> out_of_reach;
   for (std::size_t t = 0; t < c.targets.size(); ++t)
-    if (!ch.in_reach[t] && ch.grid.back().score.samples(static_cast<Eigen::Index>(t)) > 0)
-      out_of_reach.push_back(c.targets[t]);
+    if (ch.out_of_reach[t]) out_of_reach.push_back(c.targets[t]);
   return {{"runs", ch.runs},
           {"correction_relative_sigma", pick.correction_relative_sigma},
           {"expansion_relative_sigma", pick.expansion_relative_sigma},
@@ -129,7 +128,7 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
   out["changed_machine"] = nullptr;
   if (c.changed) {
     out["changed_machine"] = changed_json(*c.changed, c);
-    const studies::SigmaTermsCandidate& pick = c.changed->grid.at(c.changed->chosen);
+    const studies::SigmaTermsCandidate& pick = c.changed->pick();
     out["correction_relative_sigma"] = pick.correction_relative_sigma;
     out["expansion_relative_sigma"] = pick.expansion_relative_sigma;
     std::ostringstream more;

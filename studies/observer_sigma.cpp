@@ -83,21 +83,22 @@ ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std:
   }
   const solvers::DriftBandScore& widest = out.grid.back().score;  // the largest c and e
   const auto nt = widest.samples.size();
-  out.in_reach = std::vector<bool>(static_cast<std::size_t>(nt), false);
+  out.out_of_reach = std::vector<bool>(static_cast<std::size_t>(nt), false);
   for (Eigen::Index t = 0; t < nt; ++t)
-    out.in_reach[static_cast<std::size_t>(t)] =
-        widest.samples(t) > 0 && widest.coverage(t) >= input.coverage;
+    out.out_of_reach[static_cast<std::size_t>(t)] =
+        widest.samples(t) > 0 && widest.coverage(t) < input.coverage;
   std::optional<std::size_t> pick;
   for (std::size_t k = 0; k < out.grid.size(); ++k) {
     SigmaTermsCandidate& pair = out.grid[k];
     pair.reaches_goal = true;
     for (Eigen::Index t = 0; t < nt; ++t)
-      if (out.in_reach[static_cast<std::size_t>(t)] && pair.score.coverage(t) < input.coverage)
+      if (widest.samples(t) > 0 && !out.out_of_reach[static_cast<std::size_t>(t)] &&
+          pair.score.coverage(t) < input.coverage)
         pair.reaches_goal = false;
     if (pair.reaches_goal && (!pick || pair.width < out.grid[*pick].width)) pick = k;
   }
   out.chosen = pick.value_or(out.grid.size() - 1);  // the widest reaches it by construction
-  const SigmaTermsCandidate& chosen = out.grid[out.chosen];
+  const SigmaTermsCandidate& chosen = out.pick();
   for (std::size_t k = 0; k < o.runs.size(); ++k) {
     out.before.push_back(solvers::drift_band_score({with_sigma(o.runs[k], {}, 0, 0, after_alarm)},
                                                    {o.truths[k]}, {}, input.truth_sigma_m));

@@ -93,10 +93,11 @@ struct ChangedMachineSigma {
   /// from the alarm on, where the terms act (a run that raises nothing counts no sample)
   bool after_alarm = false;
   std::vector<SigmaTermsCandidate> grid;
-  /// per target: whether the widest pair covers `coverage` of it (false where no changed run
-  /// measured it)
-  std::vector<bool> in_reach;
+  /// per target: measured by a changed run and covered less than `coverage` even by the widest
+  /// pair (left out of the rule)
+  std::vector<bool> out_of_reach;
   std::size_t chosen = 0;  /// the chosen pair's index in grid
+  const SigmaTermsCandidate& pick() const { return grid.at(chosen); }
   /// per changed run: the score at c = e = 0 and at the chosen pair
   std::vector<solvers::DriftBandScore> before, after;
 };

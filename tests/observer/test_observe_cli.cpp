@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -615,6 +616,42 @@ double band_coverage(const fs::path& observed, const io::MeasuredRun& run,
   return inside / n;
 }
 
+using Refusals = std::vector<std::pair<std::vector<std::string>, std::string>>;
+
+/// Each of `refused` (flags, a part of the message) makes `observe` (the flags with --out
+/// DIR/refused) exit non-zero with that message in `log`, and writes nothing.
+void expect_refused(const std::function<int(std::vector<std::string>)>& observe,
+                    const Refusals& refused, const fs::path& dir, const fs::path& log) {
+  for (const auto& [flags, message] : refused) {
+    std::vector<std::string> args = flags;
+    args.insert(args.end(), {"--out", (dir / "refused").string()});
+    EXPECT_NE(observe(args), 0) << flags.back();
+    EXPECT_NE(rt::read_text(log).find(message), std::string::npos) << rt::read_text(log);
+    EXPECT_FALSE(fs::exists(dir / "refused"));
+  }
+}
+
+/// The run in `run_dir` streamed through `compensate --rom` with the sigma calibration `file`
+/// (into DIR/live.csv) gives `observed`'s observer.csv `columns` to 1e-6 um, sample by sample.
+void expect_streamed_as_observed(const fs::path& rom, const fs::path& run_dir, const fs::path& file,
+                                 const fs::path& observed, const std::vector<std::string>& columns,
+                                 const fs::path& dir, const fs::path& log) {
+  ASSERT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
+                     "--meta", (run_dir / "meta.json").string(), "--in",
+                     (run_dir / "data.csv").string(), "--until-eof", "--out",
+                     (dir / "live.csv").string(), "--sigma-calibration", file.string()},
+                    {}, log),
+            0)
+      << rt::read_text(log);
+  const auto offline = tt::test::csv_rows(observed / "observer.csv");
+  const auto streamed = tt::test::csv_rows(dir / "live.csv");
+  ASSERT_EQ(streamed.size(), offline.size());
+  for (std::size_t i = 0; i < offline.size(); ++i)
+    for (const std::string& column : columns)
+      EXPECT_NEAR(std::stod(streamed[i].at(column)), std::stod(offline[i].at(column)), 1e-6)
+          << i << " " << column;
+}
+
 TEST(ObserveCli, TheSigmaIsCalibratedOnTrainingRunsWhoseDriftWasMeasured) {
   // Three clean 3-hour runs of the generator with their measured drift: two train the factors on
   // the reported sigma (observe --train), the third is observed with them (--sigma-calibration,
@@ -717,22 +754,7 @@ TEST(ObserveCli, TheSigmaIsCalibratedOnTrainingRunsWhoseDriftWasMeasured) {
             rt::read_text(dir / "held" / "observer.csv"));
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "both"));
   // compensate --rom takes the same file: the held-out run streamed gives the same sigmas.
-  ASSERT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
-                     "--meta", (dir / "run_held" / "meta.json").string(), "--in",
-                     (dir / "run_held" / "data.csv").string(), "--until-eof", "--out",
-                     (dir / "live.csv").string(), "--sigma-calibration", file},
-                    {}, log),
-            0)
-      << rt::read_text(log);
-  {
-    const auto offline = tt::test::csv_rows(dir / "held" / "observer.csv");
-    const auto streamed = tt::test::csv_rows(dir / "live.csv");
-    ASSERT_EQ(streamed.size(), offline.size());
-    for (std::size_t i = 0; i < offline.size(); ++i)
-      EXPECT_NEAR(std::stod(streamed[i].at("dz_sigma_um")), std::stod(offline[i].at("dz_sigma_um")),
-                  1e-6)
-          << i;
-  }
+  expect_streamed_as_observed(rom, dir / "run_held", file, dir / "held", {"dz_sigma_um"}, dir, log);
   const auto held_json = nlohmann::json::parse(std::ifstream(dir / "held" / "observer.json"));
   EXPECT_EQ(held_json["noise"]["drift_sigma_scale"], cal["drift_sigma_scale"]);
   for (const char* t : {"dy", "dz"}) {
@@ -746,20 +768,15 @@ TEST(ObserveCli, TheSigmaIsCalibratedOnTrainingRunsWhoseDriftWasMeasured) {
     EXPECT_GE(after, 0.85) << t;
   }
   // Refused, nothing written: other sensors, the factor given twice, no measured drift.
-  const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
-      {{"--data", held, "--sigma-calibration", file, "--sensors", "T02,T08,T11"},
-       "calibrated for other sensors"},
-      {{"--data", held, "--sigma-calibration", file, "--drift-sigma-scale", "0.5"}, "not both"},
-      {{"--data", held, "--sigma-calibration", (dir / "noisy" / "sigma_calibration.json").string(),
-        "--drift-readings-every-s", "600"},
-       "calibrated with another probe cycle"}};
-  for (const auto& [flags, message] : refused) {
-    std::vector<std::string> args = flags;
-    args.insert(args.end(), {"--out", (dir / "refused").string()});
-    EXPECT_NE(observe(args), 0) << flags.back();
-    EXPECT_NE(rt::read_text(log).find(message), std::string::npos) << rt::read_text(log);
-    EXPECT_FALSE(fs::exists(dir / "refused"));
-  }
+  expect_refused(
+      observe,
+      {{{"--data", held, "--sigma-calibration", file, "--sensors", "T02,T08,T11"},
+        "calibrated for other sensors"},
+       {{"--data", held, "--sigma-calibration", file, "--drift-sigma-scale", "0.5"}, "not both"},
+       {{"--data", held, "--sigma-calibration", (dir / "noisy" / "sigma_calibration.json").string(),
+         "--drift-readings-every-s", "600"},
+        "calibrated with another probe cycle"}},
+      dir, log);
   io::MeasuredRun unmeasured = runs[0];
   unmeasured.displacements.clear();
   unmeasured.displacement.resize(unmeasured.time.size(), 0);
@@ -922,45 +939,25 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   EXPECT_EQ(gated_held["noise"]["changed_terms_after_alarm"], true);
   // compensate --rom takes the same file: the held-out run streamed gives observe's sigmas, the
   // terms switched on at the same alarm.
-  ASSERT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
-                     "--meta", (dir / "run_held" / "meta.json").string(), "--in",
-                     (dir / "run_held" / "data.csv").string(), "--until-eof", "--out",
-                     (dir / "live.csv").string(), "--sigma-calibration",
-                     (dir / "gated" / "sigma_calibration.json").string()},
-                    {}, log),
-            0)
-      << rt::read_text(log);
-  {
-    const auto offline = tt::test::csv_rows(dir / "gated" / "observer.csv");
-    const auto streamed = tt::test::csv_rows(dir / "live.csv");
-    ASSERT_EQ(streamed.size(), offline.size());
-    for (std::size_t i = 0; i < offline.size(); ++i)
-      for (const char* column : {"dy_sigma_um", "dz_sigma_um"})
-        EXPECT_NEAR(std::stod(streamed[i].at(column)), std::stod(offline[i].at(column)), 1e-6)
-            << i << " " << column;
-  }
+  expect_streamed_as_observed(rom, dir / "run_held", dir / "gated" / "sigma_calibration.json",
+                              dir / "gated", {"dy_sigma_um", "dz_sigma_um"}, dir, log);
   std::printf("[changed sigma] after the alarm: c %.2f, e %.2f; held-out run raised at %s s\n",
               gated["correction_relative_sigma"].get<double>(),
               gated["expansion_relative_sigma"].get<double>(),
               gated_held["recalibrate_raised_s"].dump().c_str());
   // Refused, nothing written.
   const std::string file = (dir / "cal" / "sigma_calibration.json").string();
-  const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
-      {{"--train", path("a"), "--changed", path("heat"), "--correction-relative-sigma", "1"},
-       "give it or them, not both"},
-      {{"--data", path("held"), "--sigma-calibration", file, "--expansion-relative-sigma", "0.1"},
-       "its changed_machine chose"},
-      {{"--data", path("held"), "--sigma-calibration", file, "--changed-terms-after-alarm"},
-       "changed_machine.after_alarm = false"},
-      {{"--train", path("a"), "--changed", path("a")}, "--changed"},
-      {{"--data", path("held"), "--changed", path("heat")}, "--changed requires --train"}};
-  for (const auto& [flags, message] : refused) {
-    std::vector<std::string> args = flags;
-    args.insert(args.end(), {"--out", (dir / "refused").string()});
-    EXPECT_NE(observe(args), 0) << flags.back();
-    EXPECT_NE(rt::read_text(log).find(message), std::string::npos) << rt::read_text(log);
-    EXPECT_FALSE(fs::exists(dir / "refused"));
-  }
+  expect_refused(
+      observe,
+      {{{"--train", path("a"), "--changed", path("heat"), "--correction-relative-sigma", "1"},
+        "give it or them, not both"},
+       {{"--data", path("held"), "--sigma-calibration", file, "--expansion-relative-sigma", "0.1"},
+        "its changed_machine chose"},
+       {{"--data", path("held"), "--sigma-calibration", file, "--changed-terms-after-alarm"},
+        "changed_machine.after_alarm = false"},
+       {{"--train", path("a"), "--changed", path("a")}, "--changed"},
+       {{"--data", path("held"), "--changed", path("heat")}, "--changed requires --train"}},
+      dir, log);
   if (!HasFailure()) fs::remove_all(dir);
 }
 
