@@ -102,8 +102,9 @@ struct ObserverOptions {
   double sensor_offset_k = 0.5;         /// per-sensor offset state: spread at t = 0 [K]
   double sensor_offset_walk_k = 0.05;   /// per-sensor offset state: random walk [K/sqrt(h)]
   bool widen_on_inconsistency = false;  /// widen sigma by sqrt(window NIS / readings) when > 1
-  /// the correction's and expansion's terms only once the filter says recalibrate
-  bool changed_terms_after_alarm = false;
+  /// the correction's and expansion's terms only once the filter says recalibrate, or weighted
+  /// by the readings' departure from the declared model before it (at most one of the two)
+  bool changed_terms_after_alarm = false, changed_terms_on_evidence = false;
   double drift_relative_sigma = 0.04;    /// the drift rows' own error, relative to the drift [-]
   double correction_relative_sigma = 0;  /// the corrections' error, relative to them [-]
   /// each material's expansion error, relative [-]: one value for all or one per material

@@ -57,7 +57,8 @@ void print_calibration(const studies::SigmaCalibration& cal) {
   std::cerr << "thermotwin: observe: on the changed runs, correction relative sigma "
             << pick.correction_relative_sigma << " and expansion relative sigma "
             << pick.expansion_relative_sigma << "\n";
-  for (std::size_t r = 0; ch.after_alarm && r < ch.runs.size(); ++r)
+  for (std::size_t r = 0; ch.gate == solvers::ChangedTermsGate::after_alarm && r < ch.runs.size();
+       ++r)
     if ((ch.before[r].samples.array() == 0).all())
       std::cerr << "thermotwin: observe:   changed run " << ch.runs[r]
                 << " raised no alarm: with --changed-terms-after-alarm its band is never widened, "

@@ -108,13 +108,17 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           ": its changed_machine chose the correction's and the expansion's "
                           "relative sigma; give it or --correction-relative-sigma / "
                           "--expansion-relative-sigma, not both");
-  if (o.changed_terms_after_alarm && !f.changed_terms_after_alarm)
-    throw core::DataError("--sigma-calibration " + file +
-                          ": changed_machine.after_alarm = false: its relative sigmas were chosen "
-                          "with the terms always on; choose them again with "
-                          "--changed-terms-after-alarm, or leave the flag out");
+  if (const auto gate = changed_terms_gate(o);
+      gate != solvers::ChangedTermsGate::always && gate != f.changed_terms)
+    throw core::DataError(
+        "--sigma-calibration " + file + ": changed_machine.gate = \"" +
+        io::changed_terms_gate_name(f.changed_terms) +
+        "\": its relative sigmas were chosen with the terms acting so; choose "
+        "them again with --changed-terms-" +
+        (gate == solvers::ChangedTermsGate::after_alarm ? "after-alarm" : "on-evidence") +
+        ", or leave the flag out");
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
-  setup.noise.changed_terms_after_alarm = f.changed_terms_after_alarm;
+  setup.noise.changed_terms = f.changed_terms;
   setup.noise.expansion_relative_sigma =
       expansion_sigmas({f.expansion_relative_sigma.value_or(0.0)}, setup);
 }
@@ -228,10 +232,17 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
                    "noise model is off (default: off)");
-  command.add_flag("--changed-terms-after-alarm", o.changed_terms_after_alarm,
-                   "add --correction-relative-sigma's and --expansion-relative-sigma's terms only "
-                   "once the filter says recalibrate: the band stays as calibrated until the "
-                   "machine is seen to have changed (default: off, always)");
+  CLI::Option* alarm =
+      command.add_flag("--changed-terms-after-alarm", o.changed_terms_after_alarm,
+                       "add --correction-relative-sigma's and --expansion-relative-sigma's terms "
+                       "only once the filter says recalibrate: the band stays as calibrated until "
+                       "the machine is seen to have changed (default: off, always)");
+  command
+      .add_flag("--changed-terms-on-evidence", o.changed_terms_on_evidence,
+                "add those terms weighted by how far the readings have left the declared "
+                "model's own run before the alarm: 0 while every sensor is within 1 of its sigmas, "
+                "1 at --model-residual-sigmas; fully from the alarm on (default: off, always)")
+      ->excludes(alarm);
 }
 
 solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
@@ -251,7 +262,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   noise.drift_reading_sigma_m = 1e-6 * o.drift_reading_sigma_um;
   noise.correction_relative_sigma = o.correction_relative_sigma;
   noise.widen_on_inconsistency = o.widen_on_inconsistency;
-  noise.changed_terms_after_alarm = o.changed_terms_after_alarm;
+  noise.changed_terms = changed_terms_gate(o);
   solvers::ObserverSetup setup =
       solvers::twin_observer_setup(twin, spec, sensors, noise, sensor_rows);
   setup.noise.expansion_relative_sigma = expansion_sigmas(o.expansion_relative_sigma, setup);
@@ -270,6 +281,12 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   return setup;
 }
 
+solvers::ChangedTermsGate changed_terms_gate(const ObserverOptions& o) {
+  if (o.changed_terms_after_alarm) return solvers::ChangedTermsGate::after_alarm;
+  if (o.changed_terms_on_evidence) return solvers::ChangedTermsGate::on_evidence;
+  return solvers::ChangedTermsGate::always;
+}
+
 bool gives_changed_terms(const ObserverOptions& o) {
   return o.correction_relative_sigma > 0 ||
          std::any_of(o.expansion_relative_sigma.begin(), o.expansion_relative_sigma.end(),
@@ -281,20 +298,22 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup) {
   const Eigen::VectorXd scale = n.drift_sigma_scale.size() != 0
                                     ? n.drift_sigma_scale
                                     : Eigen::VectorXd::Ones(setup.target_rows.rows());
-  nlohmann::json out = {{"sensor_sigma_K", io::as_vector(n.sensor_sigma_k)},
-                        {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
-                        {"heat_initial_W", n.heat_initial_w},
-                        {"air_walk_K_per_sqrt_h", n.air_walk_k},
-                        {"air_initial_K", n.air_initial_k},
-                        {"state_walk_K_per_sqrt_h", n.state_walk_k},
-                        {"sensor_offset_K", n.sensor_offset_initial_k},
-                        {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
-                        {"drift_relative_sigma", n.drift_relative_sigma},
-                        {"correction_relative_sigma", n.correction_relative_sigma},
-                        {"expansion_relative_sigma", expansion_json(setup)},
-                        {"drift_sigma_scale", io::as_vector(scale)},
-                        {"widen_on_inconsistency", n.widen_on_inconsistency},
-                        {"changed_terms_after_alarm", n.changed_terms_after_alarm}};
+  nlohmann::json out = {
+      {"sensor_sigma_K", io::as_vector(n.sensor_sigma_k)},
+      {"heat_walk_W_per_sqrt_h", n.heat_walk_w},
+      {"heat_initial_W", n.heat_initial_w},
+      {"air_walk_K_per_sqrt_h", n.air_walk_k},
+      {"air_initial_K", n.air_initial_k},
+      {"state_walk_K_per_sqrt_h", n.state_walk_k},
+      {"sensor_offset_K", n.sensor_offset_initial_k},
+      {"sensor_offset_walk_K_per_sqrt_h", n.sensor_offset_walk_k},
+      {"drift_relative_sigma", n.drift_relative_sigma},
+      {"correction_relative_sigma", n.correction_relative_sigma},
+      {"expansion_relative_sigma", expansion_json(setup)},
+      {"drift_sigma_scale", io::as_vector(scale)},
+      {"widen_on_inconsistency", n.widen_on_inconsistency},
+      {"changed_terms", io::changed_terms_gate_name(n.changed_terms)},
+      {"changed_terms_after_alarm", n.changed_terms == solvers::ChangedTermsGate::after_alarm}};
   if (n.probed_drift_sigma_scale.size() != 0)
     out["probed_drift_sigma_scale"] = io::as_vector(n.probed_drift_sigma_scale);
   return out;

@@ -41,4 +41,8 @@ nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup);
 /// 0): what `observe --changed` and a --sigma-calibration file that chose them refuse beside them.
 bool gives_changed_terms(const ObserverOptions& options);
 
+/// When the options let the correction's and the expansion's terms act
+/// (--changed-terms-after-alarm, --changed-terms-on-evidence; neither: always).
+solvers::ChangedTermsGate changed_terms_gate(const ObserverOptions& options);
+
 }  // namespace tt::app

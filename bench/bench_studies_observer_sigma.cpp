@@ -179,17 +179,23 @@ int main(int argc, char** argv) {
     for (std::size_t k = first_changed; k < runs.size(); ++k)
       undeclared.changed.push_back(&runs[k].measured);
     const studies::SigmaCalibration cal_plain = studies::calibrate_observer_sigma(undeclared);
-    // The same with the terms acting only once the filter says recalibrate
-    // (--changed-terms-after-alarm): chosen so, and scored so.
-    studies::SigmaCalibrationInput gated = undeclared;
-    gated.setup = [&twin](const core::CaseSpec& c, const std::vector<std::string>& s,
-                          const Eigen::MatrixXd& rows) {
-      solvers::ObserverSetup setup = cli_setup(twin, c, s, rows, {});
-      setup.noise.changed_terms_after_alarm = true;
-      return setup;
+    // The same with the terms gated (--changed-terms-after-alarm, --changed-terms-on-evidence):
+    // chosen so, and scored so.
+    const auto gated_by = [&](solvers::ChangedTermsGate gate) {
+      studies::SigmaCalibrationInput gated = undeclared;
+      gated.setup = [&twin, gate](const core::CaseSpec& c, const std::vector<std::string>& s,
+                                  const Eigen::MatrixXd& rows) {
+        solvers::ObserverSetup setup = cli_setup(twin, c, s, rows, {});
+        setup.noise.changed_terms = gate;
+        return setup;
+      };
+      return *studies::calibrate_observer_sigma(gated).changed;
     };
-    const studies::ChangedMachineSigma after_alarm =
-        *studies::calibrate_observer_sigma(gated).changed;
+    const std::vector<std::pair<const char*, solvers::ChangedTermsGate>> gates{
+        {"after the alarm", solvers::ChangedTermsGate::after_alarm},
+        {"on evidence", solvers::ChangedTermsGate::on_evidence}};
+    std::vector<studies::ChangedMachineSigma> gated;
+    for (const auto& g : gates) gated.push_back(gated_by(g.second));
     std::printf("calibration on %d training runs (%.0f s): factors", train, seconds_since(t_cal));
     for (Eigen::Index t = 0; t < cal.temperatures.drift_sigma_scale.size(); ++t)
       std::printf(" %s %.4g", cal.targets[static_cast<std::size_t>(t)].c_str(),
@@ -209,13 +215,15 @@ int main(int argc, char** argv) {
       std::printf(" %s %.1f -> %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
                   100 * changed.grid.front().score.coverage(t), 100 * pick.score.coverage(t));
     std::printf("\n");
-    const studies::SigmaTermsCandidate& gated_pick = after_alarm.pick();
-    std::printf("with the terms after the alarm: c %g, e %g; their coverage at the choice:",
-                gated_pick.correction_relative_sigma, gated_pick.expansion_relative_sigma);
-    for (Eigen::Index t = 0; t < gated_pick.score.coverage.size(); ++t)
-      std::printf(" %s %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
-                  100 * gated_pick.score.coverage(t));
-    std::printf("\n");
+    for (std::size_t g = 0; g < gates.size(); ++g) {
+      const studies::SigmaTermsCandidate& gated_pick = gated[g].pick();
+      std::printf("with the terms %s: c %g, e %g; their coverage at the choice:", gates[g].first,
+                  gated_pick.correction_relative_sigma, gated_pick.expansion_relative_sigma);
+      for (Eigen::Index t = 0; t < gated_pick.score.coverage.size(); ++t)
+        std::printf(" %s %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
+                    100 * gated_pick.score.coverage(t));
+      std::printf("\n");
+    }
     if (cal.probed) {
       std::printf("with a probe cycle every %g s: factors", probe_every_s);
       for (Eigen::Index t = 0; t < cal.probed->drift_sigma_scale.size(); ++t)
@@ -270,7 +278,7 @@ int main(int argc, char** argv) {
            cal.targets);
     // c and e chosen on the changed runs, on the factors of the noise not declared.
     const auto with_choice = [&](const Pooled& p, const studies::SigmaTermsCandidate& choice,
-                                 bool gate) {
+                                 solvers::ChangedTermsGate gate) {
       Pooled out = p;
       for (solvers::ObserverRun& r : out.runs)
         r = studies::with_sigma(r, cal_plain.temperatures.drift_sigma_scale,
@@ -280,13 +288,30 @@ int main(int argc, char** argv) {
     };
     const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cal.temperatures.drift_sigma_scale.size());
     report("held-out clean, noise not declared, c and e of the changed runs",
-           with_choice(clean, pick, false), ones, 0, cal.targets);
+           with_choice(clean, pick, solvers::ChangedTermsGate::always), ones, 0, cal.targets);
     report("effect runs, noise not declared, c and e of the changed runs",
-           with_choice(effect, pick, false), ones, 0, cal.targets);
-    report("held-out clean, noise not declared, c and e after the alarm",
-           with_choice(clean, gated_pick, true), ones, 0, cal.targets);
-    report("effect runs, noise not declared, c and e after the alarm",
-           with_choice(effect, gated_pick, true), ones, 0, cal.targets);
+           with_choice(effect, pick, solvers::ChangedTermsGate::always), ones, 0, cal.targets);
+    for (std::size_t g = 0; g < gates.size(); ++g) {
+      const std::string how = std::string(", c and e ") + gates[g].first;
+      report("held-out clean, noise not declared" + how,
+             with_choice(clean, gated[g].pick(), gates[g].second), ones, 0, cal.targets);
+      report("effect runs, noise not declared" + how,
+             with_choice(effect, gated[g].pick(), gates[g].second), ones, 0, cal.targets);
+    }
+    // How often the readings show evidence of a change (the on-evidence gate's weight > 0), and
+    // its mean weight, on the clean and the effect runs.
+    for (const auto* p : {&clean, &effect}) {
+      double any = 0, sum = 0, n = 0;
+      for (const solvers::ObserverRun& r : p->runs)
+        for (const solvers::DriftSigmaTerms& t : r.sigma_terms) {
+          const double w = solvers::changed_terms_weight(t, solvers::ChangedTermsGate::on_evidence);
+          any += w > 0;
+          sum += w;
+          n += 1;
+        }
+      std::printf("%s runs: evidence weight > 0 on %.1f %% of the samples, mean %.3f\n",
+                  p == &clean ? "held-out clean" : "effect", 100 * any / n, sum / n);
+    }
     if (cal.probed) {
       report("held-out clean, probe cycle, noise declared", clean_probed,
              cal.probed->drift_sigma_scale, gopt.noise_displacement_m, cal.targets);

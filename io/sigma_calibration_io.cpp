@@ -72,10 +72,33 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
   return {{"runs", ch.runs},
           {"correction_relative_sigma", pick.correction_relative_sigma},
           {"expansion_relative_sigma", pick.expansion_relative_sigma},
-          {"after_alarm", ch.after_alarm},
+          {"gate", changed_terms_gate_name(ch.gate)},
+          {"after_alarm", ch.gate == solvers::ChangedTermsGate::after_alarm},
           {"out_of_reach", out_of_reach},
           {"grid", grid},
           {"per_run", runs}};
+}
+
+/// changed_machine's gate: its "gate" (from session 19 on), which agrees with its "after_alarm";
+/// a file of session 18 has only the latter.
+solvers::ChangedTermsGate gate_at(const json& changed, const fit_keys::Place& p) {
+  const json& alarm = fit_keys::member(changed, "after_alarm", p, "changed_machine.");
+  if (!alarm.is_boolean())
+    throw core::DataError(p.at("changed_machine.after_alarm") + " = " + alarm.dump() +
+                          ": expected true or false");
+  if (!changed.contains("gate"))
+    return alarm.get<bool>() ? solvers::ChangedTermsGate::after_alarm
+                             : solvers::ChangedTermsGate::always;
+  for (const auto gate : {solvers::ChangedTermsGate::always, solvers::ChangedTermsGate::on_evidence,
+                          solvers::ChangedTermsGate::after_alarm})
+    if (changed["gate"] == changed_terms_gate_name(gate)) {
+      if (alarm.get<bool>() != (gate == solvers::ChangedTermsGate::after_alarm))
+        throw core::DataError(p.at("changed_machine.after_alarm") + " = " + alarm.dump() +
+                              ": disagrees with changed_machine.gate = " + changed["gate"].dump());
+      return gate;
+    }
+  throw core::DataError(p.at("changed_machine.gate") + " = " + changed["gate"].dump() +
+                        ": expected \"always\", \"on_evidence\" or \"after_alarm\"");
 }
 
 /// "a,b,c": the factors as a flag's value.
@@ -135,7 +158,10 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
     more << " --correction-relative-sigma " << pick.correction_relative_sigma;
     if (pick.expansion_relative_sigma > 0)
       more << " --expansion-relative-sigma " << pick.expansion_relative_sigma;
-    if (c.changed->after_alarm) more << " --changed-terms-after-alarm";
+    if (c.changed->gate == solvers::ChangedTermsGate::after_alarm)
+      more << " --changed-terms-after-alarm";
+    if (c.changed->gate == solvers::ChangedTermsGate::on_evidence)
+      more << " --changed-terms-on-evidence";
     flags += more.str();
   }
   out["flags"] = flags;
@@ -169,13 +195,21 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
     };
     f.correction_relative_sigma = relative("correction_relative_sigma");
     f.expansion_relative_sigma = relative("expansion_relative_sigma");
-    const json& gate = fit_keys::member(j["changed_machine"], "after_alarm", p, "changed_machine.");
-    if (!gate.is_boolean())
-      throw core::DataError(p.at("changed_machine.after_alarm") + " = " + gate.dump() +
-                            ": expected true or false");
-    f.changed_terms_after_alarm = gate.get<bool>();
+    f.changed_terms = gate_at(j["changed_machine"], p);
   }
   return f;
+}
+
+std::string changed_terms_gate_name(solvers::ChangedTermsGate gate) {
+  switch (gate) {
+    case solvers::ChangedTermsGate::on_evidence:
+      return "on_evidence";
+    case solvers::ChangedTermsGate::after_alarm:
+      return "after_alarm";
+    case solvers::ChangedTermsGate::always:
+      break;
+  }
+  return "always";
 }
 
 }  // namespace tt::io

@@ -35,8 +35,13 @@ struct SigmaCalibrationFile {
   /// with changed runs (changed_machine): the correction's relative sigma, and the expansion
   /// relative sigma of every material
   std::optional<double> correction_relative_sigma, expansion_relative_sigma;
-  bool changed_terms_after_alarm = false;  /// and whether they act only after the alarm
+  /// and when they act (changed_machine.gate)
+  solvers::ChangedTermsGate changed_terms = solvers::ChangedTermsGate::always;
 };
+
+/// The gate's name in sigma_calibration.json and observer.json: "always", "on_evidence" or
+/// "after_alarm".
+std::string changed_terms_gate_name(solvers::ChangedTermsGate gate);
 
 /// Reads a sigma_calibration.json. IoError when it cannot be read; DataError naming the file and
 /// the key for one that is missing or malformed, a factor that is not above 0, factors that are

@@ -501,9 +501,8 @@ ObserverEstimate KalmanObserver::assimilate(double t, const Eigen::VectorXd& rea
   e.recalibrate_since_s = monitor_.since_s();
   test_departures(t, readings, e);
   e.sigma_terms.alarm = e.recalibrate;
-  e.drift_sigma =
-      drift_sigma(e.sigma_terms, setup_.noise.correction_relative_sigma,
-                  setup_.noise.expansion_relative_sigma, setup_.noise.changed_terms_after_alarm);
+  e.drift_sigma = drift_sigma(e.sigma_terms, setup_.noise.correction_relative_sigma,
+                              setup_.noise.expansion_relative_sigma, setup_.noise.changed_terms);
   return e;
 }
 
@@ -590,12 +589,24 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
         residual(k) = std::numeric_limits<double>::quiet_NaN();
     for (const HeldSensor& d : departures_.add(t, residual, setup_.noise.sensor_sigma_k))
       earliest(d.onset_s);
+    e.sigma_terms.evidence = departure_evidence(residual, setup_.noise.sensor_sigma_k,
+                                                setup_.consistency.departure_onset_sigmas,
+                                                setup_.consistency.model_residual_sigmas);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
         e.recalibrate ? std::min(e.recalibrate_since_s, departure_s_) : departure_s_;
     e.recalibrate = true;
   }
+}
+
+double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd& sigma,
+                          double onset, double bound) {
+  double largest = 0;
+  for (Eigen::Index k = 0; k < residual.size(); ++k)
+    if (std::isfinite(residual(k))) largest = std::max(largest, std::abs(residual(k)) / sigma(k));
+  if (bound <= onset) return largest > bound ? 1 : 0;
+  return std::clamp((largest - onset) / (bound - onset), 0.0, 1.0);
 }
 
 DriftSigmaTerms KalmanObserver::drift_sigma_terms(const Eigen::VectorXd& drift) const {
@@ -616,14 +627,20 @@ DriftSigmaTerms KalmanObserver::drift_sigma_terms(const Eigen::VectorXd& drift) 
   return terms;
 }
 
+double changed_terms_weight(const DriftSigmaTerms& terms, ChangedTermsGate gate) {
+  if (gate == ChangedTermsGate::always || terms.alarm) return 1;
+  return gate == ChangedTermsGate::on_evidence ? terms.evidence : 0;
+}
+
 Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
-                            const Eigen::VectorXd& expansion, bool after_alarm) {
+                            const Eigen::VectorXd& expansion, ChangedTermsGate gate) {
   Eigen::ArrayXd var = terms.model.array().square();
-  if (after_alarm && !terms.alarm) return terms.widening * var.sqrt().matrix();
-  if (correction > 0) var += (correction * terms.correction.array()).square();
+  const double w = changed_terms_weight(terms, gate);
+  if (w <= 0) return terms.widening * var.sqrt().matrix();
+  if (correction > 0) var += (w * correction * terms.correction.array()).square();
   for (Eigen::Index m = 0; m < expansion.size(); ++m)
     if (expansion(m) > 0)
-      var += (expansion(m) * terms.expansion[static_cast<std::size_t>(m)].array()).square();
+      var += (w * expansion(m) * terms.expansion[static_cast<std::size_t>(m)].array()).square();
   return terms.widening * var.sqrt().matrix();
 }
 

@@ -31,6 +31,20 @@
 
 namespace tt::solvers {
 
+/// When the drift sigma's terms for a changed machine (ObserverNoise::correction_relative_sigma
+/// and expansion_relative_sigma) act. A change no reading shows (a wrong expansion coefficient
+/// without a probe cycle) raises no evidence and no alarm: only `always` covers it.
+enum class ChangedTermsGate {
+  always,  /// on every sample: wide on a machine that has not changed
+  /// Before the alarm, weighted by the evidence that the machine is departing from the declared
+  /// model (DriftSigmaTerms::evidence: 0 while every reading is within the departure test's
+  /// onset bound of the declared model's run, 1 at its alarm bound); fully from the alarm on.
+  on_evidence,
+  /// Only from the sample at which the filter says recalibrate (its NIS test, a model departure,
+  /// a late offset): the band stays as calibrated until the filter sees the change.
+  after_alarm,
+};
+
 /// What the observer does not know, and how sure it is of the rest.
 struct ObserverNoise {
   /// Per sensor: standard deviation of a reading's white noise [K] (#sensors).
@@ -89,12 +103,9 @@ struct ObserverNoise {
   /// the filter (gain, innovations, alarm) as it is, like drift_sigma_scale, on top of which it
   /// acts: a sigma calibrated where the model holds does not stay narrow where it no longer does.
   bool widen_on_inconsistency = false;
-  /// Add the correction's and the expansion's terms (correction_relative_sigma,
-  /// expansion_relative_sigma) only from the sample at which the filter says recalibrate (its NIS
-  /// test, a model departure, a late offset): the band stays as calibrated on a machine that has
-  /// not changed and widens once the filter sees that it has. A change no reading shows (a wrong
-  /// expansion coefficient without a probe cycle) raises nothing and is then not covered.
-  bool changed_terms_after_alarm = false;
+  /// When the correction's and the expansion's terms (correction_relative_sigma,
+  /// expansion_relative_sigma) act (ChangedTermsGate).
+  ChangedTermsGate changed_terms = ChangedTermsGate::always;
 };
 
 /// The consistency test of the innovations: the normalised innovation squared (NIS, nu^T S^-1 nu,
@@ -256,13 +267,30 @@ struct DriftSigmaTerms {
   std::vector<Eigen::VectorXd> expansion;
   double widening = 1;  /// the widening on inconsistency's factor, >= 1 (1: none)
   bool alarm = false;   /// the filter says recalibrate at this time
+  /// In [0, 1]: how far the readings have departed from the declared model's own run, on the
+  /// departure test's scale (ConsistencyOptions::model_residual_sigmas): (max over the sensors of
+  /// |reading - declared run| / sigma_k - onset) / (bound - onset), clamped, the onset bound
+  /// departure_onset_sigmas and the bound model_residual_sigmas; the sensors the departure test
+  /// leaves out (a faulty offset) are left out here too. 0 without that test.
+  double evidence = 0;
 };
 
+/// DriftSigmaTerms::evidence of the residuals (reading - declared run, per sensor; NaN: left
+/// out) and their sigmas: the largest |residual| / sigma, from `onset` (0) to `bound` (1),
+/// clamped (a step at `bound` when bound <= onset).
+double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd& sigma,
+                          double onset, double bound);
+
+/// The weight of the changed machine's terms in `terms` under `gate`: 1, the evidence or 0
+/// before the alarm, 1 from it on.
+double changed_terms_weight(const DriftSigmaTerms& terms, ChangedTermsGate gate);
+
 /// The reported sigma (#targets [m]) of `terms` under a correction sigma c and, per material,
-/// an expansion sigma (`expansion`: empty or one per material); with `after_alarm`, neither
-/// before terms.alarm (ObserverNoise::changed_terms_after_alarm).
+/// an expansion sigma (`expansion`: empty or one per material), both times the gate's weight
+/// (changed_terms_weight).
 Eigen::VectorXd drift_sigma(const DriftSigmaTerms& terms, double correction,
-                            const Eigen::VectorXd& expansion, bool after_alarm = false);
+                            const Eigen::VectorXd& expansion,
+                            ChangedTermsGate gate = ChangedTermsGate::always);
 
 /// What the observer says after one assimilation.
 struct ObserverEstimate {

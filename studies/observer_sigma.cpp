@@ -54,12 +54,11 @@ SigmaPass calibrate_pass(const Observed& o, const SigmaCalibrationInput& input) 
   return pass;
 }
 
-SigmaTermsCandidate score_pair(const Observed& o, double c, double e, bool after_alarm,
-                               double noise) {
+SigmaTermsCandidate score_pair(const Observed& o, double c, double e,
+                               solvers::ChangedTermsGate gate, double noise) {
   SigmaTermsCandidate pair{c, e};
   std::vector<solvers::ObserverRun> runs;
-  for (const solvers::ObserverRun& run : o.runs)
-    runs.push_back(with_sigma(run, {}, c, e, after_alarm));
+  for (const solvers::ObserverRun& run : o.runs) runs.push_back(with_sigma(run, {}, c, e, gate));
   pair.score = solvers::drift_band_score(runs, o.truths, {}, noise);
   for (Eigen::Index t = 0; t < pair.score.samples.size(); ++t)
     if (pair.score.samples(t) > 0)  // measured
@@ -70,16 +69,17 @@ SigmaTermsCandidate score_pair(const Observed& o, double c, double e, bool after
 /// The pair chosen on the changed runs (ChangedMachineSigma's rule), `o` observed with the
 /// calibrated factors.
 ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std::string>& names,
-                                       bool after_alarm, const SigmaCalibrationInput& input) {
+                                       solvers::ChangedTermsGate gate,
+                                       const SigmaCalibrationInput& input) {
   const bool materials = !o.runs.empty() && !o.runs.front().sigma_terms.empty() &&
                          !o.runs.front().sigma_terms.front().expansion.empty();
   ChangedMachineSigma out;
   out.runs = names;
-  out.after_alarm = after_alarm;
+  out.gate = gate;
   for (const double e : {0.0, 0.05, 0.1, 0.15, 0.2, 0.3}) {
     if (e > 0 && !materials) break;
     for (const double c : {0.0, 0.25, 0.5, 1.0, 2.0, 4.0})
-      out.grid.push_back(score_pair(o, c, e, after_alarm, input.truth_sigma_m));
+      out.grid.push_back(score_pair(o, c, e, gate, input.truth_sigma_m));
   }
   const solvers::DriftBandScore& widest = out.grid.back().score;  // the largest c and e
   const auto nt = widest.samples.size();
@@ -87,24 +87,25 @@ ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std:
   for (Eigen::Index t = 0; t < nt; ++t)
     out.out_of_reach[static_cast<std::size_t>(t)] =
         widest.samples(t) > 0 && widest.coverage(t) < input.coverage;
+  // Per measured target: the coverage, or kReachTolerance below the widest pair's.
+  const Eigen::ArrayXd goal =
+      widest.coverage.array().min(input.coverage + kReachTolerance) - kReachTolerance;
   std::optional<std::size_t> pick;
   for (std::size_t k = 0; k < out.grid.size(); ++k) {
     SigmaTermsCandidate& pair = out.grid[k];
     pair.reaches_goal = true;
     for (Eigen::Index t = 0; t < nt; ++t)
-      if (widest.samples(t) > 0 && !out.out_of_reach[static_cast<std::size_t>(t)] &&
-          pair.score.coverage(t) < input.coverage)
-        pair.reaches_goal = false;
+      if (widest.samples(t) > 0 && pair.score.coverage(t) < goal(t)) pair.reaches_goal = false;
     if (pair.reaches_goal && (!pick || pair.width < out.grid[*pick].width)) pick = k;
   }
   out.chosen = pick.value_or(out.grid.size() - 1);  // the widest reaches it by construction
   const SigmaTermsCandidate& chosen = out.pick();
   for (std::size_t k = 0; k < o.runs.size(); ++k) {
-    out.before.push_back(solvers::drift_band_score({with_sigma(o.runs[k], {}, 0, 0, after_alarm)},
+    out.before.push_back(solvers::drift_band_score({with_sigma(o.runs[k], {}, 0, 0, gate)},
                                                    {o.truths[k]}, {}, input.truth_sigma_m));
     out.after.push_back(
         solvers::drift_band_score({with_sigma(o.runs[k], {}, chosen.correction_relative_sigma,
-                                              chosen.expansion_relative_sigma, after_alarm)},
+                                              chosen.expansion_relative_sigma, gate)},
                                   {o.truths[k]}, {}, input.truth_sigma_m));
   }
   return out;
@@ -124,17 +125,20 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input,
   };
   Observed o;
   std::vector<std::string> names;
-  bool after_alarm = false;
+  auto gate = solvers::ChangedTermsGate::always;
   for (const io::MeasuredRun* run : input.changed) {
     const ObserveInput in{input.declared, run,        input.twin, cal.sensors,
                           calibrated,     input.mesh, 0.0};
     const ObserveReport report = observe_run(in);
-    after_alarm = report.setup.noise.changed_terms_after_alarm;
+    gate = report.setup.noise.changed_terms;
     Eigen::MatrixXd truth =
         drift_columns(*run, cal.targets, "a changed-machine run of the sigma calibration").readings;
     // Terms that act from the alarm on are judged where they act: before it, the band is the
-    // factors' alone, calibrated on the training runs.
-    for (std::size_t i = 0; after_alarm && i < report.result.sigma_terms.size(); ++i)
+    // factors' alone, calibrated on the training runs. Terms weighted by the evidence are
+    // judged on every sample, where the weight is small as much as where it is large.
+    for (std::size_t i = 0;
+         gate == solvers::ChangedTermsGate::after_alarm && i < report.result.sigma_terms.size();
+         ++i)
       if (!report.result.sigma_terms[i].alarm)
         truth.row(static_cast<Eigen::Index>(i)).setConstant(std::nan(""));
     o.runs.push_back(report.result);
@@ -145,21 +149,20 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input,
                      std::to_string(names.size()) + " of " + std::to_string(input.changed.size()) +
                      ")");
   }
-  return choose_sigma_terms(o, names, after_alarm, input);
+  return choose_sigma_terms(o, names, gate, input);
 }
 
 }  // namespace
 
 solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
-                                double c, double e, bool after_alarm) {
+                                double c, double e, solvers::ChangedTermsGate gate) {
   solvers::ObserverRun out = run;
   for (std::size_t i = 0; i < run.sigma_terms.size(); ++i) {
     solvers::DriftSigmaTerms terms = run.sigma_terms[i];
     if (factor.size() != 0) terms.model = terms.model.cwiseProduct(factor);
     const auto materials = static_cast<Eigen::Index>(terms.expansion.size());
     out.drift_sigma.row(static_cast<Eigen::Index>(i)) =
-        solvers::drift_sigma(terms, c, Eigen::VectorXd::Constant(materials, e), after_alarm)
-            .transpose();
+        solvers::drift_sigma(terms, c, Eigen::VectorXd::Constant(materials, e), gate).transpose();
   }
   return out;
 }

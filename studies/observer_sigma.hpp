@@ -72,26 +72,30 @@ struct SigmaTermsCandidate {
   double correction_relative_sigma = 0, expansion_relative_sigma = 0;
   solvers::DriftBandScore score;  /// pooled over the changed runs
   double width = 0;               /// over the measured targets: the sum of RMS sigma / RMS error
-  bool reaches_goal = false;      /// the coverage reached in every measured target within reach
+  bool reaches_goal = false;      /// every measured target's goal reached (ChangedMachineSigma)
 };
+
+/// How far below the widest pair's coverage an out-of-reach target's goal is (ChangedMachineSigma).
+inline constexpr double kReachTolerance = 0.01;
 
 /// c and e chosen on runs of a changed machine (docs/observer.md, "A machine that has changed"):
 /// the sigma calibrated where the model holds (the factors) with (c d_c)^2 and the sum over the
 /// materials of (e d_m)^2 added (solvers::DriftSigmaTerms). The sigma grows with c and e sample by
 /// sample, so the grid's widest pair covers the most in every target. A measured target where even
 /// that pair covers less than `coverage` is out of the terms' reach (a drift no term follows: a
-/// heat input off the unknown inputs' shapes moves dx on SB-1) and left out of the rule: the
-/// terms widen it by a little at most, and asking for that little would take the widest pair
-/// every time. Rule: the narrowest pair (least width) that covers `coverage` in every measured
-/// target within reach. The grid: c over
+/// heat input off the unknown inputs' shapes moves dx on SB-1; gated terms that act late or
+/// weakly): its goal is the widest pair's coverage less kReachTolerance, since asking for the
+/// last few samples the terms reach would take the widest pair every time, and leaving the target
+/// out would leave a rule with no target at c = e = 0. Rule: the narrowest pair (least width)
+/// that reaches every measured target's goal (`coverage`, or that). The grid: c over
 /// 0, 0.25, 0.5, 1, 2, 4 and e over 0, 0.05, 0.1, 0.15, 0.2, 0.3 (e 0 only when the reduced model
 /// keeps no drift rows per material).
 struct ChangedMachineSigma {
   std::vector<std::string> runs;  /// the changed runs' names
-  /// the terms act only once the filter says recalibrate (the set-up's
-  /// ObserverNoise::changed_terms_after_alarm): the changed runs are then scored on their samples
-  /// from the alarm on, where the terms act (a run that raises nothing counts no sample)
-  bool after_alarm = false;
+  /// when the terms act (the set-up's ObserverNoise::changed_terms); after the alarm, the changed
+  /// runs are scored on their samples from the alarm on, where the terms act (a run that raises
+  /// nothing counts no sample); always and on evidence, on every sample
+  solvers::ChangedTermsGate gate = solvers::ChangedTermsGate::always;
   std::vector<SigmaTermsCandidate> grid;
   /// per target: measured by a changed run and covered less than `coverage` even by the widest
   /// pair (left out of the rule)
@@ -118,10 +122,11 @@ struct SigmaCalibration {
 
 /// `run` with the sigma that its terms (solvers::DriftSigmaTerms) make with `factor` on the sigma
 /// it was observed with (per target; empty: 1), the correction's relative sigma c and an expansion
-/// relative sigma e for every material (with `after_alarm`, only from the alarm on): as the
-/// observer would have reported it with them.
+/// relative sigma e for every material, as `gate` lets them act: as the observer would have
+/// reported it with them.
 solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
-                                double c, double e, bool after_alarm = false);
+                                double c, double e,
+                                solvers::ChangedTermsGate gate = solvers::ChangedTermsGate::always);
 
 /// `truth` (#samples x #targets) with NaN at every sample where `read` (drift readings of the same
 /// samples, NaN where none) holds a reading: a probe-cycle filter is scored between its readings,

@@ -588,7 +588,8 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
   // --changed` scores other c and e without observing again: the terms of a run observed with
   // c = e = 0 give, through solvers::drift_sigma, the sigma of a run observed with c = 0.7 and
   // e = (0.1, 0.2, ...), widening on inconsistency included; and the terms do not depend on c, e.
-  // With changed_terms_after_alarm the terms act from the alarm on.
+  // With the terms after the alarm they act from the alarm on; on evidence, weighted by the
+  // readings' departure before it.
   const core::CaseSpec c = run_spec();
   const auto& sys = s_->twin.model.system;
   solvers::ObserverNoise plain_noise = default_noise();
@@ -618,10 +619,10 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
       EXPECT_NEAR(wide.drift_sigma(i, d), expected(d), 1e-12 * expected(d)) << i << " " << d;
   }
   EXPECT_GT(widened, 1.0);  // the heat run's innovations widen the sigma somewhere
-  // With the terms after the alarm (changed_terms_after_alarm): the plain sigma until the filter
-  // says recalibrate, the wide one from then on.
+  // With the terms after the alarm (ChangedTermsGate::after_alarm): the plain sigma until the
+  // filter says recalibrate, the wide one from then on.
   ASSERT_TRUE(plain.recalibrate);
-  wide_noise.changed_terms_after_alarm = true;
+  wide_noise.changed_terms = solvers::ChangedTermsGate::after_alarm;
   const solvers::ObserverRun gated =
       solvers::observe(sys, c, setup(wide_noise), run.time, run.temperature);
   EXPECT_EQ(gated.recalibrate_at_s, plain.recalibrate_at_s);
@@ -632,6 +633,42 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
     for (int d = 0; d < 3; ++d)
       EXPECT_NEAR(gated.drift_sigma(i, d), expected(i, d), 1e-12 * expected(i, d)) << i << " " << d;
   }
+  // On evidence: before the alarm the terms' variance times the evidence squared (sigma^2 =
+  // plain^2 + w^2 (wide^2 - plain^2)), all of it from the alarm on. The heat run departs from
+  // the declared run before the alarm (which waits for 3 sigma held for sustain_s).
+  wide_noise.changed_terms = solvers::ChangedTermsGate::on_evidence;
+  const solvers::ObserverRun weighted =
+      solvers::observe(sys, c, setup(wide_noise), run.time, run.temperature);
+  int partly = 0;
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    const solvers::DriftSigmaTerms& t = plain.sigma_terms[static_cast<std::size_t>(i)];
+    EXPECT_EQ(weighted.sigma_terms[static_cast<std::size_t>(i)].evidence, t.evidence) << i;
+    ASSERT_GE(t.evidence, 0.0);
+    ASSERT_LE(t.evidence, 1.0);
+    const double w = t.alarm ? 1.0 : t.evidence;
+    EXPECT_EQ(solvers::changed_terms_weight(t, solvers::ChangedTermsGate::on_evidence), w);
+    if (!t.alarm && w > 0 && w < 1) ++partly;
+    for (int d = 0; d < 3; ++d) {
+      const double p2 = std::pow(plain.drift_sigma(i, d), 2);
+      const double expected = std::sqrt(p2 + w * w * (std::pow(wide.drift_sigma(i, d), 2) - p2));
+      EXPECT_NEAR(weighted.drift_sigma(i, d), expected, 1e-9 * expected) << i << " " << d;
+    }
+  }
+  EXPECT_GT(partly, 0);
+  EXPECT_EQ(plain.sigma_terms.front().evidence, 0.0);  // the run starts at the declared state
+}
+
+TEST(DepartureEvidence, RampsFromTheOnsetBoundToTheAlarmBound) {
+  // The largest |residual| / sigma over the sensors (NaN left out), 0 at `onset`, 1 at `bound`.
+  const Eigen::Vector3d sigma(0.1, 0.2, 0.05);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(solvers::departure_evidence(Eigen::Vector3d(0.05, -0.1, 0.0), sigma, 1, 3), 0.0);
+  EXPECT_DOUBLE_EQ(solvers::departure_evidence(Eigen::Vector3d(0.05, -0.4, 0.0), sigma, 1, 3),
+                   0.5);  // 2 sigmas of the second sensor
+  EXPECT_EQ(solvers::departure_evidence(Eigen::Vector3d(0.05, -0.1, 0.5), sigma, 1, 3), 1.0);
+  EXPECT_EQ(solvers::departure_evidence(Eigen::Vector3d(0.05, -0.1, nan), sigma, 1, 3), 0.0);
+  EXPECT_EQ(solvers::departure_evidence(Eigen::Vector3d(0.35, 0, 0), sigma, 3, 3), 1.0);  // a step
+  EXPECT_EQ(solvers::departure_evidence(Eigen::Vector3d(0.25, 0, 0), sigma, 3, 3), 0.0);
 }
 
 TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
