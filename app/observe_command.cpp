@@ -14,6 +14,7 @@
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,24 @@ void print_calibration(const studies::SigmaCalibration& cal) {
                             std::to_string(100 * ch.grid.back().score.coverage(k)) + " %)"
                       : "")
               << "\n";
+  }
+  // Each gate's price on the training runs (RMS sigma / RMS error) beside its gain on the
+  // changed runs (their coverage).
+  for (const studies::GateChoice& g : ch.gates) {
+    std::ostringstream held, width;
+    for (std::size_t t = 0; t < cal.targets.size(); ++t) {
+      const auto k = static_cast<Eigen::Index>(t);
+      if (g.pick.score.samples(k) > 0)
+        held << " " << cal.targets[t] << " " << 100 * g.pick.score.coverage(k) << " %";
+      if (g.training.samples(k) > 0)
+        width << " " << cal.targets[t] << " "
+              << g.training.rms_sigma_m(k) / g.training.rms_error_m(k);
+    }
+    std::cerr << "thermotwin: observe:   gate " << io::changed_terms_gate_name(g.gate)
+              << (g.gate == ch.gate ? " (chosen)" : "") << ": c "
+              << g.pick.correction_relative_sigma << ", e " << g.pick.expansion_relative_sigma
+              << "; ±2 sigma held on the changed runs" << held.str()
+              << "; RMS sigma / RMS error on the training runs" << width.str() << "\n";
   }
 }
 

@@ -179,23 +179,11 @@ int main(int argc, char** argv) {
     for (std::size_t k = first_changed; k < runs.size(); ++k)
       undeclared.changed.push_back(&runs[k].measured);
     const studies::SigmaCalibration cal_plain = studies::calibrate_observer_sigma(undeclared);
-    // The same with the terms gated (--changed-terms-after-alarm, --changed-terms-on-evidence):
-    // chosen so, and scored so.
-    const auto gated_by = [&](solvers::ChangedTermsGate gate) {
-      studies::SigmaCalibrationInput gated = undeclared;
-      gated.setup = [&twin, gate](const core::CaseSpec& c, const std::vector<std::string>& s,
-                                  const Eigen::MatrixXd& rows) {
-        solvers::ObserverSetup setup = cli_setup(twin, c, s, rows, {});
-        setup.noise.changed_terms = gate;
-        return setup;
-      };
-      return *studies::calibrate_observer_sigma(gated).changed;
-    };
-    const std::vector<std::pair<const char*, solvers::ChangedTermsGate>> gates{
-        {"after the alarm", solvers::ChangedTermsGate::after_alarm},
-        {"on evidence", solvers::ChangedTermsGate::on_evidence}};
-    std::vector<studies::ChangedMachineSigma> gated;
-    for (const auto& g : gates) gated.push_back(gated_by(g.second));
+    // The terms gated (--changed-terms-after-alarm, --changed-terms-on-evidence), chosen so on
+    // the same observation of the changed runs (ChangedMachineSigma::gates; always is `pick`).
+    const std::vector<std::pair<const char*, const studies::GateChoice*>> gates{
+        {"after the alarm", &cal_plain.changed->gates.at(2)},
+        {"on evidence", &cal_plain.changed->gates.at(1)}};
     std::printf("calibration on %d training runs (%.0f s): factors", train, seconds_since(t_cal));
     for (Eigen::Index t = 0; t < cal.temperatures.drift_sigma_scale.size(); ++t)
       std::printf(" %s %.4g", cal.targets[static_cast<std::size_t>(t)].c_str(),
@@ -216,13 +204,15 @@ int main(int argc, char** argv) {
                   100 * changed.grid.front().score.coverage(t), 100 * pick.score.coverage(t));
     std::printf("\n");
     for (std::size_t g = 0; g < gates.size(); ++g) {
-      const studies::SigmaTermsCandidate& gated_pick = gated[g].pick();
+      const studies::SigmaTermsCandidate& gated_pick = gates[g].second->pick;
       std::printf("with the terms %s: c %g, e %g; their coverage at the choice:", gates[g].first,
                   gated_pick.correction_relative_sigma, gated_pick.expansion_relative_sigma);
       for (Eigen::Index t = 0; t < gated_pick.score.coverage.size(); ++t)
         std::printf(" %s %.1f %%", cal.targets[static_cast<std::size_t>(t)].c_str(),
                     100 * gated_pick.score.coverage(t));
-      std::printf("\n");
+      std::printf(
+          "; the training runs' band %.2f (always on: %.2f; sum of RMS sigma / RMS error)\n",
+          gates[g].second->training_width, cal_plain.changed->gates.at(0).training_width);
     }
     if (cal.probed) {
       std::printf("with a probe cycle every %g s: factors", probe_every_s);
@@ -294,9 +284,11 @@ int main(int argc, char** argv) {
     for (std::size_t g = 0; g < gates.size(); ++g) {
       const std::string how = std::string(", c and e ") + gates[g].first;
       report("held-out clean, noise not declared" + how,
-             with_choice(clean, gated[g].pick(), gates[g].second), ones, 0, cal.targets);
+             with_choice(clean, gates[g].second->pick, gates[g].second->gate), ones, 0,
+             cal.targets);
       report("effect runs, noise not declared" + how,
-             with_choice(effect, gated[g].pick(), gates[g].second), ones, 0, cal.targets);
+             with_choice(effect, gates[g].second->pick, gates[g].second->gate), ones, 0,
+             cal.targets);
     }
     // How often the readings show evidence of a change (the on-evidence gate's weight > 0), and
     // its mean weight, on the clean and the effect runs.

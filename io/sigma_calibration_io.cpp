@@ -65,6 +65,15 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
     runs.push_back({{"run", ch.runs[k]},
                     {"before", score_json(ch.before[k], c.targets)},
                     {"after", score_json(ch.after[k], c.targets)}});
+  json gates = json::array();
+  for (const studies::GateChoice& g : ch.gates)
+    gates.push_back({{"gate", changed_terms_gate_name(g.gate)},
+                     {"correction_relative_sigma", g.pick.correction_relative_sigma},
+                     {"expansion_relative_sigma", g.pick.expansion_relative_sigma},
+                     {"changed", score_json(g.pick.score, c.targets)},
+                     {"changed_width", g.pick.width},
+                     {"training", score_json(g.training, c.targets)},
+                     {"training_width", g.training_width}});
   const studies::SigmaTermsCandidate& pick = ch.pick();
   std::vector<std::string> out_of_reach;
   for (std::size_t t = 0; t < c.targets.size(); ++t)
@@ -76,7 +85,8 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
           {"after_alarm", ch.gate == solvers::ChangedTermsGate::after_alarm},
           {"out_of_reach", out_of_reach},
           {"grid", grid},
-          {"per_run", runs}};
+          {"per_run", runs},
+          {"gates", gates}};
 }
 
 /// changed_machine's gate: its "gate" (from session 19 on), which agrees with its "after_alarm";

@@ -54,16 +54,42 @@ SigmaPass calibrate_pass(const Observed& o, const SigmaCalibrationInput& input) 
   return pass;
 }
 
+/// Over the measured targets: the sum of RMS sigma / RMS error.
+double band_width(const solvers::DriftBandScore& score) {
+  double width = 0;
+  for (Eigen::Index t = 0; t < score.samples.size(); ++t)
+    if (score.samples(t) > 0) width += score.rms_sigma_m(t) / score.rms_error_m(t);
+  return width;
+}
+
+/// `o`'s runs with `factor` (empty: 1), c and e as `gate` lets them act, scored.
+solvers::DriftBandScore score_with(const Observed& o, const Eigen::VectorXd& factor, double c,
+                                   double e, solvers::ChangedTermsGate gate, double noise) {
+  std::vector<solvers::ObserverRun> runs;
+  for (const solvers::ObserverRun& run : o.runs)
+    runs.push_back(with_sigma(run, factor, c, e, gate));
+  return solvers::drift_band_score(runs, o.truths, {}, noise);
+}
+
 SigmaTermsCandidate score_pair(const Observed& o, double c, double e,
                                solvers::ChangedTermsGate gate, double noise) {
   SigmaTermsCandidate pair{c, e};
-  std::vector<solvers::ObserverRun> runs;
-  for (const solvers::ObserverRun& run : o.runs) runs.push_back(with_sigma(run, {}, c, e, gate));
-  pair.score = solvers::drift_band_score(runs, o.truths, {}, noise);
-  for (Eigen::Index t = 0; t < pair.score.samples.size(); ++t)
-    if (pair.score.samples(t) > 0)  // measured
-      pair.width += pair.score.rms_sigma_m(t) / pair.score.rms_error_m(t);
+  pair.score = score_with(o, {}, c, e, gate, noise);
+  pair.width = band_width(pair.score);
   return pair;
+}
+
+/// `o` scored where `gate`'s terms act: terms that act from the alarm on are judged there (before
+/// it the band is the factors' alone, calibrated on the training runs); terms weighted by the
+/// evidence, like terms always on, on every sample, where the weight is small as much as where it
+/// is large.
+Observed scored_where_acting(Observed o, solvers::ChangedTermsGate gate) {
+  if (gate != solvers::ChangedTermsGate::after_alarm) return o;
+  for (std::size_t k = 0; k < o.runs.size(); ++k)
+    for (std::size_t i = 0; i < o.runs[k].sigma_terms.size(); ++i)
+      if (!o.runs[k].sigma_terms[i].alarm)
+        o.truths[k].row(static_cast<Eigen::Index>(i)).setConstant(std::nan(""));
+  return o;
 }
 
 /// The pair chosen on the changed runs (ChangedMachineSigma's rule), `o` observed with the
@@ -112,9 +138,9 @@ ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std:
 }
 
 /// The changed runs observed with the factors calibrated in `cal` (its sensors), and c and e
-/// chosen on them.
-ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input,
-                                    const SigmaCalibration& cal) {
+/// chosen on them with every gate; `training` the training runs as `cal` observed them.
+ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const SigmaCalibration& cal,
+                                    const Observed& training) {
   const Eigen::VectorXd factors = cal.temperatures.drift_sigma_scale;
   const ObserverSetupFor calibrated = [&](const core::CaseSpec& spec,
                                           const std::vector<std::string>& sensors,
@@ -131,25 +157,33 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input,
                           calibrated,     input.mesh, 0.0};
     const ObserveReport report = observe_run(in);
     gate = report.setup.noise.changed_terms;
-    Eigen::MatrixXd truth =
-        drift_columns(*run, cal.targets, "a changed-machine run of the sigma calibration").readings;
-    // Terms that act from the alarm on are judged where they act: before it, the band is the
-    // factors' alone, calibrated on the training runs. Terms weighted by the evidence are
-    // judged on every sample, where the weight is small as much as where it is large.
-    for (std::size_t i = 0;
-         gate == solvers::ChangedTermsGate::after_alarm && i < report.result.sigma_terms.size();
-         ++i)
-      if (!report.result.sigma_terms[i].alarm)
-        truth.row(static_cast<Eigen::Index>(i)).setConstant(std::nan(""));
     o.runs.push_back(report.result);
-    o.truths.push_back(std::move(truth));
+    o.truths.push_back(
+        drift_columns(*run, cal.targets, "a changed-machine run of the sigma calibration")
+            .readings);
     names.push_back(run->run);
     if (input.progress)
       input.progress("sigma calibration: changed run " + run->run + " observed (" +
                      std::to_string(names.size()) + " of " + std::to_string(input.changed.size()) +
                      ")");
   }
-  return choose_sigma_terms(o, names, gate, input);
+  // The terms do not change the estimate: every gate is chosen from the same observation.
+  const Eigen::VectorXd factor =
+      cal.temperatures.drift_sigma_scale.cwiseQuotient(training.observed_with);
+  ChangedMachineSigma out;
+  std::vector<GateChoice> gates;
+  for (const auto g : {solvers::ChangedTermsGate::always, solvers::ChangedTermsGate::on_evidence,
+                       solvers::ChangedTermsGate::after_alarm}) {
+    ChangedMachineSigma chosen = choose_sigma_terms(scored_where_acting(o, g), names, g, input);
+    GateChoice choice{g, chosen.pick(), {}, 0};
+    choice.training = score_with(training, factor, choice.pick.correction_relative_sigma,
+                                 choice.pick.expansion_relative_sigma, g, input.truth_sigma_m);
+    choice.training_width = band_width(choice.training);
+    gates.push_back(std::move(choice));
+    if (g == gate) out = std::move(chosen);
+  }
+  out.gates = std::move(gates);
+  return out;
 }
 
 }  // namespace
@@ -224,7 +258,7 @@ SigmaCalibration calibrate_observer_sigma(const SigmaCalibrationInput& input) {
     if (measured[t]) cal.measured_targets.push_back(cal.targets[t]);
   cal.temperatures = calibrate_pass(blind, input);
   if (input.drift_readings_every_s > 0) cal.probed = calibrate_pass(probed, input);
-  if (!input.changed.empty()) cal.changed = observe_changed(input, cal);
+  if (!input.changed.empty()) cal.changed = observe_changed(input, cal, blind);
   return cal;
 }
 

@@ -75,6 +75,16 @@ struct SigmaTermsCandidate {
   bool reaches_goal = false;      /// every measured target's goal reached (ChangedMachineSigma)
 };
 
+/// One gate's choice beside the others' (ChangedMachineSigma::gates): the pair the rule takes with
+/// the terms acting so, and what that pair costs on the training runs, a machine that has not
+/// changed (its band with the factors and the pair, scored as the factors were).
+struct GateChoice {
+  solvers::ChangedTermsGate gate = solvers::ChangedTermsGate::always;
+  SigmaTermsCandidate pick;          /// scored on the changed runs, as the gate scores them
+  solvers::DriftBandScore training;  /// pooled over the training runs
+  double training_width = 0;         /// over the measured targets: sum of RMS sigma / RMS error
+};
+
 /// How far below the widest pair's coverage an out-of-reach target's goal is (ChangedMachineSigma).
 inline constexpr double kReachTolerance = 0.01;
 
@@ -104,6 +114,10 @@ struct ChangedMachineSigma {
   const SigmaTermsCandidate& pick() const { return grid.at(chosen); }
   /// per changed run: the score at c = e = 0 and at the chosen pair
   std::vector<solvers::DriftBandScore> before, after;
+  /// every gate's choice (always, on evidence, after the alarm; `gate`'s is this one's), from the
+  /// same observation of the changed runs: what a tight band on a healthy machine costs in
+  /// coverage of a changed one
+  std::vector<GateChoice> gates;
 };
 
 struct SigmaCalibration {

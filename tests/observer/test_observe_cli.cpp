@@ -844,6 +844,8 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   EXPECT_NE(rt::read_text(log).find("on the changed runs, correction relative sigma"),
             std::string::npos)
       << rt::read_text(log);
+  for (const char* gate : {"gate always (chosen): c", "gate on_evidence: c", "gate after_alarm: c"})
+    EXPECT_NE(rt::read_text(log).find(gate), std::string::npos) << rt::read_text(log);
   EXPECT_TRUE(tt::test::matches_output_schemas("observe", dir / "cal"));
   const auto cal = nlohmann::json::parse(std::ifstream(dir / "cal" / "sigma_calibration.json"));
   const auto& ch = cal["changed_machine"];
@@ -881,6 +883,25 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   EXPECT_EQ(cal["correction_relative_sigma"], c);
   EXPECT_GT(c + e, 0.0);  // the clean factors alone do not cover a changed machine
   EXPECT_NE(cal["flags"].get<std::string>().find("--correction-relative-sigma"), std::string::npos);
+  // Every gate's choice from the same observation: the file's gate (always) is the pair chosen;
+  // after the alarm the clean training runs (no alarm) keep the factors' own band, always on it
+  // is wider.
+  const auto& gates = ch["gates"];
+  ASSERT_EQ(gates.size(), 3u);
+  const auto gate_pair = [](const nlohmann::json& g) {
+    return std::make_pair(g["correction_relative_sigma"].get<double>(),
+                          g["expansion_relative_sigma"].get<double>());
+  };
+  EXPECT_EQ(gates[0]["gate"], "always");
+  EXPECT_EQ(gate_pair(gates[0]), std::make_pair(c, e));
+  EXPECT_EQ(gates[2]["gate"], "after_alarm");
+  for (const char* t : {"dx", "dy", "dz"}) {
+    const double factors_alone = cal["temperatures"]["after"][t]["rms_sigma_um"];
+    EXPECT_NEAR(gates[2]["training"][t]["rms_sigma_um"].get<double>(), factors_alone,
+                1e-9 * factors_alone)
+        << t;
+    EXPECT_GE(gates[0]["training"][t]["rms_sigma_um"].get<double>(), factors_alone) << t;
+  }
   // The changed runs observed with the file's factors, c and e as flags: their coverage is the
   // file's (per_run after), to a sample.
   std::ostringstream factors, flag_c, flag_e;
@@ -937,6 +958,8 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   const auto gated = nlohmann::json::parse(std::ifstream(dir / "gated" / "sigma_calibration.json"));
   EXPECT_EQ(gated["changed_machine"]["after_alarm"], true);
   EXPECT_EQ(gated["changed_machine"]["gate"], "after_alarm");
+  // The pair chosen with the gate is the one the run without it reported for that gate.
+  EXPECT_EQ(gate_pair(gated), gate_pair(gates[2]));
   EXPECT_NE(gated["flags"].get<std::string>().find("--changed-terms-after-alarm"),
             std::string::npos);
   const auto gated_held = nlohmann::json::parse(std::ifstream(dir / "gated" / "observer.json"));
@@ -961,6 +984,7 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   const auto evidence = nlohmann::json::parse(std::ifstream(evidence_file));
   EXPECT_EQ(evidence["changed_machine"]["gate"], "on_evidence");
   EXPECT_EQ(evidence["changed_machine"]["after_alarm"], false);
+  EXPECT_EQ(gate_pair(evidence), gate_pair(gates[1]));
   EXPECT_NE(evidence["flags"].get<std::string>().find("--changed-terms-on-evidence"),
             std::string::npos);
   ASSERT_EQ(observe({"--data", path("held"), "--sigma-calibration", evidence_file.string(), "--out",
