@@ -120,6 +120,8 @@ struct ObserverOptions {
   double sensor_fault_sigmas = 4;  /// a sensor's offset beyond this many sigmas: faulty (0: off)
   /// a reading held this many sigmas from the declared model's run: recalibrate (0: off)
   double model_residual_sigmas = 3;
+  /// time constant of the residuals' mean that --changed-terms-on-evidence weighs [s] (0: none)
+  double evidence_time_s = 300;
   /// > 0: the run's (the stream's) displacement columns named after targets are read as drift
   /// readings, one every this many seconds (a probe cycle); 0: temperatures only
   double drift_readings_every_s = 0;

@@ -228,6 +228,12 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
                   "declared model's own run (no unknown input, no correction) for --sustain-s "
                   "says recalibrate (observer.json model_departures; default 3, 0: no such test)")
       ->check(non_negative_number());
+  command
+      .add_option("--evidence-time-s", o.evidence_time_s,
+                  "--changed-terms-on-evidence weighs each sensor's residual against the "
+                  "declared model's run averaged with this time constant, so that a reading's "
+                  "noise does not widen the band [s] (default 300, 0: the residual itself)")
+      ->check(non_negative_number());
   command.add_flag("--widen-on-inconsistency", o.widen_on_inconsistency,
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
@@ -278,6 +284,7 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   setup.consistency.probability = o.probability;
   setup.consistency.sensor_fault_sigmas = o.sensor_fault_sigmas;
   setup.consistency.model_residual_sigmas = o.model_residual_sigmas;
+  setup.consistency.evidence_time_s = o.evidence_time_s;
   return setup;
 }
 

@@ -308,7 +308,8 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       monitor_(setup.consistency),
       faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s),
       departures_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false,
-                  setup.consistency.departure_onset_sigmas) {
+                  setup.consistency.departure_onset_sigmas),
+      evidence_mean_(setup.consistency.evidence_time_s) {
   r_ = system.states();
   check_setup(system, spec, setup_);
   const ObserverNoise& n = setup_.noise;
@@ -589,15 +590,31 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
         residual(k) = std::numeric_limits<double>::quiet_NaN();
     for (const HeldSensor& d : departures_.add(t, residual, setup_.noise.sensor_sigma_k))
       earliest(d.onset_s);
-    e.sigma_terms.evidence = departure_evidence(residual, setup_.noise.sensor_sigma_k,
-                                                setup_.consistency.departure_onset_sigmas,
-                                                setup_.consistency.model_residual_sigmas);
+    e.sigma_terms.evidence = departure_evidence(
+        evidence_mean_.add(t, residual), setup_.noise.sensor_sigma_k,
+        setup_.consistency.departure_onset_sigmas, setup_.consistency.model_residual_sigmas);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
         e.recalibrate ? std::min(e.recalibrate_since_s, departure_s_) : departure_s_;
     e.recalibrate = true;
   }
+}
+
+Eigen::VectorXd ExponentialMean::add(double t, const Eigen::VectorXd& value) {
+  if (mean_.size() != value.size())
+    mean_ = last_t_ = Eigen::VectorXd::Constant(value.size(), std::nan(""));
+  Eigen::VectorXd out = value;
+  for (Eigen::Index k = 0; k < value.size(); ++k) {
+    if (std::isnan(value(k))) continue;
+    if (std::isnan(mean_(k)) || !(tau_s_ > 0))
+      mean_(k) = value(k);
+    else
+      mean_(k) += (1.0 - std::exp(-(t - last_t_(k)) / tau_s_)) * (value(k) - mean_(k));
+    last_t_(k) = t;
+    out(k) = mean_(k);
+  }
+  return out;
 }
 
 double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd& sigma,

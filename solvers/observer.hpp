@@ -139,6 +139,11 @@ struct ConsistencyOptions {
   /// run. A change that grows from its start crosses 3 sigma hours after it began; the readings
   /// of a clean run are within 1 sigma 68 % of the time. 0: dated from the crossing.
   double departure_onset_sigmas = 1;
+  /// The evidence of a change (DriftSigmaTerms::evidence) is taken of each sensor's residual
+  /// against the declared run averaged with this time constant [s] (ExponentialMean), so that a
+  /// reading's noise does not make it: the departure test holds its bound for sustain_s instead,
+  /// the evidence has no hold. 0: of the residual itself.
+  double evidence_time_s = 300;
 };
 
 /// The observer's set-up on a reduced system.
@@ -251,6 +256,21 @@ class HeldBeyondMonitor {
   std::vector<double> within_onset_;
   std::vector<bool> raised_;
   std::vector<HeldSensor> held_;
+};
+
+/// Per sensor an exponentially weighted mean of a value fed one assimilation at a time, with time
+/// constant tau_s: mean += (1 - exp(-dt / tau_s)) (value - mean), dt since that sensor's last
+/// value. Its first value starts it; a NaN value leaves its mean as it was and reads NaN at that
+/// time; tau_s 0: the value itself.
+class ExponentialMean {
+ public:
+  explicit ExponentialMean(double tau_s) : tau_s_(tau_s) {}
+  /// The values at time t (after the last); returns the means at t.
+  Eigen::VectorXd add(double t, const Eigen::VectorXd& value);
+
+ private:
+  double tau_s_;
+  Eigen::VectorXd mean_, last_t_;  /// per sensor (NaN: no value yet)
 };
 
 /// The terms of the reported drift sigma at one time (docs/observer.md, "Drift"): sigma^2 =
@@ -385,6 +405,7 @@ class KalmanObserver {
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
   HeldBeyondMonitor faults_, departures_;
+  ExponentialMean evidence_mean_;  /// the departure test's residuals, for the evidence
   /// The earliest start of what says recalibrate besides the NIS test [s] (NaN: none yet): a
   /// fault whose offset appeared after the first consistency window, or a reading held away
   /// from the declared model's run.

@@ -1062,7 +1062,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
           "--heat-initial-w", "--air-initial-k", "--state-walk-k", "--drift-sigma-scale",
           "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma",
           "--model-residual-sigmas", "--drift-readings-every-s", "--drift-reading-sigma-um",
-          "--sigma-calibration", "--changed-terms-after-alarm", "--changed-terms-on-evidence"})
+          "--sigma-calibration", "--changed-terms-after-alarm", "--changed-terms-on-evidence",
+          "--evidence-time-s"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
@@ -1070,6 +1071,7 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
       out.string()};
   const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
       {{"--sensor-offset-k", "-0.5"}, "--sensor-offset-k: -0.5: expected a finite number >= 0"},
+      {{"--evidence-time-s", "-1"}, "--evidence-time-s: -1: expected a finite number >= 0"},
       {{"--sensor-offset-walk-k", "nan"},
        "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
       {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},

@@ -658,6 +658,23 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
   EXPECT_EQ(plain.sigma_terms.front().evidence, 0.0);  // the run starts at the declared state
 }
 
+TEST(ExponentialMean, FollowsAStepWithItsTimeConstantAndSkipsMissingValues) {
+  // mean += (1 - exp(-dt / tau)) (value - mean), dt since the sensor's last value, from its first
+  // value on; NaN leaves the mean.
+  solvers::ExponentialMean mean(100);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(mean.add(0, Eigen::Vector2d(1, 2)), Eigen::Vector2d(1, 2));
+  const Eigen::VectorXd at100 = mean.add(100, Eigen::Vector2d(0, nan));
+  EXPECT_NEAR(at100(0), std::exp(-1.0), 1e-15);
+  EXPECT_TRUE(std::isnan(at100(1)));
+  const Eigen::VectorXd at300 = mean.add(300, Eigen::Vector2d(0, 4));
+  EXPECT_NEAR(at300(0), std::exp(-3.0), 1e-15);
+  EXPECT_NEAR(at300(1), 2 + (1 - std::exp(-3.0)) * 2, 1e-15);  // the 300 s since its last value
+  solvers::ExponentialMean none(0);
+  none.add(0, Eigen::Vector2d(1, 2));
+  EXPECT_EQ(none.add(10, Eigen::Vector2d(5, 6)), Eigen::Vector2d(5, 6));
+}
+
 TEST(DepartureEvidence, RampsFromTheOnsetBoundToTheAlarmBound) {
   // The largest |residual| / sigma over the sensors (NaN left out), 0 at `onset`, 1 at `bound`.
   const Eigen::Vector3d sigma(0.1, 0.2, 0.05);
