@@ -1,6 +1,7 @@
 #include "app/observer_options.hpp"
 
 #include <algorithm>
+#include <tuple>
 
 #include "app/cli_numbers.hpp"
 #include "core/errors.hpp"
@@ -74,6 +75,28 @@ void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
       ->check(positive_number());
 }
 
+/// Gated terms act on the alarm and the evidence: refuses options whose settings of them differ
+/// from the ones the file chose its pair with (`file` names it).
+void check_same_consistency(const ObserverOptions& o, const solvers::ConsistencyOptions& chosen,
+                            const std::string& file) {
+  const std::tuple<const char*, const char*, double, double> settings[] = {
+      {"window_s", "--window-s", o.window_s, chosen.window_s},
+      {"sustain_s", "--sustain-s", o.sustain_s, chosen.sustain_s},
+      {"probability", "--probability", o.probability, chosen.probability},
+      {"sensor_fault_sigmas", "--sensor-fault-sigmas", o.sensor_fault_sigmas,
+       chosen.sensor_fault_sigmas},
+      {"model_residual_sigmas", "--model-residual-sigmas", o.model_residual_sigmas,
+       chosen.model_residual_sigmas},
+      {"evidence_time_s", "--evidence-time-s", o.evidence_time_s, chosen.evidence_time_s}};
+  for (const auto& [key, flag, given, in_file] : settings)
+    if (given != in_file)
+      throw core::DataError("--sigma-calibration " + file + ": changed_machine.consistency." + key +
+                            " = " + nlohmann::json(in_file).dump() +
+                            ": its gated relative sigmas were chosen with that setting, not " +
+                            flag + " " + nlohmann::json(given).dump() + "; give " + flag + " " +
+                            nlohmann::json(in_file).dump() + ", or choose them again");
+}
+
 /// The factors of --sigma-calibration's file on `setup`, and the relative sigmas it chose on
 /// changed runs. DataError naming the file when it was calibrated for other sensors, targets or
 /// probe cycle, or when --drift-sigma-scale or --probed-drift-sigma-scale is given too (or
@@ -117,6 +140,8 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
         "them again with --changed-terms-" +
         (gate == solvers::ChangedTermsGate::after_alarm ? "after-alarm" : "on-evidence") +
         ", or leave the flag out");
+  if (f.changed_terms != solvers::ChangedTermsGate::always && f.consistency)
+    check_same_consistency(o, *f.consistency, file);
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
   setup.noise.changed_terms = f.changed_terms;
   setup.noise.expansion_relative_sigma =

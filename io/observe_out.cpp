@@ -136,6 +136,16 @@ std::string final_status(const solvers::ObserverRun& r) {
 
 }  // namespace
 
+nlohmann::json consistency_json(const solvers::ConsistencyOptions& c) {
+  return {{"window_s", c.window_s},
+          {"sustain_s", c.sustain_s},
+          {"probability", c.probability},
+          {"sensor_fault_sigmas", c.sensor_fault_sigmas},
+          {"model_residual_sigmas", c.model_residual_sigmas},
+          {"departure_onset_sigmas", c.departure_onset_sigmas},
+          {"evidence_time_s", c.evidence_time_s}};
+}
+
 void write_observe(const std::filesystem::path& dir, const studies::ObserveReport& report,
                    const ObserveSource& source) {
   const solvers::ObserverRun& r = report.result;
@@ -148,14 +158,7 @@ void write_observe(const std::filesystem::path& dir, const studies::ObserveRepor
       {"sensors", report.sensors},
       {"sensor_places", places_json(report)},
       {"noise", source.noise},
-      {"consistency",
-       {{"window_s", setup.consistency.window_s},
-        {"sustain_s", setup.consistency.sustain_s},
-        {"probability", setup.consistency.probability},
-        {"sensor_fault_sigmas", setup.consistency.sensor_fault_sigmas},
-        {"model_residual_sigmas", setup.consistency.model_residual_sigmas},
-        {"departure_onset_sigmas", setup.consistency.departure_onset_sigmas},
-        {"evidence_time_s", setup.consistency.evidence_time_s}}},
+      {"consistency", consistency_json(setup.consistency)},
       {"status", final_status(r)},
       {"unknown_inputs", unknown_inputs_json(r)},
       {"sensor_faults", sensor_faults_json(r, report.sensors)},

@@ -19,6 +19,10 @@ struct ObserveSource {
   nlohmann::json noise;       /// the set-up's noise model and consistency test
 };
 
+/// The consistency test's and the departure test's settings, as observer.json and
+/// sigma_calibration.json write them.
+nlohmann::json consistency_json(const solvers::ConsistencyOptions& c);
+
 /// Writes observer.csv and observer.json into `dir` (a folder the caller publishes).
 void write_observe(const std::filesystem::path& dir, const studies::ObserveReport& report,
                    const ObserveSource& source);

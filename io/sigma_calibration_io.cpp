@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "core/units.hpp"
 #include "io/fit_json_keys.hpp"
+#include "io/observe_out.hpp"
 #include "io/reports.hpp"
 
 namespace tt::io {
@@ -86,7 +87,8 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
           {"out_of_reach", out_of_reach},
           {"grid", grid},
           {"per_run", runs},
-          {"gates", gates}};
+          {"gates", gates},
+          {"consistency", consistency_json(c.setup.consistency)}};
 }
 
 /// changed_machine's gate: its "gate" (from session 19 on), which agrees with its "after_alarm";
@@ -206,6 +208,19 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
     f.correction_relative_sigma = relative("correction_relative_sigma");
     f.expansion_relative_sigma = relative("expansion_relative_sigma");
     f.changed_terms = gate_at(j["changed_machine"], p);
+    // Written from session 19 on: the settings the gates' alarm and evidence were scored with.
+    if (j["changed_machine"].contains("consistency")) {
+      const json& c = j["changed_machine"]["consistency"];
+      const std::string at = "changed_machine.consistency.";
+      solvers::ConsistencyOptions o;
+      o.window_s = fit_keys::number_at(c, "window_s", p, at);
+      o.sustain_s = fit_keys::number_at(c, "sustain_s", p, at);
+      o.probability = fit_keys::number_at(c, "probability", p, at);
+      o.sensor_fault_sigmas = fit_keys::number_at(c, "sensor_fault_sigmas", p, at);
+      o.model_residual_sigmas = fit_keys::number_at(c, "model_residual_sigmas", p, at);
+      o.evidence_time_s = fit_keys::number_at(c, "evidence_time_s", p, at);
+      f.consistency = o;
+    }
   }
   return f;
 }

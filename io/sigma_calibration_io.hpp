@@ -37,6 +37,9 @@ struct SigmaCalibrationFile {
   std::optional<double> correction_relative_sigma, expansion_relative_sigma;
   /// and when they act (changed_machine.gate)
   solvers::ChangedTermsGate changed_terms = solvers::ChangedTermsGate::always;
+  /// the alarm's and the evidence's settings the gated terms were chosen with (absent in files
+  /// of session 18)
+  std::optional<solvers::ConsistencyOptions> consistency;
 };
 
 /// The gate's name in sigma_calibration.json and observer.json: "always", "on_evidence" or

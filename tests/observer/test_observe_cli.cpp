@@ -985,6 +985,7 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   EXPECT_EQ(evidence["changed_machine"]["gate"], "on_evidence");
   EXPECT_EQ(evidence["changed_machine"]["after_alarm"], false);
   EXPECT_EQ(gate_pair(evidence), gate_pair(gates[1]));
+  EXPECT_EQ(evidence["changed_machine"]["consistency"]["evidence_time_s"], 300.0);
   EXPECT_NE(evidence["flags"].get<std::string>().find("--changed-terms-on-evidence"),
             std::string::npos);
   ASSERT_EQ(observe({"--data", path("held"), "--sigma-calibration", evidence_file.string(), "--out",
@@ -1039,6 +1040,13 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
         "changed_machine.gate = \"on_evidence\""},
        {{"--data", path("held"), "--changed-terms-after-alarm", "--changed-terms-on-evidence"},
         "excludes"},
+       {{"--data", path("held"), "--sigma-calibration", evidence_file.string(), "--evidence-time-s",
+         "0"},
+        "changed_machine.consistency.evidence_time_s = 300.0: its gated relative sigmas were "
+        "chosen with that setting, not --evidence-time-s 0.0"},
+       {{"--data", path("held"), "--sigma-calibration",
+         (dir / "gated" / "sigma_calibration.json").string(), "--sustain-s", "600"},
+        "changed_machine.consistency.sustain_s = 900.0"},
        {{"--data", path("held"), "--sigma-calibration", with_gate("bad.json", "sometimes", false)},
         "changed_machine.gate = \"sometimes\": expected"},
        {{"--data", path("held"), "--sigma-calibration", with_gate("odd.json", "on_evidence", true)},
