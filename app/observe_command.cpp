@@ -12,6 +12,7 @@
 //      every sensor of the run that is a named point of the model), the observer's set-up
 //      (app/observer_options.hpp, with the calibrated factors), the run through the filter;
 //   4. observer.csv and observer.json (io/observe_out.hpp), all or nothing.
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -80,6 +81,8 @@ void print_calibration(const studies::SigmaCalibration& cal) {
   // changed runs (their coverage).
   for (const studies::GateChoice& g : ch.gates) {
     std::ostringstream held, width;
+    held << std::fixed << std::setprecision(1);
+    width << std::fixed << std::setprecision(2);
     for (std::size_t t = 0; t < cal.targets.size(); ++t) {
       const auto k = static_cast<Eigen::Index>(t);
       if (g.pick.score.samples(k) > 0)
@@ -91,8 +94,10 @@ void print_calibration(const studies::SigmaCalibration& cal) {
     std::cerr << "thermotwin: observe:   gate " << io::changed_terms_gate_name(g.gate)
               << (g.gate == ch.gate ? " (chosen)" : "") << ": c "
               << g.pick.correction_relative_sigma << ", e " << g.pick.expansion_relative_sigma
-              << "; ±2 sigma held on the changed runs" << held.str()
-              << "; RMS sigma / RMS error on the training runs" << width.str() << "\n";
+              << "; ±2 sigma held on the changed runs"
+              << (g.gate == solvers::ChangedTermsGate::after_alarm ? " from their alarm on" : "")
+              << held.str() << "; RMS sigma / RMS error on the training runs" << width.str()
+              << "\n";
   }
 }
 
