@@ -100,8 +100,8 @@ void check_same_consistency(const ObserverOptions& o, const solvers::Consistency
 /// The factors of --sigma-calibration's file on `setup`, and the relative sigmas it chose on
 /// changed runs. DataError naming the file when it was calibrated for other sensors, targets or
 /// probe cycle, or when --drift-sigma-scale or --probed-drift-sigma-scale is given too (or
-/// --correction-relative-sigma or --expansion-relative-sigma, when it chose those, or
-/// --changed-terms-after-alarm, when it chose them with the terms always on).
+/// --correction-relative-sigma or --expansion-relative-sigma, when it chose those, or a gate's
+/// flag other than the file's gate, or alarm and evidence settings other than a gated pair's).
 void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::string>& sensors,
                              solvers::ObserverSetup& setup) {
   const std::string file = o.sigma_calibration.string();
@@ -133,13 +133,11 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           "--expansion-relative-sigma, not both");
   if (const auto gate = changed_terms_gate(o);
       gate != solvers::ChangedTermsGate::always && gate != f.changed_terms)
-    throw core::DataError(
-        "--sigma-calibration " + file + ": changed_machine.gate = \"" +
-        io::changed_terms_gate_name(f.changed_terms) +
-        "\": its relative sigmas were chosen with the terms acting so; choose "
-        "them again with --changed-terms-" +
-        (gate == solvers::ChangedTermsGate::after_alarm ? "after-alarm" : "on-evidence") +
-        ", or leave the flag out");
+    throw core::DataError("--sigma-calibration " + file + ": changed_machine.gate = \"" +
+                          io::changed_terms_gate_name(f.changed_terms) +
+                          "\": its relative sigmas were chosen with the terms acting so; choose "
+                          "them again with " +
+                          io::changed_terms_gate_flag(gate) + ", or leave the flag out");
   if (f.changed_terms != solvers::ChangedTermsGate::always && f.consistency)
     check_same_consistency(o, *f.consistency, file);
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;

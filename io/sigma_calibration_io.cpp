@@ -1,5 +1,6 @@
 #include "io/sigma_calibration_io.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -101,8 +102,7 @@ solvers::ChangedTermsGate gate_at(const json& changed, const fit_keys::Place& p)
   if (!changed.contains("gate"))
     return alarm.get<bool>() ? solvers::ChangedTermsGate::after_alarm
                              : solvers::ChangedTermsGate::always;
-  for (const auto gate : {solvers::ChangedTermsGate::always, solvers::ChangedTermsGate::on_evidence,
-                          solvers::ChangedTermsGate::after_alarm})
+  for (const auto gate : solvers::kChangedTermsGates)
     if (changed["gate"] == changed_terms_gate_name(gate)) {
       if (alarm.get<bool>() != (gate == solvers::ChangedTermsGate::after_alarm))
         throw core::DataError(p.at("changed_machine.after_alarm") + " = " + alarm.dump() +
@@ -170,10 +170,8 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
     more << " --correction-relative-sigma " << pick.correction_relative_sigma;
     if (pick.expansion_relative_sigma > 0)
       more << " --expansion-relative-sigma " << pick.expansion_relative_sigma;
-    if (c.changed->gate == solvers::ChangedTermsGate::after_alarm)
-      more << " --changed-terms-after-alarm";
-    if (c.changed->gate == solvers::ChangedTermsGate::on_evidence)
-      more << " --changed-terms-on-evidence";
+    if (c.changed->gate != solvers::ChangedTermsGate::always)
+      more << " " << changed_terms_gate_flag(c.changed->gate);
     flags += more.str();
   }
   out["flags"] = flags;
@@ -223,6 +221,12 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
     }
   }
   return f;
+}
+
+std::string changed_terms_gate_flag(solvers::ChangedTermsGate gate) {
+  std::string flag = "--changed-terms-" + changed_terms_gate_name(gate);
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
 }
 
 std::string changed_terms_gate_name(solvers::ChangedTermsGate gate) {

@@ -46,6 +46,10 @@ struct SigmaCalibrationFile {
 /// "after_alarm".
 std::string changed_terms_gate_name(solvers::ChangedTermsGate gate);
 
+/// The flag that asks for a gate other than always: --changed-terms-on-evidence or
+/// --changed-terms-after-alarm.
+std::string changed_terms_gate_flag(solvers::ChangedTermsGate gate);
+
 /// Reads a sigma_calibration.json. IoError when it cannot be read; DataError naming the file and
 /// the key for one that is missing or malformed, a factor that is not above 0, factors that are
 /// not one per target, or a relative sigma below 0.

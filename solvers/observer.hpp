@@ -45,6 +45,10 @@ enum class ChangedTermsGate {
   after_alarm,
 };
 
+/// Every gate, in the order sigma_calibration.json's changed_machine.gates lists them.
+inline constexpr ChangedTermsGate kChangedTermsGates[] = {
+    ChangedTermsGate::always, ChangedTermsGate::on_evidence, ChangedTermsGate::after_alarm};
+
 /// What the observer does not know, and how sure it is of the rest.
 struct ObserverNoise {
   /// Per sensor: standard deviation of a reading's white noise [K] (#sensors).

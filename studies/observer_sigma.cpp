@@ -79,12 +79,10 @@ SigmaTermsCandidate score_pair(const Observed& o, double c, double e,
   return pair;
 }
 
-/// `o` scored where `gate`'s terms act: terms that act from the alarm on are judged there (before
-/// it the band is the factors' alone, calibrated on the training runs); terms weighted by the
-/// evidence, like terms always on, on every sample, where the weight is small as much as where it
-/// is large.
-Observed scored_where_acting(Observed o, solvers::ChangedTermsGate gate) {
-  if (gate != solvers::ChangedTermsGate::after_alarm) return o;
+/// `o` scored from each run's alarm on, where terms gated by it act (before it the band is the
+/// factors' alone, calibrated on the training runs). Terms weighted by the evidence, like terms
+/// always on, are judged on every sample, where the weight is small as much as where it is large.
+Observed scored_from_alarm(Observed o) {
   for (std::size_t k = 0; k < o.runs.size(); ++k)
     for (std::size_t i = 0; i < o.runs[k].sigma_terms.size(); ++i)
       if (!o.runs[k].sigma_terms[i].alarm)
@@ -172,9 +170,10 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const Si
       cal.temperatures.drift_sigma_scale.cwiseQuotient(training.observed_with);
   ChangedMachineSigma out;
   std::vector<GateChoice> gates;
-  for (const auto g : {solvers::ChangedTermsGate::always, solvers::ChangedTermsGate::on_evidence,
-                       solvers::ChangedTermsGate::after_alarm}) {
-    ChangedMachineSigma chosen = choose_sigma_terms(scored_where_acting(o, g), names, g, input);
+  const Observed from_alarm = scored_from_alarm(o);
+  for (const auto g : solvers::kChangedTermsGates) {
+    const Observed& scored = g == solvers::ChangedTermsGate::after_alarm ? from_alarm : o;
+    ChangedMachineSigma chosen = choose_sigma_terms(scored, names, g, input);
     GateChoice choice{g, chosen.pick(), {}, 0};
     choice.training = score_with(training, factor, choice.pick.correction_relative_sigma,
                                  choice.pick.expansion_relative_sigma, g, input.truth_sigma_m);
