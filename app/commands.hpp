@@ -122,6 +122,12 @@ struct ObserverOptions {
   double model_residual_sigmas = 3;
   /// time constant of the residuals' mean that --changed-terms-on-evidence weighs [s] (0: none)
   double evidence_time_s = 300;
+  /// the residuals' mean (in sigmas) at which that weight starts to rise from 0 (1 at
+  /// model_residual_sigmas)
+  double evidence_onset_sigmas = 1;
+  /// whether --evidence-time-s or --evidence-onset-sigmas was given: if not, --sigma-calibration
+  /// takes its file's
+  bool evidence_given = false;
   /// > 0: the run's (the stream's) displacement columns named after targets are read as drift
   /// readings, one every this many seconds (a probe cycle); 0: temperatures only
   double drift_readings_every_s = 0;
@@ -159,6 +165,9 @@ struct ObserveArgs {
   std::vector<std::filesystem::path> changed;
   double truth_sigma_um = 0;  /// white noise of the training runs' measured drift [um]
   double coverage = 0.95;     /// the share of training samples the ±2 sigma band is to hold
+  /// with changed and the terms on evidence: the evidence setting chosen on the changed runs
+  /// (studies::ChangedMachineSigma::evidence_chosen) instead of the options'
+  bool choose_evidence = false;
   ObserverOptions observer;
   bool quiet = false;
 };

@@ -472,14 +472,22 @@ Command observe_line(CLI::App& cli) {
                                  "the reported drift sigma on them (OUT/sigma_calibration.json) "
                                  "and use them on --data")
                     ->check(CLI::ExistingDirectory);
+  auto* changed =
+      observe
+          ->add_option("--changed", observe_args.changed,
+                       "with --train: measured runs of the machine changed (an effect the "
+                       "declared model lacks), their drift measured as the training runs' is: "
+                       "choose --correction-relative-sigma and --expansion-relative-sigma on them "
+                       "(sigma_calibration.json changed_machine; docs/observer.md)")
+          ->check(CLI::ExistingDirectory)
+          ->needs(train);
   observe
-      ->add_option("--changed", observe_args.changed,
-                   "with --train: measured runs of the machine changed (an effect the declared "
-                   "model lacks), their drift measured as the training runs' is: choose "
-                   "--correction-relative-sigma and --expansion-relative-sigma on them "
-                   "(sigma_calibration.json changed_machine; docs/observer.md)")
-      ->check(CLI::ExistingDirectory)
-      ->needs(train);
+      ->add_flag("--choose-evidence", observe_args.choose_evidence,
+                 "with --changed and --changed-terms-on-evidence: also choose --evidence-time-s "
+                 "and --evidence-onset-sigmas on the changed runs (the setting whose pair comes "
+                 "nearest the coverage with the narrowest band on the training runs; "
+                 "changed_machine.evidence_settings)")
+      ->needs(changed);
   observe
       ->add_option("--truth-sigma-um", observe_args.truth_sigma_um,
                    "with --train: white noise of the measured drift [um]: where the errors are "

@@ -99,6 +99,24 @@ void print_calibration(const studies::SigmaCalibration& cal) {
               << held.str() << "; RMS sigma / RMS error on the training runs" << width.str()
               << "\n";
   }
+  if (!ch.evidence_settings.empty()) {
+    const studies::EvidenceChoice& e = ch.evidence_settings.at(ch.evidence_chosen);
+    const bool taken = ch.gate == solvers::ChangedTermsGate::on_evidence &&
+                       ch.evidence.time_s == e.settings.time_s &&
+                       ch.evidence.onset_sigmas == e.settings.onset_sigmas;
+    std::cerr << "thermotwin: observe:   on evidence, the setting these runs choose of "
+              << ch.evidence_settings.size() << " (changed_machine.evidence_settings): "
+              << "--evidence-time-s " << e.settings.time_s << " --evidence-onset-sigmas "
+              << e.settings.onset_sigmas << ", c " << e.choice.pick.correction_relative_sigma
+              << ", e " << e.choice.pick.expansion_relative_sigma
+              << "; RMS sigma / RMS error on the training runs, summed over the targets, "
+              << e.choice.training_width
+              << (taken ? " (taken)"
+                  : ch.gate == solvers::ChangedTermsGate::on_evidence
+                      ? " (not taken: --choose-evidence takes it)"
+                      : "")
+              << "\n";
+  }
 }
 
 /// The sigma calibrated on the training runs (sigma_calibration.json into `dir`), `input` holding
@@ -114,6 +132,7 @@ void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>
   input.drift_readings_every_s = options.drift_readings_every_s;
   input.truth_sigma_m = core::kMetresPerMicrometre * args.truth_sigma_um;
   input.coverage = args.coverage;
+  input.evidence_from_data = args.choose_evidence;
   if (!args.quiet)
     input.progress = [](const std::string& line) {
       std::cerr << "thermotwin: observe: " << line << "\n";
@@ -131,6 +150,8 @@ void calibrate_sigma(const ObserveArgs& args, const std::vector<io::MeasuredRun>
     const studies::SigmaTermsCandidate& pick = cal.changed->pick();
     options.correction_relative_sigma = pick.correction_relative_sigma;
     options.expansion_relative_sigma = {pick.expansion_relative_sigma};
+    options.evidence_time_s = cal.changed->evidence.time_s;
+    options.evidence_onset_sigmas = cal.changed->evidence.onset_sigmas;
   }
   if (!args.quiet) print_calibration(cal);
 }
@@ -177,6 +198,14 @@ int observe_command(const ObserveArgs& args) {
     throw core::DataError(
         "observe: --changed chooses --correction-relative-sigma and --expansion-relative-sigma; "
         "give it or them, not both");
+  if (args.choose_evidence && !args.observer.changed_terms_on_evidence)
+    throw core::DataError(
+        "observe: --choose-evidence chooses the evidence of --changed-terms-on-evidence; give "
+        "that too");
+  if (args.choose_evidence && args.observer.evidence_given)
+    throw core::DataError(
+        "observe: --choose-evidence chooses --evidence-time-s and --evidence-onset-sigmas; give "
+        "it or them, not both");
   std::vector<io::MeasuredRun> training, changed;
   for (const auto& path : args.train) training.push_back(io::read_measured_run(path));
   for (const auto& path : args.changed) changed.push_back(io::read_measured_run(path));

@@ -87,14 +87,19 @@ void check_same_consistency(const ObserverOptions& o, const solvers::Consistency
        chosen.sensor_fault_sigmas},
       {"model_residual_sigmas", "--model-residual-sigmas", o.model_residual_sigmas,
        chosen.model_residual_sigmas},
-      {"evidence_time_s", "--evidence-time-s", o.evidence_time_s, chosen.evidence_time_s}};
-  for (const auto& [key, flag, given, in_file] : settings)
-    if (given != in_file)
+      {"evidence_time_s", "--evidence-time-s", o.evidence_time_s, chosen.evidence_time_s},
+      {"evidence_onset_sigmas", "--evidence-onset-sigmas", o.evidence_onset_sigmas,
+       chosen.evidence_onset_sigmas}};
+  for (const auto& [key, flag, given, in_file] : settings) {
+    // The evidence's settings, when not given, are the file's (observer_setup takes them).
+    const bool evidence = std::string_view(key).starts_with("evidence_");
+    if (given != in_file && !(evidence && !o.evidence_given))
       throw core::DataError("--sigma-calibration " + file + ": changed_machine.consistency." + key +
                             " = " + nlohmann::json(in_file).dump() +
                             ": its gated relative sigmas were chosen with that setting, not " +
                             flag + " " + nlohmann::json(given).dump() + "; give " + flag + " " +
                             nlohmann::json(in_file).dump() + ", or choose them again");
+  }
 }
 
 /// The factors of --sigma-calibration's file on `setup`, and the relative sigmas it chose on
@@ -138,8 +143,11 @@ void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::st
                           "\": its relative sigmas were chosen with the terms acting so; choose "
                           "them again with " +
                           io::changed_terms_gate_flag(gate) + ", or leave the flag out");
-  if (f.changed_terms != solvers::ChangedTermsGate::always && f.consistency)
+  if (f.changed_terms != solvers::ChangedTermsGate::always && f.consistency) {
     check_same_consistency(o, *f.consistency, file);
+    setup.consistency.evidence_time_s = f.consistency->evidence_time_s;
+    setup.consistency.evidence_onset_sigmas = f.consistency->evidence_onset_sigmas;
+  }
   setup.noise.correction_relative_sigma = *f.correction_relative_sigma;
   setup.noise.changed_terms = f.changed_terms;
   setup.noise.expansion_relative_sigma =
@@ -255,8 +263,17 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
       .add_option("--evidence-time-s", o.evidence_time_s,
                   "--changed-terms-on-evidence weighs each sensor's residual against the "
                   "declared model's run averaged with this time constant, so that a reading's "
-                  "noise does not widen the band [s] (default 300, 0: the residual itself)")
-      ->check(non_negative_number());
+                  "noise does not widen the band [s] (default 300, 0: the residual itself; with "
+                  "--sigma-calibration and neither this nor --evidence-onset-sigmas, its file's)")
+      ->check(non_negative_number())
+      ->each([&o](const std::string&) { o.evidence_given = true; });
+  command
+      .add_option("--evidence-onset-sigmas", o.evidence_onset_sigmas,
+                  "--changed-terms-on-evidence's weight rises from 0 where a sensor's mean "
+                  "residual leaves this many of its sigmas to 1 at --model-residual-sigmas "
+                  "(default 1; with --sigma-calibration, as --evidence-time-s)")
+      ->check(non_negative_number())
+      ->each([&o](const std::string&) { o.evidence_given = true; });
   command.add_flag("--widen-on-inconsistency", o.widen_on_inconsistency,
                    "widen the reported drift sigma by sqrt(window NIS / window readings) while "
                    "that is above 1: the consistency window's innovations say by how much the "
@@ -301,13 +318,14 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   if (!o.probed_drift_sigma_scale.empty())
     setup.noise.probed_drift_sigma_scale = per_name(o.probed_drift_sigma_scale, setup.target_names,
                                                     "--probed-drift-sigma-scale", "targets");
-  if (!o.sigma_calibration.empty()) apply_sigma_calibration(o, sensors, setup);
   setup.consistency.window_s = o.window_s;
   setup.consistency.sustain_s = o.sustain_s;
   setup.consistency.probability = o.probability;
   setup.consistency.sensor_fault_sigmas = o.sensor_fault_sigmas;
   setup.consistency.model_residual_sigmas = o.model_residual_sigmas;
   setup.consistency.evidence_time_s = o.evidence_time_s;
+  setup.consistency.evidence_onset_sigmas = o.evidence_onset_sigmas;
+  if (!o.sigma_calibration.empty()) apply_sigma_calibration(o, sensors, setup);
   return setup;
 }
 

@@ -214,6 +214,19 @@ int main(int argc, char** argv) {
           "; the training runs' band %.2f (always on: %.2f; sum of RMS sigma / RMS error)\n",
           gates[g].second->training_width, cal_plain.changed->gates.at(0).training_width);
     }
+    // Terms on evidence under every evidence setting (ChangedMachineSigma::evidence_settings).
+    std::printf(
+        "on evidence, by setting (time constant s, onset sigmas): c, e; the changed runs' "
+        "coverage; the training runs' band\n");
+    for (std::size_t k = 0; k < changed.evidence_settings.size(); ++k) {
+      const studies::EvidenceChoice& e = changed.evidence_settings[k];
+      std::printf("  %5g s %3g: c %g, e %g;", e.settings.time_s, e.settings.onset_sigmas,
+                  e.choice.pick.correction_relative_sigma, e.choice.pick.expansion_relative_sigma);
+      for (Eigen::Index t = 0; t < e.choice.pick.score.coverage.size(); ++t)
+        std::printf(" %.1f", 100 * e.choice.pick.score.coverage(t));
+      std::printf(" %%; %.2f%s%s\n", e.choice.training_width, e.reaches_goal ? " reaches" : "",
+                  k == changed.evidence_chosen ? " (chosen)" : "");
+    }
     if (cal.probed) {
       std::printf("with a probe cycle every %g s: factors", probe_every_s);
       for (Eigen::Index t = 0; t < cal.probed->drift_sigma_scale.size(); ++t)
@@ -290,9 +303,31 @@ int main(int argc, char** argv) {
              with_choice(effect, gates[g].second->pick, gates[g].second->gate), ones, 0,
              cal.targets);
     }
+    // The evidence setting the data chose, its pair, on the held-out runs.
+    const studies::EvidenceChoice& data_evidence =
+        changed.evidence_settings.at(changed.evidence_chosen);
+    const auto reweighed = [&](const Pooled& p) {
+      Pooled out = p;
+      for (solvers::ObserverRun& r : out.runs)
+        r = studies::with_evidence(std::move(r), data_evidence.settings);
+      return out;
+    };
+    const Pooled clean_chosen = reweighed(clean), effect_chosen = reweighed(effect);
+    char setting[96];
+    std::snprintf(setting, sizeof setting, ", c and e on evidence (%g s, onset %g sigma)",
+                  data_evidence.settings.time_s, data_evidence.settings.onset_sigmas);
+    report(std::string("held-out clean, noise not declared") + setting,
+           with_choice(clean_chosen, data_evidence.choice.pick,
+                       solvers::ChangedTermsGate::on_evidence),
+           ones, 0, cal.targets);
+    report(std::string("effect runs, noise not declared") + setting,
+           with_choice(effect_chosen, data_evidence.choice.pick,
+                       solvers::ChangedTermsGate::on_evidence),
+           ones, 0, cal.targets);
     // How often the readings show evidence of a change (the on-evidence gate's weight > 0), and
     // its mean weight, on the clean and the effect runs.
-    for (const auto* p : {&clean, &effect}) {
+    for (const Pooled* p :
+         std::initializer_list<const Pooled*>{&clean, &effect, &clean_chosen, &effect_chosen}) {
       double any = 0, sum = 0, n = 0;
       for (const solvers::ObserverRun& r : p->runs)
         for (const solvers::DriftSigmaTerms& t : r.sigma_terms) {
@@ -301,8 +336,9 @@ int main(int argc, char** argv) {
           sum += w;
           n += 1;
         }
-      std::printf("%s runs: evidence weight > 0 on %.1f %% of the samples, mean %.3f\n",
-                  p == &clean ? "held-out clean" : "effect", 100 * any / n, sum / n);
+      std::printf("%s runs%s: evidence weight > 0 on %.1f %% of the samples, mean %.3f\n",
+                  p == &clean || p == &clean_chosen ? "held-out clean" : "effect",
+                  p == &clean || p == &effect ? "" : setting, 100 * any / n, sum / n);
     }
     if (cal.probed) {
       report("held-out clean, probe cycle, noise declared", clean_probed,

@@ -143,7 +143,8 @@ nlohmann::json consistency_json(const solvers::ConsistencyOptions& c) {
           {"sensor_fault_sigmas", c.sensor_fault_sigmas},
           {"model_residual_sigmas", c.model_residual_sigmas},
           {"departure_onset_sigmas", c.departure_onset_sigmas},
-          {"evidence_time_s", c.evidence_time_s}};
+          {"evidence_time_s", c.evidence_time_s},
+          {"evidence_onset_sigmas", c.evidence_onset_sigmas}};
 }
 
 void write_observe(const std::filesystem::path& dir, const studies::ObserveReport& report,

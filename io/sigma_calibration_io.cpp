@@ -76,7 +76,25 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
                      {"changed_width", g.pick.width},
                      {"training", score_json(g.training, c.targets)},
                      {"training_width", g.training_width}});
+  json evidence = json::array();
+  for (std::size_t k = 0; k < ch.evidence_settings.size(); ++k) {
+    const studies::EvidenceChoice& e = ch.evidence_settings[k];
+    evidence.push_back({{"evidence_time_s", e.settings.time_s},
+                        {"onset_sigmas", e.settings.onset_sigmas},
+                        {"bound_sigmas", e.settings.bound_sigmas},
+                        {"correction_relative_sigma", e.choice.pick.correction_relative_sigma},
+                        {"expansion_relative_sigma", e.choice.pick.expansion_relative_sigma},
+                        {"changed", score_json(e.choice.pick.score, c.targets)},
+                        {"training", score_json(e.choice.training, c.targets)},
+                        {"training_width", e.choice.training_width},
+                        {"reaches_goal", e.reaches_goal},
+                        {"chosen", k == ch.evidence_chosen}});
+  }
   const studies::SigmaTermsCandidate& pick = ch.pick();
+  // The alarm's settings the pair was chosen with, and the evidence's it was scored under.
+  solvers::ConsistencyOptions chosen_with = c.setup.consistency;
+  chosen_with.evidence_time_s = ch.evidence.time_s;
+  chosen_with.evidence_onset_sigmas = ch.evidence.onset_sigmas;
   std::vector<std::string> out_of_reach;
   for (std::size_t t = 0; t < c.targets.size(); ++t)
     if (ch.out_of_reach[t]) out_of_reach.push_back(c.targets[t]);
@@ -89,7 +107,8 @@ json changed_json(const studies::ChangedMachineSigma& ch, const studies::SigmaCa
           {"grid", grid},
           {"per_run", runs},
           {"gates", gates},
-          {"consistency", consistency_json(c.setup.consistency)}};
+          {"evidence_settings", evidence},
+          {"consistency", consistency_json(chosen_with)}};
 }
 
 /// changed_machine's gate: its "gate" (from session 19 on), which agrees with its "after_alarm";
@@ -172,6 +191,9 @@ json sigma_calibration_json(const studies::SigmaCalibration& c,
       more << " --expansion-relative-sigma " << pick.expansion_relative_sigma;
     if (c.changed->gate != solvers::ChangedTermsGate::always)
       more << " " << changed_terms_gate_flag(c.changed->gate);
+    if (c.changed->gate == solvers::ChangedTermsGate::on_evidence)
+      more << " --evidence-time-s " << c.changed->evidence.time_s << " --evidence-onset-sigmas "
+           << c.changed->evidence.onset_sigmas;
     flags += more.str();
   }
   out["flags"] = flags;
@@ -217,6 +239,9 @@ SigmaCalibrationFile read_sigma_calibration(const std::filesystem::path& path) {
       o.sensor_fault_sigmas = fit_keys::number_at(c, "sensor_fault_sigmas", p, at);
       o.model_residual_sigmas = fit_keys::number_at(c, "model_residual_sigmas", p, at);
       o.evidence_time_s = fit_keys::number_at(c, "evidence_time_s", p, at);
+      // Written from session 20 on; before, the evidence's onset was 1 sigma.
+      if (c.contains("evidence_onset_sigmas"))
+        o.evidence_onset_sigmas = fit_keys::number_at(c, "evidence_onset_sigmas", p, at);
       f.consistency = o;
     }
   }

@@ -590,9 +590,10 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
         residual(k) = std::numeric_limits<double>::quiet_NaN();
     for (const HeldSensor& d : departures_.add(t, residual, setup_.noise.sensor_sigma_k))
       earliest(d.onset_s);
+    e.sigma_terms.departure = residual.cwiseQuotient(setup_.noise.sensor_sigma_k);
     e.sigma_terms.evidence = departure_evidence(
         evidence_mean_.add(t, residual), setup_.noise.sensor_sigma_k,
-        setup_.consistency.departure_onset_sigmas, setup_.consistency.model_residual_sigmas);
+        setup_.consistency.evidence_onset_sigmas, setup_.consistency.model_residual_sigmas);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
@@ -624,6 +625,19 @@ double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd
     if (std::isfinite(residual(k))) largest = std::max(largest, std::abs(residual(k)) / sigma(k));
   if (bound <= onset) return largest > bound ? 1 : 0;
   return std::clamp((largest - onset) / (bound - onset), 0.0, 1.0);
+}
+
+Eigen::VectorXd evidence_of(const ObserverRun& run, const EvidenceSettings& settings) {
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(run.sigma_terms.size()));
+  ExponentialMean mean(settings.time_s);
+  for (std::size_t i = 0; i < run.sigma_terms.size(); ++i) {
+    const Eigen::VectorXd& z = run.sigma_terms[i].departure;
+    if (z.size() == 0) continue;
+    const auto k = static_cast<Eigen::Index>(i);
+    out(k) = departure_evidence(mean.add(run.times(k), z), Eigen::VectorXd::Ones(z.size()),
+                                settings.onset_sigmas, settings.bound_sigmas);
+  }
+  return out;
 }
 
 DriftSigmaTerms KalmanObserver::drift_sigma_terms(const Eigen::VectorXd& drift) const {

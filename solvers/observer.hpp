@@ -148,6 +148,10 @@ struct ConsistencyOptions {
   /// reading's noise does not make it: the departure test holds its bound for sustain_s instead,
   /// the evidence has no hold. 0: of the residual itself.
   double evidence_time_s = 300;
+  /// The evidence is 0 while every sensor's mean is within this many of its sigmas and 1 at
+  /// model_residual_sigmas (departure_evidence's onset; the alarm's dating keeps
+  /// departure_onset_sigmas).
+  double evidence_onset_sigmas = 1;
 };
 
 /// The observer's set-up on a reduced system.
@@ -294,9 +298,13 @@ struct DriftSigmaTerms {
   /// In [0, 1]: how far the readings have departed from the declared model's own run, on the
   /// departure test's scale (ConsistencyOptions::model_residual_sigmas): (max over the sensors of
   /// |reading - declared run| / sigma_k - onset) / (bound - onset), clamped, the onset bound
-  /// departure_onset_sigmas and the bound model_residual_sigmas; the sensors the departure test
+  /// evidence_onset_sigmas and the bound model_residual_sigmas; the sensors the departure test
   /// leaves out (a faulty offset) are left out here too. 0 without that test.
   double evidence = 0;
+  /// #sensors: the departure test's residual over each sensor's sigma, NaN where that test left
+  /// the sensor out (empty without the test): what the evidence is made of, kept so that other
+  /// evidence settings are scored without observing again (evidence_of).
+  Eigen::VectorXd departure;
 };
 
 /// DriftSigmaTerms::evidence of the residuals (reading - declared run, per sensor; NaN: left
@@ -304,6 +312,12 @@ struct DriftSigmaTerms {
 /// clamped (a step at `bound` when bound <= onset).
 double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd& sigma,
                           double onset, double bound);
+
+/// How the evidence is taken of the departure test's residuals (ConsistencyOptions'
+/// evidence_time_s and evidence_onset_sigmas, the bound its model_residual_sigmas).
+struct EvidenceSettings {
+  double time_s = 300, onset_sigmas = 1, bound_sigmas = 3;
+};
 
 /// The weight of the changed machine's terms in `terms` under `gate`: 1, the evidence or 0
 /// before the alarm, 1 from it on.
@@ -444,6 +458,11 @@ struct ObserverRun {
   std::vector<HeldSensor> drift_departures;
   std::vector<DriftSigmaTerms> sigma_terms;  /// per sample: what drift_sigma is made of
 };
+
+/// The evidence at each of `run`'s samples (DriftSigmaTerms::departure, in order, at run.times)
+/// under `settings`: what the observer would have said with them; the observer's own where they
+/// are its own. Zeros where a sample kept no departure.
+Eigen::VectorXd evidence_of(const ObserverRun& run, const EvidenceSettings& settings);
 
 /// `setup` for a filter that assimilates drift readings: its reported sigma scaled by
 /// noise.probed_drift_sigma_scale when that is set.

@@ -135,6 +135,62 @@ ChangedMachineSigma choose_sigma_terms(const Observed& o, const std::vector<std:
   return out;
 }
 
+/// `o` with each sample's evidence taken under `settings`.
+Observed with_evidence(Observed o, const solvers::EvidenceSettings& settings) {
+  for (solvers::ObserverRun& run : o.runs) run = studies::with_evidence(std::move(run), settings);
+  return o;
+}
+
+/// `pick` (chosen on the changed runs) scored on `training` with `factor`, under `gate`.
+GateChoice priced(solvers::ChangedTermsGate gate, const SigmaTermsCandidate& pick,
+                  const Observed& training, const Eigen::VectorXd& factor, double noise) {
+  GateChoice choice{gate, pick, {}, 0};
+  choice.training = score_with(training, factor, pick.correction_relative_sigma,
+                               pick.expansion_relative_sigma, gate, noise);
+  choice.training_width = band_width(choice.training);
+  return choice;
+}
+
+/// Terms on evidence under every evidence setting (ChangedMachineSigma::evidence_settings), and
+/// the one chosen (evidence_chosen) into `out`.
+void choose_evidence(const Observed& changed, const std::vector<std::string>& names,
+                     const Observed& training, const Eigen::VectorXd& factor, double bound,
+                     const SigmaCalibrationInput& input, ChangedMachineSigma& out) {
+  constexpr auto gate = solvers::ChangedTermsGate::on_evidence;
+  Eigen::ArrayXd best;
+  for (const double time_s : kEvidenceTimes)
+    for (const double onset : kEvidenceOnsets) {
+      const solvers::EvidenceSettings settings{time_s, onset, bound};
+      const SigmaTermsCandidate pick =
+          choose_sigma_terms(with_evidence(changed, settings), names, gate, input).pick();
+      out.evidence_settings.push_back(
+          {settings,
+           priced(gate, pick, with_evidence(training, settings), factor, input.truth_sigma_m)});
+      const Eigen::ArrayXd covered = pick.score.coverage.array();
+      best = best.size() == 0 ? covered : best.max(covered);
+    }
+  const Eigen::ArrayXd goal = best.min(input.coverage + kReachTolerance) - kReachTolerance;
+  // Per setting the largest shortfall from a goal over the measured targets (<= 0: reaches).
+  std::vector<double> shortfall;
+  for (EvidenceChoice& s : out.evidence_settings) {
+    const solvers::DriftBandScore& score = s.choice.pick.score;
+    shortfall.push_back(
+        (score.samples.array() > 0).select(goal - score.coverage.array(), -1.0).maxCoeff());
+    s.reaches_goal = shortfall.back() <= 0;
+  }
+  // The narrowest that reaches; when none does (targets best covered by different settings), the
+  // one that falls least short.
+  const auto better = [&](std::size_t a, std::size_t b) {
+    const EvidenceChoice &x = out.evidence_settings[a], &y = out.evidence_settings[b];
+    if (x.reaches_goal != y.reaches_goal) return x.reaches_goal;
+    return x.reaches_goal ? x.choice.training_width < y.choice.training_width
+                          : shortfall[a] < shortfall[b];
+  };
+  out.evidence_chosen = 0;
+  for (std::size_t k = 1; k < out.evidence_settings.size(); ++k)
+    if (better(k, out.evidence_chosen)) out.evidence_chosen = k;
+}
+
 /// The changed runs observed with the factors calibrated in `cal` (its sensors), and c and e
 /// chosen on them with every gate; `training` the training runs as `cal` observed them.
 ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const SigmaCalibration& cal,
@@ -174,15 +230,22 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const Si
   for (const auto g : solvers::kChangedTermsGates) {
     const Observed& scored = g == solvers::ChangedTermsGate::after_alarm ? from_alarm : o;
     ChangedMachineSigma chosen = choose_sigma_terms(scored, names, g, input);
-    GateChoice choice{g, chosen.pick(), {}, 0};
-    choice.training = score_with(training, factor, choice.pick.correction_relative_sigma,
-                                 choice.pick.expansion_relative_sigma, g, input.truth_sigma_m);
-    choice.training_width = band_width(choice.training);
-    gates.push_back(std::move(choice));
+    gates.push_back(priced(g, chosen.pick(), training, factor, input.truth_sigma_m));
     if (g == gate) out = std::move(chosen);
   }
   out.gates = std::move(gates);
-  return out;
+  const solvers::ConsistencyOptions& own = cal.setup.consistency;
+  choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);
+  out.evidence = {own.evidence_time_s, own.evidence_onset_sigmas, own.model_residual_sigmas};
+  if (gate != solvers::ChangedTermsGate::on_evidence || !input.evidence_from_data) return out;
+  // The pair, the grid and the per-run scores under the setting the changed runs chose.
+  const solvers::EvidenceSettings chosen = out.evidence_settings.at(out.evidence_chosen).settings;
+  ChangedMachineSigma data = choose_sigma_terms(with_evidence(o, chosen), names, gate, input);
+  data.gates = std::move(out.gates);
+  data.evidence_settings = std::move(out.evidence_settings);
+  data.evidence_chosen = out.evidence_chosen;
+  data.evidence = chosen;
+  return data;
 }
 
 }  // namespace
@@ -198,6 +261,14 @@ solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::Ve
         solvers::drift_sigma(terms, c, Eigen::VectorXd::Constant(materials, e), gate).transpose();
   }
   return out;
+}
+
+solvers::ObserverRun with_evidence(solvers::ObserverRun run,
+                                   const solvers::EvidenceSettings& settings) {
+  const Eigen::VectorXd evidence = solvers::evidence_of(run, settings);
+  for (std::size_t i = 0; i < run.sigma_terms.size(); ++i)
+    run.sigma_terms[i].evidence = evidence(static_cast<Eigen::Index>(i));
+  return run;
 }
 
 Eigen::MatrixXd between_readings(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& read) {

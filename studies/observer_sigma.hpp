@@ -42,6 +42,9 @@ struct SigmaCalibrationInput {
   /// as the training runs' is: with one or more, the correction's and the materials' expansion
   /// relative sigma are chosen on them (ChangedMachineSigma)
   std::vector<const io::MeasuredRun*> changed;
+  /// with the terms on evidence: the pair chosen under the evidence setting the changed runs
+  /// choose (ChangedMachineSigma::evidence_chosen) instead of the set-up's own
+  bool evidence_from_data = false;
   Progress progress;  /// a line per run observed; may be empty
 };
 
@@ -85,6 +88,21 @@ struct GateChoice {
   double training_width = 0;         /// over the measured targets: sum of RMS sigma / RMS error
 };
 
+/// One setting of the evidence (solvers::EvidenceSettings) with the pair the rule takes under it
+/// for terms on evidence, and that pair's price on the training runs
+/// (ChangedMachineSigma::evidence_settings).
+struct EvidenceChoice {
+  solvers::EvidenceSettings settings;
+  GateChoice choice;  /// its gate on_evidence
+  bool reaches_goal =
+      false;  /// every measured target's goal (ChangedMachineSigma::evidence_chosen)
+};
+
+/// The evidence settings tried (ChangedMachineSigma::evidence_settings): time constants [s] and
+/// onsets [sigmas]; the bound stays the departure test's.
+inline constexpr double kEvidenceTimes[] = {0, 60, 300, 900, 1800};
+inline constexpr double kEvidenceOnsets[] = {0, 0.5, 1, 1.5, 2};
+
 /// How far below the widest pair's coverage an out-of-reach target's goal is (ChangedMachineSigma).
 inline constexpr double kReachTolerance = 0.01;
 
@@ -118,6 +136,20 @@ struct ChangedMachineSigma {
   /// same observation of the changed runs: what a tight band on a healthy machine costs in
   /// coverage of a changed one
   std::vector<GateChoice> gates;
+  /// Terms on evidence with every evidence setting (kEvidenceTimes x kEvidenceOnsets, the bound
+  /// the set-up's model_residual_sigmas), from the same observation, each with its pair (the rule
+  /// above) and that pair's price on the training runs.
+  std::vector<EvidenceChoice> evidence_settings;
+  /// The setting on evidence that the data choose: per measured target a goal of `coverage`, or
+  /// kReachTolerance below the best coverage any setting's pair gives; of the settings whose pair
+  /// reaches every goal, the one with the narrowest band on the training runs (training_width);
+  /// when none does (targets best covered under different settings), the one that falls least
+  /// short of a goal.
+  std::size_t evidence_chosen = 0;
+  /// the evidence setting `grid` was scored under (the set-up's own, or with evidence_from_data
+  /// and the terms on evidence the one chosen); what the alarm and evidence settings the pair
+  /// was chosen with (sigma_calibration.json changed_machine.consistency) say of the evidence
+  solvers::EvidenceSettings evidence;
 };
 
 struct SigmaCalibration {
@@ -141,6 +173,12 @@ struct SigmaCalibration {
 solvers::ObserverRun with_sigma(const solvers::ObserverRun& run, const Eigen::VectorXd& factor,
                                 double c, double e,
                                 solvers::ChangedTermsGate gate = solvers::ChangedTermsGate::always);
+
+/// `run` with each sample's evidence (solvers::DriftSigmaTerms::evidence) taken under `settings`
+/// (solvers::evidence_of): as the observer would have reported it with them. Its sigma is left as
+/// it was (with_sigma makes it).
+solvers::ObserverRun with_evidence(solvers::ObserverRun run,
+                                   const solvers::EvidenceSettings& settings);
 
 /// `truth` (#samples x #targets) with NaN at every sample where `read` (drift readings of the same
 /// samples, NaN where none) holds a reading: a probe-cycle filter is scored between its readings,

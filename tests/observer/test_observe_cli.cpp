@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -902,6 +903,33 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
         << t;
     EXPECT_GE(gates[0]["training"][t]["rms_sigma_um"].get<double>(), factors_alone) << t;
   }
+  // Terms on evidence under every evidence setting: the observer's own (300 s, onset 1 sigma) is
+  // the gate's; the chosen one reaches its goal with the narrowest training band of those that do.
+  const auto& settings = ch["evidence_settings"];
+  ASSERT_EQ(settings.size(), 25u);
+  int own = 0, chosen = 0;
+  double narrowest = std::numeric_limits<double>::infinity(), chosen_width = 0;
+  nlohmann::json data_setting;
+  for (const auto& s : settings) {
+    if (s["evidence_time_s"] == 300.0 && s["onset_sigmas"] == 1.0) {
+      ++own;
+      EXPECT_EQ(gate_pair(s), gate_pair(gates[1]));
+      EXPECT_NEAR(s["training_width"].get<double>(), gates[1]["training_width"].get<double>(),
+                  1e-9);
+    }
+    EXPECT_EQ(s["bound_sigmas"], 3.0);
+    if (s["reaches_goal"].get<bool>())
+      narrowest = std::min(narrowest, s["training_width"].get<double>());
+    if (s["chosen"].get<bool>()) {
+      ++chosen;
+      chosen_width = s["training_width"];
+      data_setting = s;
+    }
+  }
+  EXPECT_EQ(own, 1);
+  ASSERT_EQ(chosen, 1);
+  ASSERT_TRUE(std::isfinite(narrowest));  // here some setting reaches every goal
+  EXPECT_EQ(chosen_width, narrowest);
   // The changed runs observed with the file's factors, c and e as flags: their coverage is the
   // file's (per_run after), to a sample.
   std::ostringstream factors, flag_c, flag_e;
@@ -974,20 +1002,37 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
               gated["expansion_relative_sigma"].get<double>(),
               gated_held["recalibrate_raised_s"].dump().c_str());
   // The terms on evidence (--changed-terms-on-evidence): chosen and applied so; on the held-out
-  // heat run they cover at least what the clean runs' factors alone do.
+  // heat run they cover at least what the clean runs' factors alone do. With --choose-evidence
+  // the pair is the one of the setting the changed runs chose, and the file carries that setting
+  // to the runs observed with it; without, the options' (the gate's in `gates`, at the default
+  // 300 s and 1 sigma).
   ASSERT_EQ(observe({"--train", path("a"), "--train", path("b"), "--changed", path("heat"),
-                     "--changed", path("expansion"), "--changed-terms-on-evidence", "--out",
-                     (dir / "evidence").string(), "--quiet"}),
+                     "--changed", path("expansion"), "--changed-terms-on-evidence",
+                     "--choose-evidence", "--out", (dir / "evidence").string(), "--quiet"}),
             0)
       << rt::read_text(log);
   const fs::path evidence_file = dir / "evidence" / "sigma_calibration.json";
   const auto evidence = nlohmann::json::parse(std::ifstream(evidence_file));
   EXPECT_EQ(evidence["changed_machine"]["gate"], "on_evidence");
   EXPECT_EQ(evidence["changed_machine"]["after_alarm"], false);
-  EXPECT_EQ(gate_pair(evidence), gate_pair(gates[1]));
-  EXPECT_EQ(evidence["changed_machine"]["consistency"]["evidence_time_s"], 300.0);
+  EXPECT_EQ(gate_pair(evidence), gate_pair(data_setting));
+  const auto& chosen_with = evidence["changed_machine"]["consistency"];
+  EXPECT_EQ(chosen_with["evidence_time_s"], data_setting["evidence_time_s"]);
+  EXPECT_EQ(chosen_with["evidence_onset_sigmas"], data_setting["onset_sigmas"]);
   EXPECT_NE(evidence["flags"].get<std::string>().find("--changed-terms-on-evidence"),
             std::string::npos);
+  EXPECT_NE(evidence["flags"].get<std::string>().find("--evidence-onset-sigmas"),
+            std::string::npos);
+  ASSERT_EQ(observe({"--train", path("a"), "--train", path("b"), "--changed", path("heat"),
+                     "--changed", path("expansion"), "--changed-terms-on-evidence", "--out",
+                     (dir / "evidence300").string(), "--quiet"}),
+            0)
+      << rt::read_text(log);
+  const fs::path evidence300_file = dir / "evidence300" / "sigma_calibration.json";
+  const auto evidence300 = nlohmann::json::parse(std::ifstream(evidence300_file));
+  EXPECT_EQ(gate_pair(evidence300), gate_pair(gates[1]));
+  EXPECT_EQ(evidence300["changed_machine"]["consistency"]["evidence_time_s"], 300.0);
+  EXPECT_EQ(evidence300["changed_machine"]["consistency"]["evidence_onset_sigmas"], 1.0);
   ASSERT_EQ(observe({"--data", path("held"), "--sigma-calibration", evidence_file.string(), "--out",
                      (dir / "held_evidence").string(), "--quiet"}),
             0)
@@ -995,15 +1040,30 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
   const auto evidence_held =
       nlohmann::json::parse(std::ifstream(dir / "held_evidence" / "observer.json"));
   EXPECT_EQ(evidence_held["noise"]["changed_terms"], "on_evidence");
+  EXPECT_EQ(evidence_held["consistency"]["evidence_time_s"], data_setting["evidence_time_s"]);
+  EXPECT_EQ(evidence_held["consistency"]["evidence_onset_sigmas"], data_setting["onset_sigmas"]);
+  std::printf("[changed sigma] on evidence, the changed runs' setting: %s s, onset %s sigma\n",
+              data_setting["evidence_time_s"].dump().c_str(),
+              data_setting["onset_sigmas"].dump().c_str());
   expect_streamed_as_observed(rom, dir / "run_held", evidence_file, dir / "held_evidence",
                               {"dy_sigma_um", "dz_sigma_um"}, dir, log);
+  ASSERT_EQ(observe({"--data", path("held"), "--sigma-calibration", evidence300_file.string(),
+                     "--out", (dir / "held_evidence300").string(), "--quiet"}),
+            0)
+      << rt::read_text(log);
   for (const char* t : {"dy", "dz"}) {
     const double before = band_coverage(dir / "held_clean_cal", runs["held"], t);
     const double after = band_coverage(dir / "held_evidence", runs["held"], t);
-    std::printf("[changed sigma] on evidence: c %.2f, e %.2f; held-out run's %s coverage %.1f %%\n",
-                evidence["correction_relative_sigma"].get<double>(),
-                evidence["expansion_relative_sigma"].get<double>(), t, 100 * after);
+    const double after300 = band_coverage(dir / "held_evidence300", runs["held"], t);
+    std::printf(
+        "[changed sigma] on evidence: c %.2f, e %.2f; held-out run's %s coverage %.1f %% (at 300 "
+        "s and 1 sigma: c %.2f, e %.2f, %.1f %%)\n",
+        evidence["correction_relative_sigma"].get<double>(),
+        evidence["expansion_relative_sigma"].get<double>(), t, 100 * after,
+        evidence300["correction_relative_sigma"].get<double>(),
+        evidence300["expansion_relative_sigma"].get<double>(), 100 * after300);
     EXPECT_GE(after, before) << t;
+    EXPECT_GE(after300, before) << t;
   }
   // A file of session 18 (after_alarm, no gate) is read as it was written: the gate after the
   // alarm. A gate not known, or one that disagrees with after_alarm, is refused.
@@ -1040,10 +1100,13 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
         "changed_machine.gate = \"on_evidence\""},
        {{"--data", path("held"), "--changed-terms-after-alarm", "--changed-terms-on-evidence"},
         "excludes"},
-       {{"--data", path("held"), "--sigma-calibration", evidence_file.string(), "--evidence-time-s",
-         "0"},
+       {{"--data", path("held"), "--sigma-calibration", evidence300_file.string(),
+         "--evidence-time-s", "0"},
         "changed_machine.consistency.evidence_time_s = 300.0: its gated relative sigmas were "
         "chosen with that setting, not --evidence-time-s 0.0"},
+       {{"--data", path("held"), "--sigma-calibration", evidence300_file.string(),
+         "--evidence-onset-sigmas", "2"},
+        "changed_machine.consistency.evidence_onset_sigmas = 1.0"},
        {{"--data", path("held"), "--sigma-calibration",
          (dir / "gated" / "sigma_calibration.json").string(), "--sustain-s", "600"},
         "changed_machine.consistency.sustain_s = 900.0"},
@@ -1052,7 +1115,13 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
        {{"--data", path("held"), "--sigma-calibration", with_gate("odd.json", "on_evidence", true)},
         "disagrees with changed_machine.gate"},
        {{"--train", path("a"), "--changed", path("a")}, "--changed"},
-       {{"--data", path("held"), "--changed", path("heat")}, "--changed requires --train"}},
+       {{"--data", path("held"), "--changed", path("heat")}, "--changed requires --train"},
+       {{"--train", path("a"), "--changed", path("heat"), "--choose-evidence"},
+        "--choose-evidence chooses the evidence of --changed-terms-on-evidence"},
+       {{"--train", path("a"), "--changed", path("heat"), "--changed-terms-on-evidence",
+         "--choose-evidence", "--evidence-time-s", "60"},
+        "give it or them, not both"},
+       {{"--data", path("held"), "--choose-evidence"}, "--choose-evidence requires --changed"}},
       dir, log);
   if (!HasFailure()) fs::remove_all(dir);
 }
@@ -1071,7 +1140,7 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
           "--sensor-fault-sigmas", "--correction-relative-sigma", "--expansion-relative-sigma",
           "--model-residual-sigmas", "--drift-readings-every-s", "--drift-reading-sigma-um",
           "--sigma-calibration", "--changed-terms-after-alarm", "--changed-terms-on-evidence",
-          "--evidence-time-s"})
+          "--evidence-time-s", "--evidence-onset-sigmas"})
       EXPECT_NE(help.find(flag), std::string::npos) << command << " --help lacks " << flag;
   }
   const std::vector<std::string> base{
@@ -1080,6 +1149,8 @@ TEST(ObserveCli, ObserverSettingsAreFlagsAndABadValueIsRefused) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> bad{
       {{"--sensor-offset-k", "-0.5"}, "--sensor-offset-k: -0.5: expected a finite number >= 0"},
       {{"--evidence-time-s", "-1"}, "--evidence-time-s: -1: expected a finite number >= 0"},
+      {{"--evidence-onset-sigmas", "nan"},
+       "--evidence-onset-sigmas: nan: expected a finite number >= 0"},
       {{"--sensor-offset-walk-k", "nan"},
        "--sensor-offset-walk-k: nan: expected a finite number >= 0"},
       {{"--heat-walk-w", "inf"}, "--heat-walk-w: inf: expected a finite number >= 0"},

@@ -658,6 +658,46 @@ TEST_F(Observer, SigmaTermsGiveTheSigmaOfAnyCorrectionAndExpansionSigma) {
   EXPECT_EQ(plain.sigma_terms.front().evidence, 0.0);  // the run starts at the declared state
 }
 
+TEST_F(Observer, EvidenceOfOtherSettingsIsWhatTheObserverSaysWithThem) {
+  // The run keeps each sample's departure (the departure test's residual over the sensor's
+  // sigma), so that `observe --changed` scores other evidence settings without observing again:
+  // solvers::evidence_of gives the evidence of a run observed with those settings.
+  const core::CaseSpec c = run_spec();
+  const auto& sys = s_->twin.model.system;
+  const auto& run = s_->heat;
+  const solvers::ObserverSetup own = setup(default_noise());
+  const solvers::ObserverRun plain = solvers::observe(sys, c, own, run.time, run.temperature);
+  const auto m = own.sensor_rows.rows();
+  for (const solvers::DriftSigmaTerms& t : plain.sigma_terms) ASSERT_EQ(t.departure.size(), m);
+  const solvers::ConsistencyOptions& k = own.consistency;
+  const Eigen::VectorXd same = solvers::evidence_of(
+      plain, {k.evidence_time_s, k.evidence_onset_sigmas, k.model_residual_sigmas});
+  double largest = 0;
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    EXPECT_NEAR(same(i), plain.sigma_terms[static_cast<std::size_t>(i)].evidence, 1e-9) << i;
+    largest = std::max(largest, same(i));
+  }
+  EXPECT_GT(largest, 0.5);  // the heat run departs
+  solvers::ObserverSetup other = own;
+  other.consistency.evidence_time_s = 60;
+  other.consistency.evidence_onset_sigmas = 0.5;
+  const solvers::ObserverRun quick = solvers::observe(sys, c, other, run.time, run.temperature);
+  const Eigen::VectorXd rescored =
+      solvers::evidence_of(plain, {60, 0.5, other.consistency.model_residual_sigmas});
+  int differs = 0;
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    EXPECT_NEAR(rescored(i), quick.sigma_terms[static_cast<std::size_t>(i)].evidence, 1e-9) << i;
+    differs += std::abs(rescored(i) - same(i)) > 1e-3;
+  }
+  EXPECT_GT(differs, 0);
+  // Of the residual itself, from 0: the largest |departure| over the bound, clamped.
+  const Eigen::VectorXd raw = solvers::evidence_of(plain, {0, 0, 3});
+  for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
+    const Eigen::VectorXd& z = plain.sigma_terms[static_cast<std::size_t>(i)].departure;
+    EXPECT_NEAR(raw(i), std::min(1.0, z.array().abs().maxCoeff() / 3), 1e-12) << i;
+  }
+}
+
 TEST(ExponentialMean, FollowsAStepWithItsTimeConstantAndSkipsMissingValues) {
   // mean += (1 - exp(-dt / tau)) (value - mean), dt since the sensor's last value, from its first
   // value on; NaN leaves the mean.
