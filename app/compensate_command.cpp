@@ -120,10 +120,15 @@ Binder observed_model(const CompensateArgs& args) {
     mesh.reset();  // no positions: every sensor at its named point
   }
   const ObserverOptions options = args.observer;
-  // A malformed --sigma-calibration is the file's fault, not the header's: read before the stream.
-  if (!options.sigma_calibration.empty()) io::read_sigma_calibration(options.sigma_calibration);
+  // A malformed --sigma-calibration is the file's fault, not the header's: read once, before the
+  // stream.
+  std::shared_ptr<const io::SigmaCalibrationFile> calibration;
+  if (!options.sigma_calibration.empty())
+    calibration = std::make_shared<const io::SigmaCalibrationFile>(
+        io::read_sigma_calibration(options.sigma_calibration));
   const std::string source = args.meta.empty() ? "the stream" : args.meta.string();
-  return [rom, spec, mesh, meta, options, source](const std::vector<std::string>& columns) {
+  return [rom, spec, mesh, meta, options, calibration,
+          source](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;
     if (sensors.empty())
       sensors = studies::readable_sensors(rom->twin.outputs, mesh.get(), meta->sensors, columns,
@@ -135,7 +140,7 @@ Binder observed_model(const CompensateArgs& args) {
     const studies::SensorReadout readout =
         studies::sensor_readout(rom->twin, mesh.get(), meta->sensors, sensors, source);
     const solvers::ObserverSetup setup =
-        observer_setup(options, rom->twin, *spec, sensors, readout.rows);
+        observer_setup(options, rom->twin, *spec, sensors, readout.rows, calibration.get());
     auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
                                                             sensors, columns, "speed_rpm",
                                                             options.drift_readings_every_s);

@@ -1,6 +1,7 @@
 #include "app/observer_options.hpp"
 
 #include <algorithm>
+#include <string_view>
 #include <tuple>
 
 #include "app/cli_numbers.hpp"
@@ -107,14 +108,14 @@ void check_same_consistency(const ObserverOptions& o, const solvers::Consistency
 /// probe cycle, or when --drift-sigma-scale or --probed-drift-sigma-scale is given too (or
 /// --correction-relative-sigma or --expansion-relative-sigma, when it chose those, or a gate's
 /// flag other than the file's gate, or alarm and evidence settings other than a gated pair's).
-void apply_sigma_calibration(const ObserverOptions& o, const std::vector<std::string>& sensors,
+void apply_sigma_calibration(const ObserverOptions& o, const io::SigmaCalibrationFile& f,
+                             const std::vector<std::string>& sensors,
                              solvers::ObserverSetup& setup) {
   const std::string file = o.sigma_calibration.string();
   if (!o.drift_sigma_scale.empty() || !o.probed_drift_sigma_scale.empty())
     throw core::DataError(
         "--sigma-calibration " + file +
         ": give it or --drift-sigma-scale / --probed-drift-sigma-scale, not both");
-  const io::SigmaCalibrationFile f = io::read_sigma_calibration(o.sigma_calibration);
   if (f.sensors != sensors)
     throw core::DataError(file + ": sensors = " + comma_joined(f.sensors) +
                           ": calibrated for other " + "sensors than the ones read here (" +
@@ -294,7 +295,8 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
 solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::Twin& twin,
                                       const core::CaseSpec& spec,
                                       const std::vector<std::string>& sensors,
-                                      const Eigen::MatrixXd& sensor_rows) {
+                                      const Eigen::MatrixXd& sensor_rows,
+                                      const io::SigmaCalibrationFile* calibration) {
   solvers::ObserverNoise noise;
   noise.sensor_sigma_k = per_name(o.sensor_sigma_k, sensors, "--sensor-sigma-k", "sensors");
   noise.heat_walk_w = o.heat_walk_w;
@@ -325,7 +327,10 @@ solvers::ObserverSetup observer_setup(const ObserverOptions& o, const solvers::T
   setup.consistency.model_residual_sigmas = o.model_residual_sigmas;
   setup.consistency.evidence_time_s = o.evidence_time_s;
   setup.consistency.evidence_onset_sigmas = o.evidence_onset_sigmas;
-  if (!o.sigma_calibration.empty()) apply_sigma_calibration(o, sensors, setup);
+  if (!o.sigma_calibration.empty())
+    apply_sigma_calibration(
+        o, calibration ? *calibration : io::read_sigma_calibration(o.sigma_calibration), sensors,
+        setup);
   return setup;
 }
 

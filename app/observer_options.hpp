@@ -9,6 +9,7 @@
 
 #include "app/commands.hpp"
 #include "core/case_spec.hpp"
+#include "io/sigma_calibration_io.hpp"
 #include "solvers/observer.hpp"
 #include "solvers/twin.hpp"
 
@@ -26,13 +27,15 @@ void add_observer_options(CLI::App& command, ObserverOptions& options);
 void add_consistency_options(CLI::App& command, ObserverOptions& options);
 
 /// The set-up on `twin` for `sensors` (ids; read through `sensor_rows` when given, else at their
-/// named points): the noise and the consistency test of `options`. Throws DataError when
+/// named points): the noise and the consistency test of `options`, with --sigma-calibration's
+/// file (`calibration` when it was read already, else read here). Throws DataError when
 /// --sensor-sigma-k or --drift-sigma-scale has neither one value nor one per sensor (target),
 /// naming them.
 solvers::ObserverSetup observer_setup(const ObserverOptions& options, const solvers::Twin& twin,
                                       const core::CaseSpec& spec,
                                       const std::vector<std::string>& sensors,
-                                      const Eigen::MatrixXd& sensor_rows = Eigen::MatrixXd());
+                                      const Eigen::MatrixXd& sensor_rows = Eigen::MatrixXd(),
+                                      const io::SigmaCalibrationFile* calibration = nullptr);
 
 /// The noise model and consistency test of a set-up, for a result file.
 nlohmann::json observer_noise_json(const solvers::ObserverSetup& setup);

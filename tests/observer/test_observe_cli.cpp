@@ -5,9 +5,13 @@
 // the sensor's and explained), and refuses a sensor the model does not name, writing nothing.
 // The same run streamed through `compensate --rom` gives the offline observer's predictions, sigmas
 // and alarm sample by sample; a stream without the observer's sensor columns is refused.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -18,6 +22,7 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include "calibration/generator.hpp"
 #include "core/rng.hpp"
@@ -634,16 +639,44 @@ void expect_refused(const std::function<int(std::vector<std::string>)>& observe,
 
 /// The run in `run_dir` streamed through `compensate --rom` with the sigma calibration `file`
 /// (into DIR/live.csv) gives `observed`'s observer.csv `columns` to 1e-6 um, sample by sample.
+/// The open write end of the FIFO `path` once a reader has opened it (waits up to a minute).
+int fifo_writer(const fs::path& path) {
+  for (int i = 0; i < 6000; ++i) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) {
+      ::fcntl(fd, F_SETFL, 0);  // blocking writes
+      return fd;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return -1;
+}
+
+/// `compensate --rom` with --sigma-calibration `file` on `run_dir`'s run: its sigmas in
+/// `columns` are observe's (observer.csv in `observed`). With `remove_file`, the run arrives
+/// through a FIFO and `file` is removed once compensate has opened it, before the header: the
+/// calibration is read once, at the start, not again when the header binds the model.
 void expect_streamed_as_observed(const fs::path& rom, const fs::path& run_dir, const fs::path& file,
                                  const fs::path& observed, const std::vector<std::string>& columns,
-                                 const fs::path& dir, const fs::path& log) {
-  ASSERT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
-                     "--meta", (run_dir / "meta.json").string(), "--in",
-                     (run_dir / "data.csv").string(), "--until-eof", "--out",
-                     (dir / "live.csv").string(), "--sigma-calibration", file.string()},
-                    {}, log),
-            0)
-      << rt::read_text(log);
+                                 const fs::path& dir, const fs::path& log,
+                                 bool remove_file = false) {
+  const fs::path in = remove_file ? dir / "stream.fifo" : run_dir / "data.csv";
+  if (remove_file) ASSERT_EQ(::mkfifo(in.c_str(), 0600), 0);
+  const pid_t pid =
+      rt::start({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(), "--meta",
+                 (run_dir / "meta.json").string(), "--in", in.string(), "--until-eof", "--out",
+                 (dir / "live.csv").string(), "--sigma-calibration", file.string()},
+                {}, log);
+  if (remove_file) {
+    const int fd = fifo_writer(in);
+    ASSERT_GE(fd, 0) << rt::read_text(log);
+    fs::remove(file);
+    const std::string text = rt::read_text(run_dir / "data.csv");
+    EXPECT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+    ::close(fd);
+    fs::remove(in);
+  }
+  ASSERT_EQ(rt::wait_for(pid), 0) << rt::read_text(log);
   const auto offline = tt::test::csv_rows(observed / "observer.csv");
   const auto streamed = tt::test::csv_rows(dir / "live.csv");
   ASSERT_EQ(streamed.size(), offline.size());
@@ -1047,6 +1080,12 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
               data_setting["onset_sigmas"].dump().c_str());
   expect_streamed_as_observed(rom, dir / "run_held", evidence_file, dir / "held_evidence",
                               {"dy_sigma_um", "dz_sigma_um"}, dir, log);
+  // The file read once, at the start: removed while compensate waits for the stream's header, it
+  // still gives the same sigmas (a copy, which the others below do not need).
+  fs::copy_file(evidence_file, dir / "once.json");
+  expect_streamed_as_observed(rom, dir / "run_held", dir / "once.json", dir / "held_evidence",
+                              {"dy_sigma_um", "dz_sigma_um"}, dir, log, true);
+  EXPECT_FALSE(fs::exists(dir / "once.json"));
   ASSERT_EQ(observe({"--data", path("held"), "--sigma-calibration", evidence300_file.string(),
                      "--out", (dir / "held_evidence300").string(), "--quiet"}),
             0)
