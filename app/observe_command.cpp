@@ -202,6 +202,10 @@ int observe_command(const ObserveArgs& args) {
     throw core::DataError(
         "observe: --choose-evidence chooses the evidence of --changed-terms-on-evidence; give "
         "that too");
+  if (args.choose_evidence && args.observer.model_residual_sigmas <= 0)
+    throw core::DataError(
+        "observe: --choose-evidence chooses how the evidence is taken of the departure test, and "
+        "--model-residual-sigmas 0 turns that test off");
   if (args.choose_evidence && args.observer.evidence_given)
     throw core::DataError(
         "observe: --choose-evidence chooses --evidence-time-s and --evidence-onset-sigmas; give "

@@ -235,8 +235,10 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const Si
   }
   out.gates = std::move(gates);
   const solvers::ConsistencyOptions& own = cal.setup.consistency;
-  choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);
   out.evidence = {own.evidence_time_s, own.evidence_onset_sigmas, own.model_residual_sigmas};
+  // Without the departure test there is no evidence, and no setting of it to choose.
+  if (own.model_residual_sigmas <= 0) return out;
+  choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);
   if (gate != solvers::ChangedTermsGate::on_evidence || !input.evidence_from_data) return out;
   // The pair, the grid and the per-run scores under the setting the changed runs chose.
   const solvers::EvidenceSettings chosen = out.evidence_settings.at(out.evidence_chosen).settings;

@@ -138,7 +138,8 @@ struct ChangedMachineSigma {
   std::vector<GateChoice> gates;
   /// Terms on evidence with every evidence setting (kEvidenceTimes x kEvidenceOnsets, the bound
   /// the set-up's model_residual_sigmas), from the same observation, each with its pair (the rule
-  /// above) and that pair's price on the training runs.
+  /// above) and that pair's price on the training runs; empty without the departure test
+  /// (model_residual_sigmas 0), which the evidence is taken of.
   std::vector<EvidenceChoice> evidence_settings;
   /// The setting on evidence that the data choose: per measured target a goal of `coverage`, or
   /// kReachTolerance below the best coverage any setting's pair gives; of the settings whose pair

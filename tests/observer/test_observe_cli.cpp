@@ -1160,7 +1160,10 @@ TEST(ObserveCli, ChangedRunsChooseTheCorrectionAndExpansionSigma) {
        {{"--train", path("a"), "--changed", path("heat"), "--changed-terms-on-evidence",
          "--choose-evidence", "--evidence-time-s", "60"},
         "give it or them, not both"},
-       {{"--data", path("held"), "--choose-evidence"}, "--choose-evidence requires --changed"}},
+       {{"--data", path("held"), "--choose-evidence"}, "--choose-evidence requires --changed"},
+       {{"--train", path("a"), "--changed", path("heat"), "--changed-terms-on-evidence",
+         "--choose-evidence", "--model-residual-sigmas", "0"},
+        "--model-residual-sigmas 0 turns that test off"}},
       dir, log);
   if (!HasFailure()) fs::remove_all(dir);
 }
