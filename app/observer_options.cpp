@@ -287,7 +287,8 @@ void add_consistency_options(CLI::App& command, ObserverOptions& o) {
   command
       .add_flag("--changed-terms-on-evidence", o.changed_terms_on_evidence,
                 "add those terms weighted by how far the readings have left the declared "
-                "model's own run before the alarm: 0 while every sensor is within 1 of its sigmas, "
+                "model's own run before the alarm: 0 while every sensor's mean residual is within "
+                "--evidence-onset-sigmas of its sigmas, "
                 "1 at --model-residual-sigmas; fully from the alarm on (default: off, always)")
       ->excludes(alarm);
 }
