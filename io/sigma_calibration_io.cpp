@@ -30,11 +30,11 @@ json score_json(const solvers::DriftBandScore& s, const std::vector<std::string>
   return out;
 }
 
-/// Per target, which rule gave the factor written: "nees" or "coverage".
+/// Per target, which rule gave the factor written: "averaged" or "coverage".
 std::vector<std::string> rules(const studies::SigmaPass& pass) {
   std::vector<std::string> out;
   for (const studies::SigmaRule r : pass.rules)
-    out.push_back(r == studies::SigmaRule::nees ? "nees" : "coverage");
+    out.push_back(r == studies::SigmaRule::averaged ? "averaged" : "coverage");
   return out;
 }
 
@@ -48,6 +48,9 @@ json pass_json(const studies::SigmaPass& pass, const studies::SigmaCalibration& 
           {"rules", rules(pass)},
           {"coverage_drift_sigma_scale", as_vector(pass.coverage_drift_sigma_scale)},
           {"nees_drift_sigma_scale", as_vector(pass.nees_drift_sigma_scale)},
+          {"averaged_drift_sigma_scale", pass.averaged_drift_sigma_scale.size() != 0
+                                             ? json(as_vector(pass.averaged_drift_sigma_scale))
+                                             : json(nullptr)},
           {"observed_with", as_vector(pass.observed_with)},
           {"before", score_json(pass.pooled_before, c.targets)},
           {"after", score_json(pass.pooled_after, c.targets)},

@@ -3,12 +3,13 @@
 // named after the observer's targets) are observed as `observe` observes a run, and the factor on
 // each target's sigma is chosen that puts the share `coverage` of their samples within ±2 sigma of
 // the measured drift (solvers::drift_sigma_coverage_calibration). When the measured drift's own
-// noise is declared, the factor is instead the one that makes the mean normalised squared error 1
-// with that noise taken out (solvers::drift_sigma_calibration), where the errors are above the
-// noise: subtracting the noise sample by sample under the quantile made the band too narrow on
-// held-out runs (docs/observer.md). With a
-// probe cycle the runs are also observed reading their drift every so often, and that filter gets
-// its own factor, scored on the samples between readings. SI units.
+// white noise is declared, the same rule reads the measured drift's mean over a few minutes
+// (window_mean), which divides that noise and keeps the errors, slow as the machine's heat:
+// subtracting the noise sample by sample under the quantile made the band too narrow on held-out
+// runs, and the NEES rule with the noise taken out under-covered where the errors are near the
+// noise (docs/observer.md). With a probe cycle the runs are also observed reading their drift
+// every so often, and that filter gets its own factor, scored on the samples between readings. SI
+// units.
 #pragma once
 
 #include <optional>
@@ -33,9 +34,10 @@ struct SigmaCalibrationInput {
   std::vector<std::string> sensors;
   /// > 0: also calibrate the filter that reads a probe cycle of this period [s]
   double drift_readings_every_s = 0;
-  /// white noise of the measured drift [m] (0: counted as error): where the errors are above it,
-  /// the NEES rule with it taken out gives the factor; the scores' band for the measured drift is
-  /// ±2 sqrt((factor sigma)^2 + truth_sigma_m^2)
+  /// white noise of the measured drift [m] (0: counted as error): declared, the coverage rule
+  /// reads the measured drift's mean over kDriftMeanWindowS
+  /// (SigmaPass::averaged_drift_sigma_scale); the scores' band for the measured drift is ±2
+  /// sqrt((factor sigma)^2 + truth_sigma_m^2)
   double truth_sigma_m = 0;
   double coverage = 0.95;  /// the share of samples the ±2 sigma band is to hold
   /// runs of a machine that has changed (an effect the declared model lacks), their drift measured
@@ -48,18 +50,32 @@ struct SigmaCalibrationInput {
   Progress progress;  /// a line per run observed; may be empty
 };
 
-/// Which rule gave a target's factor.
-enum class SigmaRule { coverage, nees };
+/// The window of the measured drift's mean that the averaged coverage rule reads [s]
+/// (SigmaPass::averaged_drift_sigma_scale).
+inline constexpr double kDriftMeanWindowS = 300;
+
+/// Per column of `values` (#samples x #columns, rows at `times` [s], increasing) the mean of its
+/// finite values within window_s / 2 of each sample, on either side; NaN where the sample itself
+/// is NaN (a sample that was not measured stays so) or none is finite.
+Eigen::MatrixXd window_mean(const Eigen::MatrixXd& values, const Eigen::VectorXd& times,
+                            double window_s);
+
+/// Which rule gave a target's factor: the coverage rule on the measured drift, or on its mean
+/// over kDriftMeanWindowS (with the measured drift's noise declared).
+enum class SigmaRule { coverage, averaged };
 
 /// One filter's calibration (temperatures only, or with the probe cycle).
 struct SigmaPass {
   /// per target: the factor on the reported sigma (the coverage rule's; with truth_sigma_m the
-  /// NEES rule's where the errors are above that noise), the coverage rule's (the quantile, the
-  /// noise counted as error), the NEES rule's (mean normalised squared error 1, the noise taken
-  /// out; 1 where the errors are within it), the scale the runs were observed with; 1 where no
-  /// sample had a measured drift
+  /// averaged one's), the coverage rule's (the quantile, the noise counted as error), the NEES
+  /// rule's (mean normalised squared error 1, the noise taken out; 1 where the errors are within
+  /// it; recorded), the scale the runs were observed with; 1 where no sample had a measured drift
   Eigen::VectorXd drift_sigma_scale, coverage_drift_sigma_scale, nees_drift_sigma_scale,
       observed_with;
+  /// with the measured drift's noise declared (truth_sigma_m > 0): the coverage rule on the
+  /// measured drift averaged over kDriftMeanWindowS (window_mean), whose white noise the mean
+  /// divides while the errors, which change over tens of minutes, stay; empty without
+  Eigen::VectorXd averaged_drift_sigma_scale;
   std::vector<SigmaRule> rules;  /// per target: the rule of drift_sigma_scale
   /// per run, then pooled over the runs: RMS error and the band's coverage of the measured drift
   /// before (the sigma observed with) and after (times drift_sigma_scale / observed_with), the

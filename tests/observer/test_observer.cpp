@@ -24,6 +24,7 @@
 #include "solvers/twin.hpp"
 #include "studies/catalogue_detection.hpp"
 #include "studies/estimation_input.hpp"
+#include "studies/observer_sigma.hpp"
 
 namespace tt::observer_test {
 namespace {
@@ -696,6 +697,31 @@ TEST_F(Observer, EvidenceOfOtherSettingsIsWhatTheObserverSaysWithThem) {
     const Eigen::VectorXd& z = plain.sigma_terms[static_cast<std::size_t>(i)].departure;
     EXPECT_NEAR(raw(i), std::min(1.0, z.array().abs().maxCoeff() / 3), 1e-12) << i;
   }
+}
+
+TEST(WindowMean, AveragesTheFiniteValuesWithinHalfTheWindowOnEitherSide) {
+  // The measured drift's mean over a window (studies::window_mean): the averaged coverage rule
+  // reads it where the drift's white noise is declared. Uneven times, a missing value, edges.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd times(6);
+  times << 0, 60, 120, 150, 300, 600;
+  Eigen::MatrixXd values(6, 2);
+  values << 1, 10,  //
+      2, nan,       //
+      3, 30,        //
+      4, 40,        //
+      5, 50,        //
+      6, 60;
+  const Eigen::MatrixXd m = studies::window_mean(values, times, 300);
+  EXPECT_DOUBLE_EQ(m(0, 0), (1 + 2 + 3 + 4) / 4.0);      // 0 .. 150
+  EXPECT_DOUBLE_EQ(m(1, 0), (1 + 2 + 3 + 4) / 4.0);      // -90 .. 210
+  EXPECT_DOUBLE_EQ(m(2, 0), (1 + 2 + 3 + 4) / 4.0);      // -30 .. 270
+  EXPECT_DOUBLE_EQ(m(3, 0), (1 + 2 + 3 + 4 + 5) / 5.0);  // 0 .. 300, both ends in
+  EXPECT_DOUBLE_EQ(m(4, 0), (4 + 5) / 2.0);              // 150 .. 450
+  EXPECT_DOUBLE_EQ(m(5, 0), 6.0);                        // alone
+  EXPECT_DOUBLE_EQ(m(0, 1), (10 + 30 + 40) / 3.0);       // the missing value left out
+  EXPECT_TRUE(std::isnan(m(1, 1)));                      // and not filled in
+  EXPECT_EQ(studies::window_mean(values, times, 0).col(0), values.col(0));  // no window
 }
 
 TEST(ExponentialMean, FollowsAStepWithItsTimeConstantAndSkipsMissingValues) {
