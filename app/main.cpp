@@ -490,9 +490,9 @@ Command observe_line(CLI::App& cli) {
       ->needs(changed);
   observe
       ->add_option("--truth-sigma-um", observe_args.truth_sigma_um,
-                   "with --train: white noise of the measured drift [um]: where the errors are "
-                   "above it, the factor makes the mean normalised squared error 1 with it taken "
-                   "out (default 0: the noise counted as error, which errs wide; "
+                   "with --train: white noise of the measured drift [um]: declared, the factor "
+                   "is the coverage rule's on the measured drift averaged over 300 s, which "
+                   "divides that noise (default 0: the noise counted as error, which errs wide; "
                    "docs/observer.md)")
       ->check(non_negative_number())
       ->needs(train);
