@@ -273,14 +273,10 @@ int main(int argc, char** argv) {
         "sigma / RMS error\n");
     report("held-out clean, noise declared", clean, cal.temperatures.drift_sigma_scale,
            gopt.noise_displacement_m, cal.targets);
-    report("held-out clean, noise declared, coverage rule on the 300 s mean", clean,
-           cal.temperatures.averaged_drift_sigma_scale, gopt.noise_displacement_m, cal.targets);
     report("held-out clean, noise not declared", clean, cal_plain.temperatures.drift_sigma_scale, 0,
            cal.targets);
     report("effect runs, noise declared", effect, cal.temperatures.drift_sigma_scale,
            gopt.noise_displacement_m, cal.targets);
-    report("effect runs, noise declared, coverage rule on the 300 s mean", effect,
-           cal.temperatures.averaged_drift_sigma_scale, gopt.noise_displacement_m, cal.targets);
     report("effect runs, noise not declared", effect, cal_plain.temperatures.drift_sigma_scale, 0,
            cal.targets);
     // c and e chosen on the changed runs, on the factors of the noise not declared.
