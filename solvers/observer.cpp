@@ -309,7 +309,7 @@ KalmanObserver::KalmanObserver(const ReducedThermalSystem& system, const core::C
       faults_(setup.consistency.sensor_fault_sigmas, setup.consistency.sustain_s),
       departures_(setup.consistency.model_residual_sigmas, setup.consistency.sustain_s, false,
                   setup.consistency.departure_onset_sigmas),
-      evidence_mean_(setup.consistency.evidence_time_s) {
+      evidence_(evidence_settings(setup.consistency)) {
   r_ = system.states();
   check_setup(system, spec, setup_);
   const ObserverNoise& n = setup_.noise;
@@ -591,9 +591,7 @@ void KalmanObserver::test_departures(double t, const Eigen::VectorXd& readings,
     for (const HeldSensor& d : departures_.add(t, residual, setup_.noise.sensor_sigma_k))
       earliest(d.onset_s);
     e.sigma_terms.departure = residual.cwiseQuotient(setup_.noise.sensor_sigma_k);
-    e.sigma_terms.evidence = departure_evidence(
-        evidence_mean_.add(t, residual), setup_.noise.sensor_sigma_k,
-        setup_.consistency.evidence_onset_sigmas, setup_.consistency.model_residual_sigmas);
+    e.sigma_terms.evidence = evidence_.add(t, e.sigma_terms.departure);
   }
   if (!std::isnan(departure_s_)) {
     e.recalibrate_since_s =
@@ -627,15 +625,18 @@ double departure_evidence(const Eigen::VectorXd& residual, const Eigen::VectorXd
   return std::clamp((largest - onset) / (bound - onset), 0.0, 1.0);
 }
 
+double EvidenceMean::add(double t, const Eigen::VectorXd& departure) {
+  return departure_evidence(mean_.add(t, departure), Eigen::VectorXd::Ones(departure.size()),
+                            settings_.onset_sigmas, settings_.bound_sigmas);
+}
+
 Eigen::VectorXd evidence_of(const ObserverRun& run, const EvidenceSettings& settings) {
   Eigen::VectorXd out = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(run.sigma_terms.size()));
-  ExponentialMean mean(settings.time_s);
+  EvidenceMean evidence(settings);
   for (std::size_t i = 0; i < run.sigma_terms.size(); ++i) {
     const Eigen::VectorXd& z = run.sigma_terms[i].departure;
-    if (z.size() == 0) continue;
     const auto k = static_cast<Eigen::Index>(i);
-    out(k) = departure_evidence(mean.add(run.times(k), z), Eigen::VectorXd::Ones(z.size()),
-                                settings.onset_sigmas, settings.bound_sigmas);
+    if (z.size() != 0) out(k) = evidence.add(run.times(k), z);
   }
   return out;
 }

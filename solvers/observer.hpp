@@ -319,6 +319,27 @@ struct EvidenceSettings {
   double time_s = 300, onset_sigmas = 1, bound_sigmas = 3;
 };
 
+/// The evidence settings of a consistency test's options.
+inline EvidenceSettings evidence_settings(const ConsistencyOptions& c) {
+  return {c.evidence_time_s, c.evidence_onset_sigmas, c.model_residual_sigmas};
+}
+
+/// The evidence sample by sample (DriftSigmaTerms::evidence): each sensor's departure (residual
+/// over sigma; NaN: left out) averaged with settings.time_s (ExponentialMean), then
+/// departure_evidence's ramp from settings.onset_sigmas to settings.bound_sigmas. The one way the
+/// observer and evidence_of take it.
+class EvidenceMean {
+ public:
+  explicit EvidenceMean(const EvidenceSettings& settings)
+      : settings_(settings), mean_(settings.time_s) {}
+  /// The departures at time t (after the last); returns the evidence at t.
+  double add(double t, const Eigen::VectorXd& departure);
+
+ private:
+  EvidenceSettings settings_;
+  ExponentialMean mean_;
+};
+
 /// The weight of the changed machine's terms in `terms` under `gate`: 1, the evidence or 0
 /// before the alarm, 1 from it on.
 double changed_terms_weight(const DriftSigmaTerms& terms, ChangedTermsGate gate);
@@ -423,7 +444,7 @@ class KalmanObserver {
   double t_ = 0, prev_speed_ = std::numeric_limits<double>::quiet_NaN();
   InnovationMonitor monitor_;
   HeldBeyondMonitor faults_, departures_;
-  ExponentialMean evidence_mean_;  /// the departure test's residuals, for the evidence
+  EvidenceMean evidence_;  /// the departure test's residuals over their sigmas, for the evidence
   /// The earliest start of what says recalibrate besides the NIS test [s] (NaN: none yet): a
   /// fault whose offset appeared after the first consistency window, or a reading held away
   /// from the declared model's run.

@@ -236,7 +236,7 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const Si
   }
   out.gates = std::move(gates);
   const solvers::ConsistencyOptions& own = cal.setup.consistency;
-  out.evidence = {own.evidence_time_s, own.evidence_onset_sigmas, own.model_residual_sigmas};
+  out.evidence = solvers::evidence_settings(own);
   // Without the departure test there is no evidence, and no setting of it to choose.
   if (own.model_residual_sigmas <= 0) return out;
   choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);

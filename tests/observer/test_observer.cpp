@@ -671,8 +671,7 @@ TEST_F(Observer, EvidenceOfOtherSettingsIsWhatTheObserverSaysWithThem) {
   const auto m = own.sensor_rows.rows();
   for (const solvers::DriftSigmaTerms& t : plain.sigma_terms) ASSERT_EQ(t.departure.size(), m);
   const solvers::ConsistencyOptions& k = own.consistency;
-  const Eigen::VectorXd same = solvers::evidence_of(
-      plain, {k.evidence_time_s, k.evidence_onset_sigmas, k.model_residual_sigmas});
+  const Eigen::VectorXd same = solvers::evidence_of(plain, solvers::evidence_settings(k));
   double largest = 0;
   for (Eigen::Index i = 0; i < plain.times.size(); ++i) {
     EXPECT_NEAR(same(i), plain.sigma_terms[static_cast<std::size_t>(i)].evidence, 1e-9) << i;
