@@ -366,7 +366,8 @@ struct Selection {
   std::vector<PairFit> pairs;
   bool by_pair = false;
   /// Claims that backfitting replaced (chosen again with the other claims' fits removed): the
-  /// one-after-the-other claim and what replaced it, in the order it happened.
+  /// one-after-the-other claim and what replaced it (empty: dropped, nothing of its kind beating
+  /// noise and floor beside the others), in the order it happened.
   std::vector<std::pair<std::string, std::string>> backfit_replaced;
   double null_score = 0;   /// best score over fits to pure noise
   Eigen::VectorXd sigma;   /// per channel noise estimate [K | m]

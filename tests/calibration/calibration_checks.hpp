@@ -76,7 +76,8 @@ inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::m
   }
   if (res.selection.by_pair) std::printf("[calibration]   claimed by the best pair\n");
   for (const auto& [was, now] : res.selection.backfit_replaced)
-    std::printf("[calibration]   backfit: %s replaced by %s\n", was.c_str(), now.c_str());
+    std::printf("[calibration]   backfit: %s replaced by %s\n", was.c_str(),
+                now.empty() ? "nothing (dropped)" : now.c_str());
   for (const auto& a : res.selection.ambiguous)
     std::printf("[calibration]   ambiguous: %s / %s (difference %.1f, spread %.1f)\n",
                 a.first.name.c_str(), a.second.name.c_str(), a.difference, a.spread);
