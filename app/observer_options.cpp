@@ -80,21 +80,22 @@ void add_drift_reading_options(CLI::App& command, ObserverOptions& o) {
 /// from the ones the file chose its pair with (`file` names it).
 void check_same_consistency(const ObserverOptions& o, const solvers::ConsistencyOptions& chosen,
                             const std::string& file) {
-  const std::tuple<const char*, const char*, double, double> settings[] = {
-      {"window_s", "--window-s", o.window_s, chosen.window_s},
-      {"sustain_s", "--sustain-s", o.sustain_s, chosen.sustain_s},
-      {"probability", "--probability", o.probability, chosen.probability},
+  // The evidence's settings, when not given, are the file's (observer_setup takes them): only a
+  // given one is checked.
+  const std::tuple<const char*, const char*, double, double, bool> settings[] = {
+      {"window_s", "--window-s", o.window_s, chosen.window_s, true},
+      {"sustain_s", "--sustain-s", o.sustain_s, chosen.sustain_s, true},
+      {"probability", "--probability", o.probability, chosen.probability, true},
       {"sensor_fault_sigmas", "--sensor-fault-sigmas", o.sensor_fault_sigmas,
-       chosen.sensor_fault_sigmas},
+       chosen.sensor_fault_sigmas, true},
       {"model_residual_sigmas", "--model-residual-sigmas", o.model_residual_sigmas,
-       chosen.model_residual_sigmas},
-      {"evidence_time_s", "--evidence-time-s", o.evidence_time_s, chosen.evidence_time_s},
+       chosen.model_residual_sigmas, true},
+      {"evidence_time_s", "--evidence-time-s", o.evidence_time_s, chosen.evidence_time_s,
+       o.evidence_given},
       {"evidence_onset_sigmas", "--evidence-onset-sigmas", o.evidence_onset_sigmas,
-       chosen.evidence_onset_sigmas}};
-  for (const auto& [key, flag, given, in_file] : settings) {
-    // The evidence's settings, when not given, are the file's (observer_setup takes them).
-    const bool evidence = std::string_view(key).starts_with("evidence_");
-    if (given != in_file && !(evidence && !o.evidence_given))
+       chosen.evidence_onset_sigmas, o.evidence_given}};
+  for (const auto& [key, flag, given, in_file, checked] : settings) {
+    if (checked && given != in_file)
       throw core::DataError("--sigma-calibration " + file + ": changed_machine.consistency." + key +
                             " = " + nlohmann::json(in_file).dump() +
                             ": its gated relative sigmas were chosen with that setting, not " +
