@@ -74,7 +74,9 @@ solvers::DriftBandScore score_with(const Observed& o, const Eigen::VectorXd& fac
 
 SigmaTermsCandidate score_pair(const Observed& o, double c, double e,
                                solvers::ChangedTermsGate gate, double noise) {
-  SigmaTermsCandidate pair{c, e};
+  SigmaTermsCandidate pair;
+  pair.correction_relative_sigma = c;
+  pair.expansion_relative_sigma = e;
   pair.score = score_with(o, {}, c, e, gate, noise);
   pair.width = band_width(pair.score);
   return pair;
@@ -153,17 +155,21 @@ GateChoice priced(solvers::ChangedTermsGate gate, const SigmaTermsCandidate& pic
 }
 
 /// Terms on evidence under every evidence setting (ChangedMachineSigma::evidence_settings), and
-/// the one chosen (evidence_chosen) into `out`.
-void choose_evidence(const Observed& changed, const std::vector<std::string>& names,
-                     const Observed& training, const Eigen::VectorXd& factor, double bound,
-                     const SigmaCalibrationInput& input, ChangedMachineSigma& out) {
+/// the one chosen (evidence_chosen) into `out`. Returns the terms chosen under that setting (the
+/// pair, the grid and the per-run scores), so that taking it does not choose them again.
+ChangedMachineSigma choose_evidence(const Observed& changed, const std::vector<std::string>& names,
+                                    const Observed& training, const Eigen::VectorXd& factor,
+                                    double bound, const SigmaCalibrationInput& input,
+                                    ChangedMachineSigma& out) {
   constexpr auto gate = solvers::ChangedTermsGate::on_evidence;
   Eigen::ArrayXd best;
+  std::vector<ChangedMachineSigma> per_setting;
   for (const double time_s : kEvidenceTimes)
     for (const double onset : kEvidenceOnsets) {
       const solvers::EvidenceSettings settings{time_s, onset, bound};
-      const SigmaTermsCandidate pick =
-          choose_sigma_terms(with_evidence(changed, settings), names, gate, input).pick();
+      per_setting.push_back(
+          choose_sigma_terms(with_evidence(changed, settings), names, gate, input));
+      const SigmaTermsCandidate& pick = per_setting.back().pick();
       out.evidence_settings.push_back(
           {settings,
            priced(gate, pick, with_evidence(training, settings), factor, input.truth_sigma_m)});
@@ -190,6 +196,7 @@ void choose_evidence(const Observed& changed, const std::vector<std::string>& na
   out.evidence_chosen = 0;
   for (std::size_t k = 1; k < out.evidence_settings.size(); ++k)
     if (better(k, out.evidence_chosen)) out.evidence_chosen = k;
+  return std::move(per_setting.at(out.evidence_chosen));
 }
 
 /// The changed runs observed with the factors calibrated in `cal` (its sensors), and c and e
@@ -239,11 +246,11 @@ ChangedMachineSigma observe_changed(const SigmaCalibrationInput& input, const Si
   out.evidence = solvers::evidence_settings(own);
   // Without the departure test there is no evidence, and no setting of it to choose.
   if (own.model_residual_sigmas <= 0) return out;
-  choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);
+  ChangedMachineSigma data =
+      choose_evidence(o, names, training, factor, own.model_residual_sigmas, input, out);
   if (gate != solvers::ChangedTermsGate::on_evidence || !input.evidence_from_data) return out;
   // The pair, the grid and the per-run scores under the setting the changed runs chose.
   const solvers::EvidenceSettings chosen = out.evidence_settings.at(out.evidence_chosen).settings;
-  ChangedMachineSigma data = choose_sigma_terms(with_evidence(o, chosen), names, gate, input);
   data.gates = std::move(out.gates);
   data.evidence_settings = std::move(out.evidence_settings);
   data.evidence_chosen = out.evidence_chosen;
