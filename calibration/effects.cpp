@@ -1753,17 +1753,18 @@ void backfit(const Scoring& sc, const std::vector<Eigen::VectorXd>& ys, Selectio
                  return f.candidate == fits[static_cast<size_t>(k)].candidate;
                });
       });
-      // A per-run air among the others is fitted on each run alone here and takes what it can
-      // of this claim's share (an air and the mechanism it shadows are sized only jointly, as a
-      // pair): under it, nothing beating noise does not show that the claim explains nothing.
-      const bool air_beside = std::any_of(others.begin(), others.end(), [&](const EffectFit& f) {
-        return cat.candidates[static_cast<size_t>(f.candidate)].per_run;
-      });
-      if (best_at == order.end() && air_beside) continue;  // kept
       if (best_at == order.end()) {
-        // Nothing of its kind beats noise and floor beside the others, itself included: the
-        // claim explains nothing they leave (a second heat input that took an offset sensor's
-        // signal, once the offset is claimed), and is dropped as the greedy rule would not claim.
+        // Nothing of its kind beats noise and floor beside the others, itself included. A
+        // per-run air among them is fitted on each run alone here and takes what it can of this
+        // claim's share (an air and the mechanism it shadows are sized only jointly, as a pair),
+        // so then that shows nothing and the claim is kept.
+        if (std::any_of(others.begin(), others.end(), [&](const EffectFit& f) {
+              return cat.candidates[static_cast<size_t>(f.candidate)].per_run;
+            }))
+          continue;
+        // Otherwise the claim explains nothing they leave (a second heat input that took an
+        // offset sensor's signal, once the offset is claimed): dropped, as the greedy rule would
+        // not claim it.
         sel.backfit_replaced.push_back({sel.claimed[i].name, ""});
         sel.claimed.erase(sel.claimed.begin() + static_cast<std::ptrdiff_t>(i));
         changed = true;
