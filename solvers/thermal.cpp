@@ -221,11 +221,12 @@ FullThermalSystem thermal_system(const mesh::TetMesh& mesh, const core::CaseSpec
 
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                const FullThermalSystem& system, const Progress& progress,
-                               const Checkpointing& checkpointing, const SourceIteration& sources) {
+                               const Checkpointing& checkpointing, const SourceIteration& sources,
+                               KeptStepFactors<Eigen::SparseMatrix<double>>* kept) {
   StepperRequest request;
   request.record_times = output_times(spec);
   request.sources = sources;
-  SteppedHistory stepped = step_thermal(system, spec, request, progress, checkpointing);
+  SteppedHistory stepped = step_thermal(system, spec, request, progress, checkpointing, kept);
   ThermalHistory hist;
   hist.times = std::move(stepped.times);
   hist.temperature = std::move(stepped.states);

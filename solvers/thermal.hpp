@@ -74,14 +74,19 @@ struct SourceIteration {
   int max_iterations = 30;
 };
 
+template <class Matrix>
+class KeptStepFactors;
+
 /// Integrates the transient from the uniform initial temperature (or from `checkpointing.resume`)
 /// to the duty cycle's end; heat that grows with temperature is lagged by one step unless
-/// `sources` asks for it to be iterated within each step (SourceIteration). Throws SolverError
-/// when the resume state does not fit the mesh and the case's time grid.
+/// `sources` asks for it to be iterated within each step (SourceIteration). With `kept`, the
+/// factors it holds are used and the new ones added to it (several runs of one system). Throws
+/// SolverError when the resume state does not fit the mesh and the case's time grid.
 ThermalHistory thermal_history(const mesh::TetMesh& mesh, const core::CaseSpec& spec,
                                const FullThermalSystem& system, const Progress& progress = {},
                                const Checkpointing& checkpointing = {},
-                               const SourceIteration& sources = {});
+                               const SourceIteration& sources = {},
+                               KeptStepFactors<Eigen::SparseMatrix<double>>* kept = nullptr);
 
 /// Heat stored in the mesh at `temperature` relative to the uniform initial temperature [J]:
 /// quadrature of rho c (T - T0) over the elements.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -264,36 +265,44 @@ void check_request(const LinearThermalSystem<Matrix>& sys, const StepperRequest&
                               std::to_string(n) + ") or no law");
 }
 
-/// Stiffness K + sum h_c F_c per speed and factors of C + theta dt A per (step, speed, theta),
-/// built on first use; factorisations are counted in `timings`.
+/// Stiffness K + sum h_c F_c per film state and factors of C + theta dt A per (step, film state,
+/// theta), built on first use and keyed by the films' coefficients (not the speed: speeds with
+/// the same films share them, and a case with other film laws on the same system may use them);
+/// factorisations are counted in the timings it is given.
 template <class Matrix>
 class StepOperators {
  public:
   StepOperators(const LinearThermalSystem<Matrix>& sys, ThermalTimings& timings)
-      : sys_(sys), timings_(timings) {}
+      : sys_(&sys), timings_(&timings) {}
+
+  /// The same operators on `sys` (a system with the same matrices), counted in `timings`.
+  void rebind(const LinearThermalSystem<Matrix>& sys, ThermalTimings& timings) {
+    sys_ = &sys;
+    timings_ = &timings;
+  }
 
   const Matrix& stiffness(const LoadState& s) {
-    auto it = stiffness_.find(s.speed);
+    auto it = stiffness_.find(s.h);
     if (it != stiffness_.end()) return it->second;
-    Matrix kk = sys_.conduction;
-    for (size_t c = 0; c < s.h.size(); ++c) kk += s.h[c] * sys_.film[c];
+    Matrix kk = sys_->conduction;
+    for (size_t c = 0; c < s.h.size(); ++c) kk += s.h[c] * sys_->film[c];
     if constexpr (std::is_same_v<Matrix, Sparse>) kk.makeCompressed();
-    return stiffness_.emplace(s.speed, std::move(kk)).first->second;
+    return stiffness_.emplace(s.h, std::move(kk)).first->second;
   }
 
   const StepFactor<Matrix>& factor(double dt, double theta, const LoadState& s) {
-    const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, s.speed, theta);
+    const auto key = std::make_tuple(std::round(dt * 1e9) / 1e9, theta, s.h);
     auto it = factors_.find(key);
     if (it != factors_.end()) return *it->second;
     const auto t_f = Clock::now();
-    Matrix a = sys_.capacity + (theta * dt) * stiffness(s);
+    Matrix a = sys_->capacity + (theta * dt) * stiffness(s);
     if constexpr (std::is_same_v<Matrix, Sparse>) a.makeCompressed();
     std::ostringstream what;
     what << "thermal system (dt = " << dt << " s, speed = " << s.speed << " rpm)";
     auto f = std::make_unique<StepFactor<Matrix>>(a, what.str());
-    timings_.factor_s += seconds_since(t_f);
-    timings_.factorizations += 1;
-    timings_.factor_entries = std::max(timings_.factor_entries, f->entries());
+    timings_->factor_s += seconds_since(t_f);
+    timings_->factorizations += 1;
+    timings_->factor_entries = std::max(timings_->factor_entries, f->entries());
     return *factors_.emplace(key, std::move(f)).first->second;
   }
 
@@ -304,11 +313,35 @@ class StepOperators {
   }
 
  private:
-  const LinearThermalSystem<Matrix>& sys_;
-  ThermalTimings& timings_;
-  std::map<double, Matrix> stiffness_;
-  std::map<std::tuple<double, double, double>, std::unique_ptr<StepFactor<Matrix>>> factors_;
+  const LinearThermalSystem<Matrix>* sys_;
+  ThermalTimings* timings_;
+  std::map<std::vector<double>, Matrix> stiffness_;
+  std::map<std::tuple<double, double, std::vector<double>>, std::unique_ptr<StepFactor<Matrix>>>
+      factors_;
 };
+
+/// Whether `a` and `b` hold the same entries (sparse: the same compressed pattern and values).
+bool same_matrix(const Sparse& a, const Sparse& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros() ||
+      !a.isCompressed() || !b.isCompressed())
+    return false;
+  const Eigen::Index nz = a.nonZeros(), outer = a.outerSize() + 1;
+  return std::equal(a.outerIndexPtr(), a.outerIndexPtr() + outer, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + nz, b.innerIndexPtr()) &&
+         std::equal(a.valuePtr(), a.valuePtr() + nz, b.valuePtr());
+}
+bool same_matrix(const Dense& a, const Dense& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+}
+
+/// Whether `a` and `b` step alike: the same capacity, conduction and films.
+template <class Matrix>
+bool same_operators(const LinearThermalSystem<Matrix>& a, const LinearThermalSystem<Matrix>& b) {
+  return a.film.size() == b.film.size() && same_matrix(a.capacity, b.capacity) &&
+         same_matrix(a.conduction, b.conduction) &&
+         std::equal(a.film.begin(), a.film.end(), b.film.begin(),
+                    [](const Matrix& x, const Matrix& y) { return same_matrix(x, y); });
+}
 
 /// The caller columns' responses after the step `view` from `x` (#states x #columns), with the
 /// base's stiffness and factor: (C + theta dt A) x1 = (C - (1 - theta) dt A) x + dt b.
@@ -554,9 +587,35 @@ StepLoad step_load(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec&
 }
 
 template <class Matrix>
+struct KeptStepFactors<Matrix>::Impl {
+  ThermalTimings unused;               /// counts until the first run binds them
+  LinearThermalSystem<Matrix> system;  /// the matrices the operators were made for
+  std::optional<StepOperators<Matrix>> ops;
+
+  /// The kept operators for stepping `sys`, counted in `timings`: forgotten first when `sys` has
+  /// other matrices than the ones they were made for.
+  StepOperators<Matrix>& for_system(const LinearThermalSystem<Matrix>& sys,
+                                    ThermalTimings& timings) {
+    if (!ops || !same_operators(system, sys)) {
+      system.capacity = sys.capacity;
+      system.conduction = sys.conduction;
+      system.film = sys.film;
+      ops.emplace(system, unused);
+    }
+    ops->rebind(system, timings);
+    return *ops;
+  }
+};
+
+template <class Matrix>
+KeptStepFactors<Matrix>::KeptStepFactors() : impl_(std::make_unique<Impl>()) {}
+template <class Matrix>
+KeptStepFactors<Matrix>::~KeptStepFactors() = default;
+
+template <class Matrix>
 SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec& spec,
                             const StepperRequest& q, const Progress& progress,
-                            const Checkpointing& checkpointing) {
+                            const Checkpointing& checkpointing, KeptStepFactors<Matrix>* kept) {
   const Eigen::Index n = sys.states();
   const double t0_k = spec.thermal.initial_temperature_c + core::kCelsiusOffset;
   const double end = spec.duty_cycle.end;
@@ -577,7 +636,9 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
   record_start(hist, temp, read_prev, block_prev, q.record_states, reads);
   size_t next_out = 1;
 
-  StepOperators<Matrix> ops(sys, hist.timings);
+  std::optional<StepOperators<Matrix>> own;
+  StepOperators<Matrix>& ops =
+      kept ? kept->impl().for_system(sys, hist.timings) : own.emplace(sys, hist.timings);
 
   const auto t_solve = Clock::now();
   double t_prev = 0, prev_speed = std::nan("");
@@ -606,10 +667,8 @@ SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& sys, const core::
     const StepFactor<Matrix>& factor = ops.factor(dt, theta, s_new);
     Eigen::VectorXd next = solved_state(sys, spec, q, factor, kk, temp, p, {t_prev, t, t0_k, i},
                                         rhs, hist.source_iterations);
-
     if (nc > 0)
       x = stepped_responses(sys, q, {t_prev, t, s_new.speed, theta, &temp, &next}, kk, factor, x);
-
     add_step_heat(hist, sys, spec, film_total, p, next, dt, lost_rate_prev);
 
     if (reads) read_new = read_state(q.base_readout, next, start);
@@ -688,10 +747,12 @@ AffineStep ReducedStepper::step(double t0, double t1, double prev_speed,
 
 template SteppedHistory step_thermal<Sparse>(const FullThermalSystem&, const core::CaseSpec&,
                                              const StepperRequest&, const Progress&,
-                                             const Checkpointing&);
+                                             const Checkpointing&, KeptStepFactors<Sparse>*);
 template SteppedHistory step_thermal<Dense>(const ReducedThermalSystem&, const core::CaseSpec&,
                                             const StepperRequest&, const Progress&,
-                                            const Checkpointing&);
+                                            const Checkpointing&, KeptStepFactors<Dense>*);
+template class KeptStepFactors<Sparse>;
+template class KeptStepFactors<Dense>;
 template Eigen::VectorXd moving_heat_load<Sparse>(const core::CaseSpec&, const FullThermalSystem&,
                                                   double, double);
 template Eigen::VectorXd moving_heat_load<Dense>(const core::CaseSpec&, const ReducedThermalSystem&,

@@ -76,15 +76,36 @@ struct SteppedHistory {
   int source_iterations = 0;
 };
 
+/// Stiffnesses and factors kept between calls of step_thermal, so that runs of one system under
+/// other duty cycles, sinks or loads (a generator's runs of one truth) factor each (step, film
+/// coefficients, scheme weight) once for all of them. Keyed by the films' coefficients; a system
+/// with other capacity, conduction or film matrices than the last one makes them forgotten first,
+/// so any system may be stepped with them. One caller at a time.
+template <class Matrix>
+class KeptStepFactors {
+ public:
+  KeptStepFactors();
+  ~KeptStepFactors();
+  KeptStepFactors(const KeptStepFactors&) = delete;
+  KeptStepFactors& operator=(const KeptStepFactors&) = delete;
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Steps `system` under `spec`'s duty cycle, feed axis, sinks and fluxes from the uniform
 /// initial temperature (or from `checkpointing.resume`; checkpoints hold the base state and the
 /// recorded states, and are refused with caller columns or readouts). Throws SolverError for
 /// record times not ascending in (0, end], for columns or readouts whose size is not the system's,
-/// for a resume state that does not fit, and when a factorisation fails.
+/// for a resume state that does not fit, and when a factorisation fails. With `kept`, its
+/// factors are used and the new ones added to it (KeptStepFactors).
 template <class Matrix>
 SteppedHistory step_thermal(const LinearThermalSystem<Matrix>& system, const core::CaseSpec& spec,
                             const StepperRequest& request, const Progress& progress = {},
-                            const Checkpointing& checkpointing = {});
+                            const Checkpointing& checkpointing = {},
+                            KeptStepFactors<Matrix>* kept = nullptr);
 
 /// Load of every moving source averaged over the step [t0, t1]: sum_k moving[k] (fractions_k
 /// power_k), #states [W] (sums to the sources' total power in the full space).

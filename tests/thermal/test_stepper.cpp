@@ -89,6 +89,36 @@ TEST(Stepper, DenseEqualsSparseOnASmallSystem) {
   }
 }
 
+// Factors kept between runs: a second run of the same system (assembled again) factors nothing
+// and steps as a run of its own; a system with other matrices makes them forgotten, not misused.
+TEST(Stepper, KeptFactorsServeTheNextRunAndAreForgottenForAnotherSystem) {
+  core::CaseSpec spec = io::case_from_toml(test_toml::gantry_bar(1), "bar.toml");
+  for (auto& b : spec.bodies) b.max_edge = 0.06;
+  spec.duty_cycle.end = 400;
+  const mesh::TetMesh m = mesh::mesh_case(spec);
+  StepperRequest q;
+  q.record_times = output_times(spec);
+  KeptStepFactors<Eigen::SparseMatrix<double>> kept;
+  const FullThermalSystem sys = thermal_system(m, spec);
+  const SteppedHistory alone = step_thermal(sys, spec, q);
+  const SteppedHistory first = step_thermal(sys, spec, q, {}, {}, &kept);
+  EXPECT_EQ(first.states, alone.states);
+  EXPECT_EQ(first.timings.factorizations, alone.timings.factorizations);
+  ASSERT_GT(alone.timings.factorizations, 0);
+  const FullThermalSystem again = thermal_system(m, spec);
+  const SteppedHistory second = step_thermal(again, spec, q, {}, {}, &kept);
+  EXPECT_EQ(second.states, alone.states);
+  EXPECT_EQ(second.timings.factorizations, 0);
+  core::CaseSpec other = spec;
+  for (auto& mat : other.materials) mat.conductivity *= 2;
+  const FullThermalSystem other_sys = thermal_system(m, other);
+  const SteppedHistory other_alone = step_thermal(other_sys, other, q);
+  const SteppedHistory other_kept = step_thermal(other_sys, other, q, {}, {}, &kept);
+  EXPECT_EQ(other_kept.states, other_alone.states);
+  EXPECT_EQ(other_kept.timings.factorizations, other_alone.timings.factorizations);
+  EXPECT_GT((other_alone.states - alone.states).cwiseAbs().maxCoeff(), 1e-6);
+}
+
 TEST(Stepper, RefusesRecordTimesOutOfOrderAndColumnsOfAnotherSize) {
   core::CaseSpec spec = io::case_from_toml(test_toml::gantry_bar(1), "bar.toml");
   for (auto& b : spec.bodies) b.max_edge = 0.06;
