@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include "calibration/calibrate.hpp"
 #include "core/errors.hpp"
@@ -448,51 +449,97 @@ void add_ambient_sensor(io::MeasuredRun& run, const core::CaseSpec& truth) {
   run.ambient_sensor = "AIR";
 }
 
-/// `run` with the TCP's displacement probes (dx, dy, dz from the history's first column at the
-/// samples `at`) when the instrumentation asks for them and the truth has a TCP; else none.
-void add_tcp_probes(io::MeasuredRun& run, const mesh::TetMesh& m, const core::CaseSpec& truth,
-                    const Instrumentation& inst, const solvers::ThermalHistory& th,
-                    const std::vector<Eigen::Index>& at) {
-  const Eigen::Index ns = run.time.size();
-  run.displacement.resize(ns, 0);
-  if (!inst.tcp_probes || !truth.mechanical.enabled || truth.mechanical.tcp_point.empty()) return;
-  // The TCP's, then (axis_probes) each axis point's: the point's displacement in x, y, z.
-  std::vector<std::pair<std::string, std::string>> points{{truth.mechanical.tcp_point, ""}};
-  if (inst.axis_probes)
-    for (const auto& id : truth.mechanical.axis_points) points.emplace_back(id, id + "_");
-  const solvers::ElasticModel model(m, truth);
-  const char* directions[] = {"dx", "dy", "dz"};
-  run.displacement.resize(ns, 3 * static_cast<Eigen::Index>(points.size()));
-  Eigen::Index column = 0;
-  for (const auto& [id, prefix] : points) {
-    const int node = point_node(m, id);
-    const Eigen::Vector3d position = m.nodes.row(node).transpose();
-    for (int d = 0; d < 3; ++d, ++column) {
-      const Eigen::VectorXd a = model.influence(node, d);
-      run.displacements.push_back({prefix + directions[d], position, Eigen::Vector3d::Unit(d)});
-      const double u0 = a.dot(th.temperature.col(0));
-      for (Eigen::Index i = 0; i < ns; ++i)
-        run.displacement(i, column) = a.dot(th.temperature.col(at[i])) - u0;
-    }
+/// Whether `a` and `b` give the same elastic model and probes on one mesh: the same materials,
+/// supports, fixed groups, reference temperature, TCP and axis points.
+bool same_elastic_inputs(const core::CaseSpec& a, const core::CaseSpec& b) {
+  const auto fields = [](const core::Material& m) {
+    return std::tie(m.name, m.density, m.specific_heat, m.conductivity, m.youngs_modulus,
+                    m.poisson_ratio, m.expansion);
+  };
+  const auto support = [](const core::PointSupport& p) { return std::tie(p.point, p.fixed); };
+  const auto& ma = a.mechanical;
+  const auto& mb = b.mechanical;
+  return std::equal(a.materials.begin(), a.materials.end(), b.materials.begin(), b.materials.end(),
+                    [&](const auto& x, const auto& y) { return fields(x) == fields(y); }) &&
+         std::equal(ma.point_supports.begin(), ma.point_supports.end(), mb.point_supports.begin(),
+                    mb.point_supports.end(),
+                    [&](const auto& x, const auto& y) { return support(x) == support(y); }) &&
+         std::tie(ma.enabled, ma.reference_temperature_c, ma.fixed_groups, ma.tcp_point,
+                  ma.axis_points) == std::tie(mb.enabled, mb.reference_temperature_c,
+                                              mb.fixed_groups, mb.tcp_point, mb.axis_points);
+}
+
+std::vector<std::string> group_names(const core::CaseSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& g : spec.groups) names.push_back(g.name);
+  return names;
+}
+
+/// `run` with the machine's displacement probes (from the history's first column at the samples
+/// `at`); none when it has none.
+void add_probes(io::MeasuredRun& run, const TruthMachine& machine,
+                const solvers::ThermalHistory& th, const std::vector<Eigen::Index>& at) {
+  const Eigen::Index ns = static_cast<Eigen::Index>(at.size());
+  run.displacement.resize(ns, static_cast<Eigen::Index>(machine.probe_influence.size()));
+  run.displacements = machine.probes;
+  for (size_t p = 0; p < machine.probe_influence.size(); ++p) {
+    const Eigen::VectorXd& a = machine.probe_influence[p];
+    const double u0 = a.dot(th.temperature.col(0));
+    for (Eigen::Index i = 0; i < ns; ++i)
+      run.displacement(i, static_cast<Eigen::Index>(p)) = a.dot(th.temperature.col(at[i])) - u0;
   }
 }
 
 }  // namespace
 
-io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
-                          const InjectedEffects& effects, const Instrumentation& inst,
-                          const GeneratorOptions& o, const std::string& name) {
+TruthMachine truth_machine(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
+                           const Instrumentation& inst) {
+  TruthMachine machine;
   // A heat input adds boundary groups: the faces must carry the truth's own group labels, or its
   // flux and convection land on whatever group had that index before (same nodes: groups do not
   // change TetGen's input).
-  std::vector<std::string> names;
-  for (const auto& g : truth.groups) names.push_back(g.name);
-  const bool relabel = names != mesh_in.group_names;
-  const mesh::TetMesh own = relabel ? mesh::mesh_case(truth) : mesh::TetMesh{};
-  const mesh::TetMesh& m = relabel ? own : mesh_in;
+  machine.mesh = group_names(truth) != mesh_in.group_names ? mesh::mesh_case(truth) : mesh_in;
+  machine.truth = truth;
+  machine.instrumentation = inst;
+  if (!inst.tcp_probes || !truth.mechanical.enabled || truth.mechanical.tcp_point.empty())
+    return machine;
+  // The TCP's, then (axis_probes) each axis point's: the point's displacement in x, y, z.
+  std::vector<std::pair<std::string, std::string>> points{{truth.mechanical.tcp_point, ""}};
+  if (inst.axis_probes)
+    for (const auto& id : truth.mechanical.axis_points) points.emplace_back(id, id + "_");
+  const char* directions[] = {"dx", "dy", "dz"};
+  // A solve per probe, not one block solve: a block's rounding depends on its width, and the
+  // TCP's readings must not change with the axis points asked beside them.
+  const solvers::ElasticModel model(machine.mesh, truth);
+  for (const auto& [id, prefix] : points) {
+    const int node = point_node(machine.mesh, id);
+    const Eigen::Vector3d position = machine.mesh.nodes.row(node).transpose();
+    for (int d = 0; d < 3; ++d) {
+      machine.probe_influence.push_back(model.influence(node, d));
+      machine.probes.push_back({prefix + directions[d], position, Eigen::Vector3d::Unit(d)});
+    }
+  }
+  return machine;
+}
+
+io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
+                          const InjectedEffects& effects, const Instrumentation& inst,
+                          const GeneratorOptions& o, const std::string& name) {
+  return clean_run(truth_machine(mesh_in, truth, inst), truth, effects, o, name);
+}
+
+io::MeasuredRun clean_run(const TruthMachine& machine, const core::CaseSpec& truth,
+                          const InjectedEffects& effects, const GeneratorOptions& o,
+                          const std::string& name) {
+  if (group_names(truth) != machine.mesh.group_names || !same_elastic_inputs(truth, machine.truth))
+    throw std::invalid_argument("generator: run '" + name +
+                                "' has other boundary groups, materials or mechanical settings "
+                                "than the truth its machine was built for");
+  const mesh::TetMesh& m = machine.mesh;
+  const Instrumentation& inst = machine.instrumentation;
   const solvers::FullThermalSystem ops = solvers::thermal_system(m, truth);
-  const solvers::ThermalHistory th =
-      solvers::thermal_history(m, truth, ops, {}, {}, {o.source_tolerance_K});
+  const solvers::ThermalHistory th = solvers::thermal_history(
+      m, truth, ops, {}, {}, {o.source_tolerance_K}, machine.factors.get());
   io::MeasuredRun run;
   run.machine = truth.machine;
   // The mesh's extent: readers check every position against it (meta.json machine_box_m).
@@ -531,7 +578,7 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
       run.temperature(i, static_cast<Eigen::Index>(s)) = x(at[i]);
   }
   if (inst.ambient_sensor) add_ambient_sensor(run, truth);
-  add_tcp_probes(run, m, truth, inst, th, at);
+  add_probes(run, machine, th, at);
   return run;
 }
 

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "core/case_spec.hpp"
 #include "io/measured_data.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "solvers/thermal_stepper.hpp"
 
 namespace tt::calibration {
 
@@ -117,6 +119,27 @@ struct Instrumentation {
   bool ambient_sensor = false;
 };
 
+/// What every run of one truth shares, whatever its duty cycle and air: the mesh carrying the
+/// truth's boundary groups (`mesh` re-meshed when a heat input adds groups) and the displacement
+/// probes' influences (u = a . T; the elastic factor is the costly part of a run: built once
+/// for a draw's runs instead of once per run), and the thermal step factors its runs share. Valid
+/// for truth cases that differ from the one it was built for in their duty cycle and convection
+/// sinks only, as truth_case's runs of one draw do; clean_run refuses another
+/// (std::invalid_argument).
+struct TruthMachine {
+  mesh::TetMesh mesh;
+  core::CaseSpec truth;                          /// the truth it was built for, for the check
+  Instrumentation instrumentation;               /// the sensors and probes it reads
+  std::vector<io::MeasuredProbe> probes;         /// per probe: name, position, direction
+  std::vector<Eigen::VectorXd> probe_influence;  /// per probe: a with u = a . T [m/K]
+  /// The thermal step factors made so far, for the next run (forgotten when a run's system has
+  /// other matrices; one run at a time).
+  std::shared_ptr<solvers::KeptStepFactors<Eigen::SparseMatrix<double>>> factors =
+      std::make_shared<solvers::KeptStepFactors<Eigen::SparseMatrix<double>>>();
+};
+TruthMachine truth_machine(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
+                           const Instrumentation& inst);
+
 /// Simulates `truth` on `mesh` (re-meshed when `truth` has other boundary groups, as a heat input
 /// adds), samples it every options.sample_interval_s, applies sensor
 /// effects (offset, lag) and noise from `rng`, and returns the run (nominal conditions in meta).
@@ -134,6 +157,10 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& options, const std::string& name);
+/// The same on a machine built for `truth`'s draw (truth_machine), `machine.instrumentation` read.
+io::MeasuredRun clean_run(const TruthMachine& machine, const core::CaseSpec& truth,
+                          const InjectedEffects& effects, const GeneratorOptions& options,
+                          const std::string& name);
 io::MeasuredRun with_noise(const io::MeasuredRun& clean, const GeneratorOptions& options,
                            std::mt19937_64& rng);
 

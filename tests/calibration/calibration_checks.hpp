@@ -35,11 +35,15 @@ inline nlohmann::json claims_json(const CalibrationResult& res) {
 /// undeclared and returns the outcome, printing the ranking, the claims and the figures.
 inline Outcome calibrated(const Study& s, const InjectedEffects& effects, std::mt19937_64& rng) {
   std::vector<io::MeasuredRun> noiseless;
+  const auto t_gen = std::chrono::steady_clock::now();
   const auto runs = testing::effect_runs(s, effects, rng, &noiseless);
+  const double generate_s = core::seconds_since(t_gen);
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
   const auto t0 = std::chrono::steady_clock::now();
   const CalibrationResult res = calibrate(*s.model, s.declared, cat, {runs[2]}, s.copt);
   const double calibrate_s = core::seconds_since(t0);
+  std::printf("[calibration] runs generated in %.1f s, calibrated in %.1f s\n", generate_s,
+              calibrate_s);
   // RMS against the test run's noise-free truth: no model removes the sensors' noise.
   const io::MeasuredRun& truth = noiseless[2];
   const Eigen::MatrixXd clean = measured_channels(truth, s.train.readout);

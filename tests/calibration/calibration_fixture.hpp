@@ -95,10 +95,11 @@ inline std::unique_ptr<Study> make_study(const Scale& sc) {
   if (sc.seed_from_case) s->copt.seed = s->declared.seed;
   // The catalogue depends on the runs' inputs only: build it on clean declared runs.
   std::vector<io::MeasuredRun> runs;
+  const TruthMachine machine =
+      truth_machine(s->gen_mesh, truth_case(s->gen, InjectedEffect{}, s->duties[0], 0), s->inst);
   for (int k = 0; k < 2; ++k) {
     const core::CaseSpec t = truth_case(s->gen, InjectedEffect{}, s->duties[k], k);
-    runs.push_back(clean_run(s->gen_mesh, t, InjectedEffect{}, s->inst, s->gopt,
-                             "train " + std::to_string(k)));
+    runs.push_back(clean_run(machine, t, {}, s->gopt, "train " + std::to_string(k)));
   }
   std::printf("[calibration] clean generator runs (%.1f s)\n", since());
   const Readout r = readout(s->mesh, s->declared, runs.front());
@@ -121,10 +122,13 @@ inline std::vector<io::MeasuredRun> effect_runs(const Study& s, const InjectedEf
                                                 std::mt19937_64& rng,
                                                 std::vector<io::MeasuredRun>* clean = nullptr) {
   std::vector<io::MeasuredRun> out;
+  // One machine for the three runs: they differ in duty cycle and air only.
+  const TruthMachine machine =
+      truth_machine(s.gen_mesh, truth_case(s.gen, effect, s.duties[0], 0), s.inst);
   for (int k = 0; k < 3; ++k) {
     const core::CaseSpec t = truth_case(s.gen, effect, s.duties[k], k);
-    io::MeasuredRun c = clean_run(s.gen_mesh, t, effect, s.inst, s.gopt,
-                                  (k < 2 ? "train " : "test ") + std::to_string(k));
+    io::MeasuredRun c =
+        clean_run(machine, t, effect, s.gopt, (k < 2 ? "train " : "test ") + std::to_string(k));
     out.push_back(with_noise(c, s.gopt, rng));
     if (clean) clean->push_back(std::move(c));
   }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -42,11 +43,13 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
       random_effect(EffectKind::heat_input, declared, gen_mesh, inst.sensor_points, rng);
   std::vector<std::string> runs;
   const double hours[] = {2, 3, 3};
+  std::optional<TruthMachine> machine;  // one for the three runs (same effect, other duties)
   for (int k = 0; k < 3; ++k) {
     const core::DutyCycle duty = random_duty_cycle(hours[k], rng);
     const core::CaseSpec truth = truth_case(gen, effect, duty, k);
-    const io::MeasuredRun run =
-        synthetic_run(gen_mesh, truth, effect, inst, gopt, "run " + std::to_string(k), rng);
+    if (!machine) machine = truth_machine(gen_mesh, truth, inst);
+    const io::MeasuredRun run = with_noise(
+        clean_run(*machine, truth, {effect}, gopt, "run " + std::to_string(k)), gopt, rng);
     runs.push_back((dir / ("run_" + std::to_string(k))).string());
     io::write_measured_run(runs.back(), run);
   }

@@ -121,6 +121,29 @@ TEST(Augment, HeatInputCaseReadsBackAndMeshesWithTheNewGroup) {
   EXPECT_EQ(m.nodes.rows(), s.mesh.nodes.rows());
 }
 
+// One machine serves a draw's runs (their duty cycles and air differ, nothing else): each run reads
+// as if simulated on its own, and a truth with another material is refused.
+TEST(TruthMachine, SharedByADrawsRunsGivesEachRunsOwnReadings) {
+  const Study& s = study();
+  std::mt19937_64 rng = core::generator(77, 0);
+  const InjectedEffect e =
+      random_effect(EffectKind::heat_input, s.declared, s.mesh, s.inst.sensor_points, rng);
+  const core::DutyCycle first = random_duty_cycle(0.5, rng), second = random_duty_cycle(0.5, rng);
+  const TruthMachine machine = truth_machine(s.mesh, truth_case(s.declared, e, first, 0), s.inst);
+  EXPECT_NE(machine.mesh.group_names, s.mesh.group_names);  // the heat input's group added
+  const core::CaseSpec truth = truth_case(s.declared, e, second, 1);
+  const io::MeasuredRun shared = clean_run(machine, truth, {e}, s.gopt, "shared");
+  const io::MeasuredRun own = clean_run(s.mesh, truth, e, s.inst, s.gopt, "own");
+  ASSERT_EQ(shared.temperature.rows(), own.temperature.rows());
+  EXPECT_EQ(shared.temperature, own.temperature);
+  ASSERT_EQ(shared.displacement.cols(), 3);
+  EXPECT_LE((shared.displacement - own.displacement).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_GT(own.displacement.cwiseAbs().maxCoeff(), 1e-8);
+  core::CaseSpec other = truth;
+  other.materials.front().expansion *= 1.1;
+  EXPECT_THROW(clean_run(machine, other, {e}, s.gopt, "other"), std::invalid_argument);
+}
+
 TEST(Kinds, AmbientTemperature) {
   check_kind(study(), EffectKind::ambient_temperature, 11);
 }
@@ -158,6 +181,9 @@ std::vector<io::MeasuredRun> speed_on_every_film(const Study& s, const Instrumen
                                                  std::vector<io::MeasuredRun>* clean) {
   std::mt19937_64 rng = core::generator(21, 1);
   std::vector<io::MeasuredRun> out;
+  // The films' speed gain changes no elastic input: one machine for the three runs.
+  const TruthMachine machine =
+      truth_machine(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[0], 0), inst);
   for (int k = 0; k < 3; ++k) {
     core::CaseSpec t = truth_case(s.gen, InjectedEffect{}, s.duties[k], k);
     const auto& fixed = t.mechanical.fixed_groups;
@@ -167,8 +193,8 @@ std::vector<io::MeasuredRun> speed_on_every_film(const Study& s, const Instrumen
         c.speed_ref_rpm = 3000;
         c.speed_exponent = 0.8;
       }
-    io::MeasuredRun c = clean_run(s.gen_mesh, t, InjectedEffect{}, inst, s.gopt,
-                                  (k < 2 ? "train " : "test ") + std::to_string(k));
+    io::MeasuredRun c =
+        clean_run(machine, t, {}, s.gopt, (k < 2 ? "train " : "test ") + std::to_string(k));
     out.push_back(with_noise(c, s.gopt, rng));
     if (clean) clean->push_back(std::move(c));
   }
@@ -218,9 +244,11 @@ TEST(Air, ReadFromTheRunsAmbientSensor) {
   const InjectedEffect e = random_effect(EffectKind::ambient_temperature, s.declared, s.gen_mesh,
                                          inst.sensor_points, rng);
   std::vector<io::MeasuredRun> runs, clean;
+  const TruthMachine machine =
+      truth_machine(s.gen_mesh, truth_case(s.gen, e, s.duties[0], 0), inst);
   for (int k = 0; k < 3; ++k) {
     const core::CaseSpec t = truth_case(s.gen, e, s.duties[k], k);
-    clean.push_back(clean_run(s.gen_mesh, t, e, inst, s.gopt, "run " + std::to_string(k)));
+    clean.push_back(clean_run(machine, t, {e}, s.gopt, "run " + std::to_string(k)));
     runs.push_back(with_noise(clean.back(), s.gopt, rng));
   }
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
@@ -310,11 +338,14 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
                             .magnitude = 0.04,
                             .target = "front_bearing_friction"};
   std::vector<io::MeasuredRun> runs, clean;
+  const TruthMachine machine = truth_machine(
+      s.gen_mesh, truth_case(truth_case(s.gen, film, s.duties[0], 0), heat, s.duties[0], 0),
+      s.inst);
   for (int k = 0; k < 3; ++k) {
     const core::CaseSpec t =
         truth_case(truth_case(s.gen, film, s.duties[k], k), heat, s.duties[k], k);
-    clean.push_back(clean_run(s.gen_mesh, t, InjectedEffect{}, s.inst, s.gopt,
-                              (k < 2 ? "train " : "test ") + std::to_string(k)));
+    clean.push_back(
+        clean_run(machine, t, {}, s.gopt, (k < 2 ? "train " : "test ") + std::to_string(k)));
     runs.push_back(with_noise(clean.back(), s.gopt, rng));
   }
   const Catalogue cat = testing::with_measured(s.train, {runs[0], runs[1]});
@@ -350,9 +381,11 @@ TEST(Pairs, TwoEffectsAreClaimedTogether) {
 TEST(Clean, AtMostOneInTenGetsAnEffect) {
   const Study& s = study();
   std::vector<io::MeasuredRun> clean;
+  const TruthMachine machine =
+      truth_machine(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[0], 0), s.inst);
   for (int k = 0; k < 2; ++k)
-    clean.push_back(clean_run(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[k], k),
-                              InjectedEffect{}, s.inst, s.gopt, "clean " + std::to_string(k)));
+    clean.push_back(clean_run(machine, truth_case(s.gen, InjectedEffect{}, s.duties[k], k), {},
+                              s.gopt, "clean " + std::to_string(k)));
   int claimed = 0;
   const int trials = 10;
   for (int t = 0; t < trials; ++t) {

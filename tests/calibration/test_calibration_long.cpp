@@ -91,9 +91,11 @@ void confusion(const testing::Study& s, bool floors) {
   // Clean runs first (cheap; a subset run stopped early keeps them): ten noise draws on two clean
   // simulations, as Clean.AtMostOneInTenGetsAnEffect.
   std::vector<io::MeasuredRun> clean;
+  const TruthMachine machine =
+      truth_machine(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[0], 0), s.inst);
   for (int k = 0; k < (with_clean ? 2 : 0); ++k)
-    clean.push_back(clean_run(s.gen_mesh, truth_case(s.gen, InjectedEffect{}, s.duties[k], k),
-                              InjectedEffect{}, s.inst, s.gopt, "clean " + std::to_string(k)));
+    clean.push_back(clean_run(machine, truth_case(s.gen, InjectedEffect{}, s.duties[k], k), {},
+                              s.gopt, "clean " + std::to_string(k)));
   int clean_claimed = 0;
   for (int t = 0; t < (with_clean ? 10 : 0); ++t) {
     std::mt19937_64 rng = core::generator(4000, static_cast<std::uint64_t>(t));
