@@ -588,22 +588,21 @@ StepLoad step_load(const LinearThermalSystem<Matrix>& sys, const core::CaseSpec&
 
 template <class Matrix>
 struct KeptStepFactors<Matrix>::Impl {
-  ThermalTimings unused;               /// counts until the first run binds them
   LinearThermalSystem<Matrix> system;  /// the matrices the operators were made for
   std::optional<StepOperators<Matrix>> ops;
 
-  /// The kept operators for stepping `sys`, counted in `timings`: forgotten first when `sys` has
-  /// other matrices than the ones they were made for.
+  /// The kept operators for stepping `sys`, counted in `timings`: made anew when `sys` has other
+  /// matrices than the ones they were made for.
   StepOperators<Matrix>& for_system(const LinearThermalSystem<Matrix>& sys,
                                     ThermalTimings& timings) {
-    if (!ops || !same_operators(system, sys)) {
-      system.capacity = sys.capacity;
-      system.conduction = sys.conduction;
-      system.film = sys.film;
-      ops.emplace(system, unused);
+    if (ops && same_operators(system, sys)) {
+      ops->rebind(system, timings);
+      return *ops;
     }
-    ops->rebind(system, timings);
-    return *ops;
+    system.capacity = sys.capacity;
+    system.conduction = sys.conduction;
+    system.film = sys.film;
+    return ops.emplace(system, timings);
   }
 };
 
