@@ -884,6 +884,9 @@ int main(int argc, char** argv) {
         for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, other))
           plan.emplace_back(calibration::kind_name(e.kind), e);
       }
+      // The clean runs share one truth machine (mesh, probes' influences, step factors); an
+      // effect that changes groups, materials or mechanics gets its own.
+      std::optional<calibration::TruthMachine> machine;
       for (std::size_t k = 0; k < plan.size(); ++k) {
         const auto& [kind, effect] = plan[k];
         const core::DutyCycle duty = calibration::random_duty_cycle(gen_hours, rng);
@@ -902,8 +905,10 @@ int main(int argc, char** argv) {
         const core::CaseSpec truth_spec =
             calibration::truth_case(gen, effect, duty, static_cast<int>(k));
         const std::string name = "gen_" + std::to_string(k);
+        if (!machine || !calibration::serves(*machine, truth_spec))
+          machine = calibration::truth_machine(gmesh, truth_spec, inst);
         const io::MeasuredRun truth =
-            calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
+            calibration::clean_run(*machine, truth_spec, {effect}, gopt, name);
         // The noise on the sensors and the TCP's probes only: the same draws as without the axis
         // points' probes (their truth is scored, not read).
         io::MeasuredRun tcp_only = truth;

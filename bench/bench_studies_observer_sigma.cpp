@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -138,14 +139,19 @@ int main(int argc, char** argv) {
     for (const auto& e : calibration::random_effect_of_each_kind(spec, gmesh, sensors, changed_rng))
       plan.emplace_back("changed " + std::string(calibration::kind_name(e.kind)), e);
     std::vector<Generated> runs;
+    // The clean runs share one truth machine (mesh, probes' influences, step factors); an effect
+    // that changes groups, materials or mechanics gets its own.
+    std::optional<calibration::TruthMachine> machine;
     for (std::size_t k = 0; k < plan.size(); ++k) {
       const auto& [kind, effect] = plan[k];
       const core::DutyCycle duty = calibration::random_duty_cycle(hours, rng);
       const core::CaseSpec truth_spec =
           calibration::truth_case(gen, effect, duty, static_cast<int>(k));
       const std::string name = "gen_" + std::to_string(k);
+      if (!machine || !calibration::serves(*machine, truth_spec))
+        machine = calibration::truth_machine(gmesh, truth_spec, inst);
       const io::MeasuredRun clean =
-          calibration::clean_run(gmesh, truth_spec, effect, inst, gopt, name);
+          calibration::clean_run(*machine, truth_spec, {effect}, gopt, name);
       Generated g{kind, calibration::with_noise(clean, gopt, rng), clean.displacement};
       g.measured.folder = name;
       runs.push_back(std::move(g));
@@ -169,6 +175,8 @@ int main(int argc, char** argv) {
                                          .drift_readings_every_s = probe_every_s,
                                          .truth_sigma_m = gopt.noise_displacement_m,
                                          .coverage = 0.95,
+                                         .changed = {},
+                                         .evidence_from_data = false,
                                          .progress = {}};
     for (int k = 0; k < train; ++k)
       input.runs.push_back(&runs[static_cast<std::size_t>(k)].measured);

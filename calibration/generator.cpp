@@ -522,6 +522,11 @@ TruthMachine truth_machine(const mesh::TetMesh& mesh_in, const core::CaseSpec& t
   return machine;
 }
 
+bool serves(const TruthMachine& machine, const core::CaseSpec& truth) {
+  return group_names(truth) == machine.mesh.group_names &&
+         same_elastic_inputs(truth, machine.truth);
+}
+
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {
@@ -531,7 +536,7 @@ io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& tr
 io::MeasuredRun clean_run(const TruthMachine& machine, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const GeneratorOptions& o,
                           const std::string& name) {
-  if (group_names(truth) != machine.mesh.group_names || !same_elastic_inputs(truth, machine.truth))
+  if (!serves(machine, truth))
     throw std::invalid_argument("generator: run '" + name +
                                 "' has other boundary groups, materials or mechanical settings "
                                 "than the truth its machine was built for");

@@ -139,6 +139,9 @@ struct TruthMachine {
 };
 TruthMachine truth_machine(const mesh::TetMesh& mesh, const core::CaseSpec& truth,
                            const Instrumentation& inst);
+/// Whether `machine` can run `truth`: the same boundary groups, materials and mechanical
+/// settings as the truth it was built for (clean_run's check).
+bool serves(const TruthMachine& machine, const core::CaseSpec& truth);
 
 /// Simulates `truth` on `mesh` (re-meshed when `truth` has other boundary groups, as a heat input
 /// adds), samples it every options.sample_interval_s, applies sensor
