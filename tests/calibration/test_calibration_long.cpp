@@ -17,8 +17,8 @@
 //   and 8 hours, the generator 2.0 times coarser at 20 s); prints the catalogue's and each draw's
 //   calibration time (issue 16's time target). Floors only with TT_CONFUSION_FLOORS=1. Two
 //   processes on two cores (two draw subsets): give each OMP_NUM_THREADS=1, or Eigen's OpenMP
-//   teams wait for cores the other process holds (docs/benchmarks.md, session 23: 2 to 25 times
-//   the calibration time).
+//   teams wait for cores the other process holds (docs/benchmarks.md, session 23: a draw's
+//   calibration about 3 times slower).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
