@@ -139,8 +139,12 @@ TEST(TruthMachine, SharedByADrawsRunsGivesEachRunsOwnReadings) {
   ASSERT_EQ(shared.displacement.cols(), 3);
   EXPECT_LE((shared.displacement - own.displacement).cwiseAbs().maxCoeff(), 1e-15);
   EXPECT_GT(own.displacement.cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_TRUE(serves(machine, truth));
+  // Without the heat input's group, or with another material: another machine's truth.
+  EXPECT_FALSE(serves(machine, truth_case(s.declared, InjectedEffect{}, second, 1)));
   core::CaseSpec other = truth;
   other.materials.front().expansion *= 1.1;
+  EXPECT_FALSE(serves(machine, other));
   EXPECT_THROW(clean_run(machine, other, {e}, s.gopt, "other"), std::invalid_argument);
 }
 
