@@ -148,10 +148,9 @@ int main(int argc, char** argv) {
       const core::CaseSpec truth_spec =
           calibration::truth_case(gen, effect, duty, static_cast<int>(k));
       const std::string name = "gen_" + std::to_string(k);
-      if (!machine || !calibration::serves(*machine, truth_spec))
-        machine = calibration::truth_machine(gmesh, truth_spec, inst);
       const io::MeasuredRun clean =
-          calibration::clean_run(*machine, truth_spec, {effect}, gopt, name);
+          calibration::clean_run(calibration::machine_for(machine, gmesh, truth_spec, inst),
+                                 truth_spec, {effect}, gopt, name);
       Generated g{kind, calibration::with_noise(clean, gopt, rng), clean.displacement};
       g.measured.folder = name;
       runs.push_back(std::move(g));

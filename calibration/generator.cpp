@@ -527,6 +527,12 @@ bool serves(const TruthMachine& machine, const core::CaseSpec& truth) {
          same_elastic_inputs(truth, machine.truth);
 }
 
+const TruthMachine& machine_for(std::optional<TruthMachine>& kept, const mesh::TetMesh& mesh,
+                                const core::CaseSpec& truth, const Instrumentation& inst) {
+  if (!kept || !serves(*kept, truth)) kept = truth_machine(mesh, truth, inst);
+  return *kept;
+}
+
 io::MeasuredRun clean_run(const mesh::TetMesh& mesh_in, const core::CaseSpec& truth,
                           const InjectedEffects& effects, const Instrumentation& inst,
                           const GeneratorOptions& o, const std::string& name) {

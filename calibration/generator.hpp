@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -142,6 +143,10 @@ TruthMachine truth_machine(const mesh::TetMesh& mesh, const core::CaseSpec& trut
 /// Whether `machine` can run `truth`: the same boundary groups, materials and mechanical
 /// settings as the truth it was built for (clean_run's check).
 bool serves(const TruthMachine& machine, const core::CaseSpec& truth);
+/// The machine for `truth`: `kept` when it serves it, or else one built for it on `mesh` (kept in
+/// its place for the next run; runs of one truth then share it).
+const TruthMachine& machine_for(std::optional<TruthMachine>& kept, const mesh::TetMesh& mesh,
+                                const core::CaseSpec& truth, const Instrumentation& inst);
 
 /// Simulates `truth` on `mesh` (re-meshed when `truth` has other boundary groups, as a heat input
 /// adds), samples it every options.sample_interval_s, applies sensor

@@ -47,9 +47,10 @@ TEST(CalibrateCli, ReducedModelFindsAnUndeclaredHeatInput) {
   for (int k = 0; k < 3; ++k) {
     const core::DutyCycle duty = random_duty_cycle(hours[k], rng);
     const core::CaseSpec truth = truth_case(gen, effect, duty, k);
-    if (!machine) machine = truth_machine(gen_mesh, truth, inst);
-    const io::MeasuredRun run = with_noise(
-        clean_run(*machine, truth, {effect}, gopt, "run " + std::to_string(k)), gopt, rng);
+    const io::MeasuredRun run =
+        with_noise(clean_run(machine_for(machine, gen_mesh, truth, inst), truth, {effect}, gopt,
+                             "run " + std::to_string(k)),
+                   gopt, rng);
     runs.push_back((dir / ("run_" + std::to_string(k))).string());
     io::write_measured_run(runs.back(), run);
   }
