@@ -144,6 +144,9 @@ struct CompensateArgs {
   /// with rom: a recorded run's meta.json: its sensors are read at their positions (as `observe`
   /// reads them), its initial temperature is the machine's at t = 0 unless given
   std::filesystem::path meta;
+  /// with rom: the observer's period [s]: the samples of a period are assimilated as one reading
+  /// (their mean), so a fast stream costs one covariance step per period; 0: every sample
+  double filter_every_s = 1.0;
   std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input
   std::filesystem::path out;  /// empty: standard output
   bool until_eof = false;     /// with in: stop at its end instead of following it

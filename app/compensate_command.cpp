@@ -1,7 +1,8 @@
 // thermotwin compensate: live compensation from a fitted model, or from a reduced model through
 // the physics observer. Reads sensor samples as they arrive and writes, per sample, the predicted
 // thermal drift of every target with its uncertainty and a status.
-//   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [observer options])
+//   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [--filter-every-s S]
+//                         [observer options])
 //                         [--in FILE [--until-eof | --idle-s S]] [--out FILE] [--flush]
 //                         [--poll-ms MS]
 // Input: CSV lines in the measured-data format (docs/measured-data.md): a header time_s,<ids...>,
@@ -13,8 +14,9 @@
 // 2. The stream's header bound to the model by name (fitting::Compensator, or
 //    solvers::LiveObserver on the sensors and speed_rpm): a column the model reads that the header
 //    lacks refuses the stream, naming it.
-// 3. Sample by sample: parse, step the model, write one line; output is buffered and flushed when
-//    the input pauses, per line with --flush or on a terminal.
+// 3. Sample by sample: parse, step the model (the observer once per filter period), write one
+//    line; output is buffered and flushed when the input pauses, per line with --flush or on a
+//    terminal.
 #include <unistd.h>
 
 #include <algorithm>
@@ -127,8 +129,9 @@ Binder observed_model(const CompensateArgs& args) {
     calibration = std::make_shared<const io::SigmaCalibrationFile>(
         io::read_sigma_calibration(options.sigma_calibration));
   const std::string source = args.meta.empty() ? "the stream" : args.meta.string();
-  return [rom, spec, mesh, meta, options, calibration,
-          source](const std::vector<std::string>& columns) {
+  const double every_s = args.filter_every_s;
+  return [rom, spec, mesh, meta, options, calibration, source,
+          every_s](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;
     if (sensors.empty())
       sensors = studies::readable_sensors(rom->twin.outputs, mesh.get(), meta->sensors, columns,
@@ -141,9 +144,9 @@ Binder observed_model(const CompensateArgs& args) {
         studies::sensor_readout(rom->twin, mesh.get(), meta->sensors, sensors, source);
     const solvers::ObserverSetup setup =
         observer_setup(options, rom->twin, *spec, sensors, readout.rows, calibration.get());
-    auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
-                                                            sensors, columns, "speed_rpm",
-                                                            options.drift_readings_every_s);
+    auto observer = std::make_shared<solvers::LiveObserver>(
+        rom->twin.model.system, *spec, setup, sensors, columns, "speed_rpm",
+        options.drift_readings_every_s, every_s);
     // The stream's temperatures are in degC and its drifts in um (the measured-data format), the
     // observer's in K and m. The observer refers to the system and the case: they live as long
     // as it.

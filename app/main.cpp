@@ -399,6 +399,14 @@ Command compensate_line(CLI::App& cli) {
                    "--initial-temperature-c says otherwise")
       ->check(CLI::ExistingFile)
       ->needs(compensate_rom);
+  compensate
+      ->add_option("--filter-every-s", compensate_args.filter_every_s,
+                   "with --rom: the observer's period [s]: the samples of a period are assimilated "
+                   "as one reading, their mean, at its last sample, and the speed over it is "
+                   "their time mean; samples further apart are each assimilated (default 1; 0: "
+                   "every sample)")
+      ->check(non_negative_number())
+      ->needs(compensate_rom);
   // The observer's options need a reduced model: with a fitted model they would be ignored.
   const std::size_t before_observer = compensate->get_options().size();
   add_observer_options(*compensate, compensate_args.observer);

@@ -1,9 +1,11 @@
 // The physics observer on a stream of samples (thermotwin compensate --rom): the stream's header
 // bound by name to the observer's sensors and the spindle speed, the duty cycle extended sample by
 // sample (the speed read at a sample holds to the next one, as calibration::case_for_run reads a
-// recorded run: solvers::extend_duty_cycle), and one KalmanObserver::assimilate per sample. The
-// observer steps no further than the sample at hand, so a recorded run streamed through it gives
-// what solvers::observe gives on the whole run.
+// recorded run: solvers::extend_duty_cycle), and one KalmanObserver::assimilate per filter period:
+// the samples of a period are one reading, their mean, at its last sample's time, and the speed
+// over it is their held speeds' time mean. A period holds one sample where samples come at least
+// a period apart, so a recorded run streamed through it gives what solvers::observe gives on the
+// whole run; a 1 kHz stream costs one covariance step per period, not per sample.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,20 +28,24 @@ class LiveObserver {
   /// `drift_every_s` > 0: the columns named after the setup's targets (in m) are read as drift
   /// readings on a probe cycle (ProbeCycle), tested as observe tests them (DriftReadingTest);
   /// throws DataError when no column is named after a target.
+  /// `filter_every_s`: the filter period [s]; a sample at least this long after the last
+  /// assimilation (or with a drift reading due) is assimilated, with the mean of the readings
+  /// since (each sensor's mean is one reading of its sigma); 0: every sample.
   LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
                const ObserverSetup& setup, const std::vector<std::string>& sensors,
                const std::vector<std::string>& columns, const std::string& speed_column,
-               double drift_every_s = 0);
+               double drift_every_s = 0, double filter_every_s = 0);
   ~LiveObserver();
   LiveObserver(const LiveObserver&) = delete;
   LiveObserver& operator=(const LiveObserver&) = delete;
 
   /// The observer on the next sample: time [s] and one value per column (sensors [K], speed
   /// [rpm]), NaN where missing. `late` for a time not after the last sample used; `waiting` until
-  /// a speed has been read; `held` with the columns whose readings were missing (sensors left out
-  /// of the update, the speed held). Predicted drift and sigma per target [m] (the setup's
+  /// a speed has been read; `held` with the columns whose readings were missing (left out of the
+  /// period's mean, the speed held). Predicted drift and sigma per target [m] (the setup's
   /// targets); recalibrate once the observer raised it; faulty: the columns of the sensors
-  /// whose offset test raised a fault (HeldBeyondMonitor).
+  /// whose offset test raised a fault (HeldBeyondMonitor); between assimilations, the last
+  /// assimilation's.
   const core::LiveStep& next(double time, const Eigen::Ref<const Eigen::VectorXd>& values);
 
   const std::vector<std::string>& target_names() const { return target_names_; }
@@ -47,6 +53,8 @@ class LiveObserver {
   const std::vector<int>& sensor_columns() const { return sensor_columns_; }
   /// Per target, the stream's column of its drift readings (-1: none; all -1 without a cycle).
   const std::vector<int>& drift_columns() const { return drift_columns_; }
+  /// The assimilations so far (filter periods).
+  long long assimilations() const { return assimilations_; }
 
  private:
   std::unique_ptr<core::CaseSpec> spec_;  /// the duty cycle read so far; the filter refers to it
@@ -57,9 +65,19 @@ class LiveObserver {
   std::vector<int> sensor_columns_, drift_columns_;
   int speed_column_ = -1;
   std::vector<std::string> target_names_;
+  void assimilate(double time, const Eigen::Ref<const Eigen::VectorXd>& values, bool drift_due);
+
+  double every_s_ = 0;
+  /// the period so far: per sensor the sum and count of its readings, and the time integral of
+  /// the speed held since the last assimilation [rpm s]
+  Eigen::VectorXd sum_;
+  Eigen::VectorXi count_;
+  double speed_integral_ = 0;
+  double held_speed_ = 0;  /// the last speed read, >= 0 [rpm]
   Eigen::VectorXd readings_;
   core::LiveStep step_;
-  double last_time_ = 0;
+  double last_time_ = 0, assimilated_time_ = 0;
+  long long assimilations_ = 0;
   bool started_ = false;
 };
 

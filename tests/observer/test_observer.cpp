@@ -820,44 +820,105 @@ TEST_F(Observer, ExpansionSigmaIsEachMaterialsPartOfTheDrift) {
             with.drift_sigma(with.times.size() - 1, 2));
 }
 
+/// The clean run with two readings missing (samples 5 and 40), the observer's run on all of it,
+/// and what a live stream of it needs: its columns (the speed, an ignored one, the sensors in
+/// reverse order: any order) and the declared case.
+struct StreamedRun {
+  io::MeasuredRun run;
+  solvers::ObserverRun offline;
+  std::vector<std::string> columns{"speed_rpm", "ignored"};
+  core::CaseSpec declared;
+  Eigen::Index speed = 0;  /// the run's input column of the speed
+  /// The stream's values of sample i, the speed from sample `speed_from`'s.
+  Eigen::VectorXd values(Eigen::Index i, Eigen::Index speed_from) const {
+    const auto m = static_cast<Eigen::Index>(kSensors.size());
+    Eigen::VectorXd v(2 + m);
+    v(0) = run.input_values(speed_from, speed);
+    v(1) = 1e9;
+    for (Eigen::Index k = 0; k < m; ++k) v(2 + k) = run.temperature(i, m - 1 - k);
+    return v;
+  }
+};
+
+StreamedRun streamed_run(const io::MeasuredRun& clean, const core::CaseSpec& spec,
+                         const solvers::Twin& twin, const solvers::ObserverSetup& set) {
+  StreamedRun s;
+  s.run = clean;
+  s.run.temperature(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  s.run.temperature(40, 3) = std::numeric_limits<double>::quiet_NaN();
+  const core::CaseSpec c = calibration::case_for_run(spec, s.run);
+  s.offline = solvers::observe(twin.model.system, c, set, s.run.time, s.run.temperature);
+  const auto speed = std::find(s.run.inputs.begin(), s.run.inputs.end(), "speed_rpm");
+  EXPECT_NE(speed, s.run.inputs.end());
+  s.speed = speed - s.run.inputs.begin();
+  s.columns.insert(s.columns.end(), kSensors.rbegin(), kSensors.rend());
+  s.declared = spec;
+  if (s.run.initial_temperature_c)
+    s.declared.thermal.initial_temperature_c = *s.run.initial_temperature_c;
+  return s;
+}
+
+/// The largest difference of a live step's drift and sigma from the offline run's at sample i.
+double step_gap(const core::LiveStep& step, const solvers::ObserverRun& offline, Eigen::Index i) {
+  return std::max((step.predicted - offline.drift.row(i).transpose()).cwiseAbs().maxCoeff(),
+                  (step.sigma - offline.drift_sigma.row(i).transpose()).cwiseAbs().maxCoeff());
+}
+
 TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
   // The run sample by sample, its speed column read as it comes and two readings missing, gives
   // what the observer gives on the whole recorded run (its duty cycle from the same column).
-  io::MeasuredRun run = s_->clean;
-  run.temperature(5, 1) = std::numeric_limits<double>::quiet_NaN();
-  run.temperature(40, 3) = std::numeric_limits<double>::quiet_NaN();
-  const core::CaseSpec c = calibration::case_for_run(s_->spec, run);
   const solvers::ObserverSetup set = setup(default_noise());
-  const solvers::ObserverRun offline =
-      solvers::observe(s_->twin.model.system, c, set, run.time, run.temperature);
-  const auto speed = std::find(run.inputs.begin(), run.inputs.end(), "speed_rpm");
-  ASSERT_NE(speed, run.inputs.end());
-  std::vector<std::string> columns{"speed_rpm", "ignored"};
-  columns.insert(columns.end(), kSensors.rbegin(), kSensors.rend());  // any order
-  core::CaseSpec declared = s_->spec;
-  if (run.initial_temperature_c)
-    declared.thermal.initial_temperature_c = *run.initial_temperature_c;
-  solvers::LiveObserver live(s_->twin.model.system, declared, set, kSensors, columns, "speed_rpm");
-  const auto m = static_cast<Eigen::Index>(kSensors.size());
-  Eigen::VectorXd v(2 + m);
+  const StreamedRun s = streamed_run(s_->clean, s_->spec, s_->twin, set);
+  // A filter period shorter than the samples' spacing: one sample per period.
+  solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
+                             "speed_rpm", 0, 1.0);
   double worst = 0;
-  for (Eigen::Index i = 0; i < run.time.size(); ++i) {
-    v(0) = run.input_values(i, speed - run.inputs.begin());
-    v(1) = 1e9;
-    for (Eigen::Index k = 0; k < m; ++k) v(2 + k) = run.temperature(i, m - 1 - k);
-    const core::LiveStep& step = live.next(run.time(i), v);
+  for (Eigen::Index i = 0; i < s.run.time.size(); ++i) {
+    const core::LiveStep& step = live.next(s.run.time(i), s.values(i, i));
     ASSERT_EQ(step.status, (i == 5 || i == 40) ? core::SampleStatus::held : core::SampleStatus::ok)
         << "sample " << i;
-    worst =
-        std::max(worst, (step.predicted - offline.drift.row(i).transpose()).cwiseAbs().maxCoeff());
-    worst = std::max(worst,
-                     (step.sigma - offline.drift_sigma.row(i).transpose()).cwiseAbs().maxCoeff());
+    worst = std::max(worst, step_gap(step, s.offline, i));
   }
-  EXPECT_LE(worst, 1e-12 * offline.drift.cwiseAbs().maxCoeff());
-  EXPECT_EQ(live.next(run.time(3), v).status, core::SampleStatus::late);
-  EXPECT_THROW(solvers::LiveObserver(s_->twin.model.system, declared, set, kSensors,
+  EXPECT_LE(worst, 1e-12 * s.offline.drift.cwiseAbs().maxCoeff());
+  EXPECT_EQ(live.assimilations(), s.run.time.size());
+  EXPECT_EQ(live.next(s.run.time(3), s.values(3, 3)).status, core::SampleStatus::late);
+  EXPECT_THROW(solvers::LiveObserver(s_->twin.model.system, s.declared, set, kSensors,
                                      {"speed_rpm", "T02"}, "speed_rpm"),
                core::DataError);
+}
+
+TEST_F(Observer, ADenseStreamIsAssimilatedOncePerFilterPeriod) {
+  // Five samples per recorded interval, the filter period the interval: four inside it carry the
+  // interval's closing reading and the speed held over it, the fifth (at the recorded time) the
+  // recorded sample. Each period's mean is then the recorded reading and its time-mean speed the
+  // held one, so the live observer assimilates once per period and gives the recorded run's
+  // estimates at the recorded times, holding the last one between them.
+  const solvers::ObserverSetup set = setup(default_noise());
+  const StreamedRun s = streamed_run(s_->clean, s_->spec, s_->twin, set);
+  const double spacing = s.run.time(1) - s.run.time(0);
+  ASSERT_GT(spacing, 0);
+  for (Eigen::Index i = 2; i < s.run.time.size(); ++i)
+    ASSERT_NEAR(s.run.time(i) - s.run.time(i - 1), spacing, 1e-9) << "sample " << i;
+  solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
+                             "speed_rpm", 0, spacing);
+  double worst = 0;
+  long long samples = 0;
+  for (Eigen::Index i = 0; i < s.run.time.size(); ++i) {
+    const bool missing = i == 5 || i == 40;
+    for (int k = 1; i > 0 && k < 5; ++k, ++samples) {
+      const core::LiveStep& between =
+          live.next(s.run.time(i - 1) + k * spacing / 5, s.values(i, i - 1));
+      ASSERT_EQ(between.status, missing ? core::SampleStatus::held : core::SampleStatus::ok);
+      worst = std::max(worst, step_gap(between, s.offline, i - 1));
+    }
+    const core::LiveStep& step = live.next(s.run.time(i), s.values(i, i));
+    ++samples;
+    ASSERT_EQ(step.status, missing ? core::SampleStatus::held : core::SampleStatus::ok);
+    worst = std::max(worst, step_gap(step, s.offline, i));
+  }
+  EXPECT_LE(worst, 1e-12 * s.offline.drift.cwiseAbs().maxCoeff());
+  EXPECT_EQ(live.assimilations(), s.run.time.size());
+  EXPECT_EQ(samples, 5 * s.run.time.size() - 4);
 }
 
 TEST_F(Observer, PosteriorVarianceIsKnownBeforeTheReadingsAndPlacementLowersIt) {
