@@ -153,6 +153,8 @@ struct CompensateArgs {
   double idle_s = 0.0;        /// with in: stop when it has not grown for this long [s]; 0: never
   int poll_ms = 5;            /// with in: how often to look for new lines at its end [ms]
   bool flush = false;         /// flush after every line (always on a terminal)
+  /// output held for a reader that falls behind before lines are dropped [MiB]
+  double max_behind_mib = 16.0;
 };
 
 /// observe CASE --rom DIR --data RUN --out DIR: the physics observer on a measured run

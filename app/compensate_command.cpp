@@ -4,7 +4,7 @@
 //   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [--filter-every-s S]
 //                         [observer options])
 //                         [--in FILE [--until-eof | --idle-s S]] [--out FILE] [--flush]
-//                         [--poll-ms MS]
+//                         [--poll-ms MS] [--max-behind-mib M]
 // Input: CSV lines in the measured-data format (docs/measured-data.md): a header time_s,<ids...>,
 // then one sample per line; on standard input (to its end) or from FILE, followed as it grows.
 // Output (stdout or FILE): time_s, <target>_predicted_um, <target>_sigma_um per target, status.
@@ -15,8 +15,9 @@
 //    solvers::LiveObserver on the sensors and speed_rpm): a column the model reads that the header
 //    lacks refuses the stream, naming it.
 // 3. Sample by sample: parse, step the model (the observer once per filter period), write one
-//    line; output is buffered and flushed when the input pauses, per line with --flush or on a
-//    terminal.
+//    line; output is buffered and written when the input pauses, per line with --flush or on a
+//    terminal, never waiting for its reader: lines beyond --max-behind-mib are dropped, and the
+//    next line's status says how many.
 #include <unistd.h>
 
 #include <algorithm>
@@ -178,7 +179,9 @@ BoundModel bound_to_header(const Binder& bind, io::LineReader& reader, const std
 }
 
 /// Sample by sample: parse, step the model, write one line (a torn or foreign line is skipped,
-/// the last prediction repeated). Output is flushed when the input pauses, or per line.
+/// the last prediction repeated). The output is written when the input pauses, per line, or when
+/// 64 KiB are held, as far as its reader takes it without waiting; lines its reader has fallen
+/// behind on are dropped, and the next line says how many.
 void predictions(io::LineReader& reader, const BoundModel& model,
                  const std::vector<std::string>& columns, io::BufferedWriter& output,
                  bool per_line) {
@@ -186,22 +189,24 @@ void predictions(io::LineReader& reader, const BoundModel& model,
   Eigen::VectorXd last = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(model.targets.size()),
                                                    std::numeric_limits<double>::quiet_NaN());
   Eigen::VectorXd last_sigma = last;
-  const auto flush_held = [&] { output.flush(); };
+  const auto write_held = [&] { return output.write_ready(); };
   std::string_view line;
-  while (reader.next(line, flush_held)) {
+  while (reader.next(line, write_held)) {
     if (line.empty()) continue;
     double time = 0.0;
-    if (!io::parsed_sample(line, time, values)) {
-      io::append_output_line(output.text, time, last, last_sigma, "malformed");
-    } else {
+    std::string status = "malformed";
+    if (io::parsed_sample(line, time, values)) {
       const core::LiveStep& step = model.next(time, values);
       if (step.status != core::SampleStatus::late) {
         last = step.predicted;
         last_sigma = step.sigma;
       }
-      io::append_output_line(output.text, time, last, last_sigma, io::status_text(step, columns));
+      status = io::status_text(step, columns);
     }
-    if (per_line || output.text.size() >= (std::size_t(1) << 16)) output.flush();
+    if (const std::size_t dropped = output.drop_behind(); dropped > 0)
+      status = io::with_dropped(status, dropped);
+    io::append_output_line(output.text, time, last, last_sigma, status);
+    if (per_line || output.held() >= (std::size_t(1) << 16)) output.write_ready();
   }
   output.flush();
 }
@@ -222,7 +227,8 @@ int compensate_command(const CompensateArgs& args) {
   std::vector<std::string> columns;
   const BoundModel model = bound_to_header(bind, reader, in.name(), columns);
   const io::StreamFd out = io::StreamFd::writing(args.out);
-  io::BufferedWriter output(out.fd(), out.name());
+  io::BufferedWriter output(out.fd(), out.name(),
+                            static_cast<std::size_t>(args.max_behind_mib * (1 << 20)));
   output.text = io::output_header(model.targets);
   output.flush();
   // 3. Sample by sample.

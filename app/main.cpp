@@ -336,7 +336,7 @@ Command calibrate_line(CLI::App& cli) {
 }
 
 /// compensate's input and output stream options: --in, --out, --until-eof, --idle-s, --poll-ms,
-/// --flush.
+/// --flush, --max-behind-mib.
 void add_stream_options(CLI::App& compensate, CompensateArgs& compensate_args) {
   auto* compensate_in = compensate.add_option(
       "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
@@ -359,6 +359,12 @@ void add_stream_options(CLI::App& compensate, CompensateArgs& compensate_args) {
   compensate.add_flag("--flush", compensate_args.flush,
                       "flush after every line (default: when the input pauses; always on a "
                       "terminal)");
+  compensate
+      .add_option("--max-behind-mib", compensate_args.max_behind_mib,
+                  "output held for a reader that falls behind [MiB]: compensate never waits for "
+                  "its reader; beyond this the lines not yet written are dropped and the next "
+                  "line's status says dropped:N (default 16)")
+      ->check(positive_number());
 }
 
 /// `compensate --model FIT.json | --rom DIR`.

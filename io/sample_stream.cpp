@@ -5,9 +5,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -75,22 +77,85 @@ StreamFd::~StreamFd() {
   if (fd_ > 2) ::close(fd_);
 }
 
-BufferedWriter::BufferedWriter(int fd, std::string name) : fd_(fd), name_(std::move(name)) {
+BufferedWriter::BufferedWriter(int fd, std::string name, std::size_t max_behind)
+    : fd_(fd), name_(std::move(name)), max_behind_(max_behind) {
   text.reserve(1 << 17);
+  struct stat st {};
+  polled_ = ::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode);
+}
+
+bool BufferedWriter::write_ready() {
+  while (written_ < text.size()) {
+    std::size_t piece = text.size() - written_;
+    if (polled_) {
+      // POLLOUT on a pipe is a free buffer of at least PIPE_BUF bytes: a piece of that size is
+      // taken without waiting. An error or a closed reader is left to write() to report.
+      pollfd p{fd_, POLLOUT, 0};
+      const int ready = ::poll(&p, 1, 0);
+      if (ready < 0 && errno == EINTR) continue;
+      if (ready == 0) break;
+      piece = std::min<std::size_t>(piece, PIPE_BUF);
+    }
+    const ssize_t n = ::write(fd_, text.data() + written_, piece);
+    if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+    if (n < 0) throw core::IoError(name_ + ": cannot write: " + std::strerror(errno));
+    written_ += static_cast<std::size_t>(n);
+  }
+  if (written_ == text.size()) {
+    text.clear();
+    written_ = 0;
+    gap_at_ = std::string::npos;
+    return true;
+  }
+  // Keep the held text from the start of the line being written.
+  if (written_ >= (std::size_t(1) << 20)) {
+    const std::size_t line = text.rfind('\n', written_ - 1);
+    if (line != std::string::npos) {
+      text.erase(0, line + 1);
+      written_ -= line + 1;
+      gap_at_ =
+          gap_at_ != std::string::npos && gap_at_ > line ? gap_at_ - (line + 1) : std::string::npos;
+    }
+  }
+  return false;
 }
 
 void BufferedWriter::flush() {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+  while (written_ < text.size()) {
+    const ssize_t n = ::write(fd_, text.data() + written_, text.size() - written_);
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EAGAIN) {
+      pollfd p{fd_, POLLOUT, 0};
+      ::poll(&p, 1, -1);
+      continue;
+    }
     if (n < 0) throw core::IoError(name_ + ": cannot write: " + std::strerror(errno));
-    done += static_cast<std::size_t>(n);
+    written_ += static_cast<std::size_t>(n);
   }
   text.clear();
+  written_ = 0;
+  gap_at_ = std::string::npos;
 }
 
-bool LineReader::fill(const std::function<void()>& before_wait) {
+std::size_t BufferedWriter::drop_behind() {
+  if (max_behind_ == 0 || held() <= max_behind_) return 0;
+  // The line being written is finished; every line after it goes.
+  std::size_t from = written_;
+  if (from > 0 && text[from - 1] != '\n') {
+    const std::size_t end = text.find('\n', from);
+    from = end == std::string::npos ? text.size() : end + 1;
+  }
+  auto gap = static_cast<std::size_t>(
+      std::count(text.begin() + static_cast<std::ptrdiff_t>(from), text.end(), '\n'));
+  // The last gap's line goes too: its gap joins this one.
+  if (gap_at_ != std::string::npos && gap_at_ >= from) gap += gap_;
+  text.resize(from);
+  gap_ = gap;
+  gap_at_ = from;
+  return gap;
+}
+
+bool LineReader::fill(const std::function<bool()>& before_wait) {
   // Move the partial line to the front; grow when a line fills the buffer.
   if (begin_ > 0) {
     std::memmove(buffer_.data(), buffer_.data() + begin_, end_ - begin_);
@@ -101,7 +166,11 @@ bool LineReader::fill(const std::function<void()>& before_wait) {
   auto idle_since = std::chrono::steady_clock::now();
   while (!(stop_ && *stop_)) {
     pollfd p{fd_, POLLIN, 0};
-    if (::poll(&p, 1, 0) == 0 && before_wait) before_wait();
+    // No input ready: write what the output takes; while it holds lines, look at the input again
+    // every poll_ms instead of blocking on it, so that the output's reader is served meanwhile.
+    if (::poll(&p, 1, 0) == 0 && before_wait)
+      while (!before_wait() && !(stop_ && *stop_) && ::poll(&p, 1, options_.poll_ms) == 0) {
+      }
     const ssize_t got = ::read(fd_, buffer_.data() + end_, buffer_.size() - end_);
     if (got > 0) {
       end_ += static_cast<std::size_t>(got);
@@ -132,7 +201,7 @@ bool LineReader::fill(const std::function<void()>& before_wait) {
   return false;
 }
 
-bool LineReader::next(std::string_view& line, const std::function<void()>& before_wait) {
+bool LineReader::next(std::string_view& line, const std::function<bool()>& before_wait) {
   for (;;) {
     if (stop_ && *stop_) return false;
     const char* from = buffer_.data() + begin_;
@@ -218,6 +287,11 @@ std::string status_text(const core::LiveStep& step, const std::vector<std::strin
   const std::string model = model_status(step.recalibrate, faulty);
   if (model.empty()) return s;
   return step.status == core::SampleStatus::ok ? model : model + "|" + s;
+}
+
+std::string with_dropped(const std::string& status, std::size_t lines) {
+  const std::string dropped = "dropped:" + std::to_string(lines);
+  return status == "ok" ? dropped : status + "|" + dropped;
 }
 
 void append_output_line(std::string& out, double time, const Eigen::VectorXd& predicted,

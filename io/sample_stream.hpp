@@ -40,18 +40,38 @@ class StreamFd {
   std::string name_;
 };
 
-/// Lines held in `text` and written to a file descriptor by flush().
+/// Lines held in `text` and written to a file descriptor without waiting for a slow reader:
+/// write_ready() writes what the output takes now and holds the rest; once more than max_behind
+/// bytes are held, drop_behind() drops the lines not yet begun (a line is never torn), so a reader
+/// that falls behind loses lines instead of slowing the stream that feeds the writer.
 class BufferedWriter {
  public:
-  /// fd stays owned by the caller; name is used in messages.
-  BufferedWriter(int fd, std::string name);
+  /// fd stays owned by the caller; name is used in messages; max_behind: the bytes held before
+  /// lines are dropped (0: never).
+  BufferedWriter(int fd, std::string name, std::size_t max_behind = 0);
+  /// Lines to write, appended by the caller; the first `written` bytes are out already.
   std::string text;
-  /// Writes everything held. Throws IoError naming the output when a write fails.
+  /// The bytes held: appended and not yet written.
+  std::size_t held() const { return text.size() - written_; }
+  /// Writes what the output takes without waiting: a pipe, socket or terminal in pieces of at
+  /// most PIPE_BUF while poll says it takes them, a regular file whole. true when nothing is held.
+  /// Throws IoError naming the output when a write fails.
+  bool write_ready();
+  /// Writes everything held, waiting for the output as long as it takes (the stream's end).
   void flush();
+  /// When more than max_behind bytes are held: drops every line not yet begun and returns the
+  /// gap the next line appended follows: the lines dropped now and, when the last gap's line is
+  /// among them, that gap's lines. 0 when nothing is dropped.
+  std::size_t drop_behind();
 
  private:
   int fd_;
   std::string name_;
+  std::size_t max_behind_;
+  std::size_t written_ = 0;
+  bool polled_ = false;  /// not a regular file: poll before each piece
+  /// the last gap's lines, and where in text the line after it starts while it is not begun
+  std::size_t gap_ = 0, gap_at_ = std::string::npos;
 };
 
 /// How a LineReader treats the end of what has been written so far.
@@ -75,11 +95,13 @@ class LineReader {
   /// The next line without its line break ("\r\n" too). false at the end: end of data (not
   /// following), the idle time passed, or stop was set. A last line with no line break is returned
   /// at the end of data when not following; when following it waits for its line break.
-  /// before_wait is called whenever no data is ready and the reader is about to block or sleep.
-  bool next(std::string_view& line, const std::function<void()>& before_wait);
+  /// before_wait is called whenever no data is ready and the reader is about to block or sleep;
+  /// while it returns false (output still held), the reader looks at the input again every
+  /// poll_ms and calls it again, instead of blocking.
+  bool next(std::string_view& line, const std::function<bool()>& before_wait);
 
  private:
-  bool fill(const std::function<void()>& before_wait);
+  bool fill(const std::function<bool()>& before_wait);
   int fd_;
   std::string name_;
   FollowOptions options_;
@@ -111,6 +133,10 @@ std::string model_status(bool recalibrate, const std::vector<std::string>& fault
 /// ("recalibrate|held:T07", "sensor_fault:T11", "recalibrate|sensor_fault:T11|late").
 /// columns: the stream's columns.
 std::string status_text(const core::LiveStep& step, const std::vector<std::string>& columns);
+
+/// `status` with "dropped:N" added (in place of "ok"): N output lines before this one were dropped
+/// because the output's reader fell behind (BufferedWriter::drop_behind).
+std::string with_dropped(const std::string& status, std::size_t lines);
 
 /// Appends one output line: the time, predicted errors and their 1-σ [µm] (empty fields where
 /// predicted is NaN, as while waiting), and the status. predicted, sigma: #targets [m].

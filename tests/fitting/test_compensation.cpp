@@ -1,11 +1,15 @@
 // Live compensation against the offline model: every kind compensate steps is written to fit.json's
 // form, read back, streamed sample by sample and compared with predicted_error on the same samples;
 // missing readings hold, late samples are skipped, and a stream without a model's column is
-// refused naming it.
+// refused naming it; the output's writer drops whole lines, announced, for a reader that does not
+// read, instead of waiting for it.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <thread>
 
 #include "core/errors.hpp"
 #include "fitting/compensation.hpp"
@@ -201,6 +205,52 @@ TEST(Compensation, StatusTextPutsWhatTheObserverSaysFirst) {
   s.faulty.clear();
   EXPECT_EQ(tt::io::status_text(s, columns), "recalibrate|held:speed_rpm");
   EXPECT_EQ(tt::io::model_status(false, {}), "");
+}
+
+TEST(Compensation, AWriterWhoseReaderDoesNotReadDropsWholeLinesAndSaysHowMany) {
+  // 20 000 lines to a pipe nobody reads while they are written: every call returns (a writer
+  // that waited would hang here: the alarm ends the test), at most 8 KiB and a line are held,
+  // and what the reader then gets is whole lines in order, each gap announced by the line after
+  // it, none unannounced.
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ::alarm(120);
+  tt::io::BufferedWriter writer(fds[1], "the test's pipe", 8192);
+  const int lines = 20000;
+  const std::string padding(40, 'x');
+  for (int i = 0; i < lines; ++i) {
+    const std::size_t gap = writer.drop_behind();
+    const std::string status = gap ? tt::io::with_dropped("ok", gap) : "ok";
+    writer.text += std::to_string(i) + "," + status + "," + padding + "\n";
+    writer.write_ready();
+    ASSERT_LE(writer.held(), 8192u + 60u) << "line " << i;
+  }
+  ::alarm(0);
+  std::string got;
+  std::thread reader([&] {
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) got.append(buffer, n);
+  });
+  writer.flush();
+  ::close(fds[1]);
+  reader.join();
+  ::close(fds[0]);
+  std::istringstream in(got);
+  int expected = 0, gaps = 0;
+  for (std::string line; std::getline(in, line);) {
+    const std::size_t comma = line.find(','), second = line.find(',', comma + 1);
+    ASSERT_NE(second, std::string::npos) << line;
+    ASSERT_EQ(line.substr(second + 1), padding) << line;
+    const int i = std::stoi(line.substr(0, comma));
+    const std::string status = line.substr(comma + 1, second - comma - 1);
+    const int gap = status == "ok" ? 0 : std::stoi(status.substr(status.find(':') + 1));
+    ASSERT_EQ(i, expected + gap) << line;
+    gaps += gap > 0;
+    expected = i + 1;
+  }
+  EXPECT_EQ(expected, lines);
+  EXPECT_GT(gaps, 0);
+  EXPECT_EQ(tt::io::with_dropped("held:T07", 3), "held:T07|dropped:3");
 }
 
 TEST(Compensation, WaitsForACompleteFirstSampleAndSkipsLateOnes) {

@@ -2,8 +2,12 @@
 // run replayed through compensate, from a finished file and from one that grows while it is
 // followed, must give compensation.csv's predictions; a blank cell is held and flagged, and a
 // stream that lacks a model's column is refused with the column named, and the observer's options
-// with a fitted model are refused.
+// with a fitted model are refused; a reader that falls behind costs lines (announced), never the
+// pace at which the input is read.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -191,6 +195,73 @@ TEST(Compensate, FollowsAGrowingFileAndHoldsABlankCell) {
   EXPECT_EQ(expect_offline_predictions(live, f, std::stod(rows[59].at("time_s"))), 2 * 59);
   const double t59 = std::stod(rows[59].at("time_s"));
   EXPECT_GT(std::abs(std::stod(rows[59].at("q_predicted_um")) - offline(f).at({"q", t59})), 1e-3);
+}
+
+/// Bytes the process has read so far (/proc/<pid>/io's rchar), -1 when it cannot be read.
+long long bytes_read(pid_t pid) {
+  std::ifstream io("/proc/" + std::to_string(pid) + "/io");
+  std::string key;
+  long long value = -1;
+  while (io >> key >> value)
+    if (key == "rchar:") return value;
+  return -1;
+}
+
+TEST(Compensate, AReaderThatFallsBehindCostsLinesNotThePace) {
+  // 200 000 samples, the output a FIFO the test does not read until compensate has read its
+  // whole input: a compensate that waited for its reader would stop reading once the FIFO and
+  // the 0.25 MiB it may hold were full (about 4 000 lines). The reader then gets whole lines,
+  // each gap said by the line after it (dropped:N), and written and dropped lines add up.
+  const Fitted& f = fitted();
+  std::istringstream data(read_text(f.test_run / "data.csv"));
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(data, l);) lines.push_back(l);
+  const fs::path stream = f.dir / "long.csv", fifo = f.dir / "slow_reader.fifo";
+  const int samples = 200000;
+  {
+    std::ofstream out(stream);
+    out << lines[0] << "\n";
+    for (int k = 0; k < samples; ++k) {
+      const std::string& l = lines[1 + static_cast<std::size_t>(k) % (lines.size() - 1)];
+      out << k << l.substr(l.find(',')) << "\n";
+    }
+  }
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  const pid_t pid = reliability_test::start(
+      {"compensate", "--model", (f.fit / "fit.json").string(), "--in", stream.string(),
+       "--until-eof", "--out", fifo.string(), "--max-behind-mib", "0.25"},
+      {}, f.dir / "slow_reader.log");
+  const auto size = static_cast<long long>(fs::file_size(stream));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  long long read_so_far = 0;
+  while ((read_so_far = bytes_read(pid)) < size && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_GE(read_so_far, size) << "compensate stopped reading its input while its reader waited";
+  ASSERT_EQ(::fcntl(fd, F_SETFL, 0), 0);  // now read, waiting for the rest
+  std::string got;
+  char buffer[1 << 16];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;) got.append(buffer, n);
+  ::close(fd);
+  ASSERT_EQ(reliability_test::wait_for(pid), 0) << read_text(f.dir / "slow_reader.log");
+  std::istringstream out(got);
+  std::string line;
+  ASSERT_TRUE(std::getline(out, line));
+  EXPECT_EQ(line, "time_s,p_predicted_um,p_sigma_um,q_predicted_um,q_sigma_um,status");
+  int expected = 0, gaps = 0, written = 0;
+  for (; std::getline(out, line); ++written) {
+    const std::string status = line.substr(line.rfind(',') + 1);
+    const int gap = status == "ok" ? 0 : std::stoi(status.substr(status.find("dropped:") + 8));
+    ASSERT_EQ(std::count(line.begin(), line.end(), ','), 5) << line;
+    ASSERT_EQ(std::stoi(line.substr(0, line.find(','))), expected + gap) << line;
+    gaps += gap > 0;
+    expected += gap + 1;
+  }
+  EXPECT_EQ(expected, samples);
+  EXPECT_GT(gaps, 0);
+  EXPECT_LT(written, samples / 2);
 }
 
 TEST(Compensate, StreamLackingAModelColumnIsRefusedNamingIt) {
