@@ -147,6 +147,8 @@ struct CompensateArgs {
   /// with rom: the observer's period [s]: the samples of a period are assimilated as one reading
   /// (their mean), so a fast stream costs one covariance step per period; 0: every sample
   double filter_every_s = 1.0;
+  /// with rom: the first sample is the model's t = 0 (a cold start there), whatever its time_s
+  bool from_first_sample = false;
   std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input
   std::filesystem::path out;  /// empty: standard output
   bool until_eof = false;     /// with in: stop at its end instead of following it

@@ -130,9 +130,11 @@ Binder observed_model(const CompensateArgs& args) {
     calibration = std::make_shared<const io::SigmaCalibrationFile>(
         io::read_sigma_calibration(options.sigma_calibration));
   const std::string source = args.meta.empty() ? "the stream" : args.meta.string();
-  const double every_s = args.filter_every_s;
+  const solvers::LiveOptions live{.drift_every_s = options.drift_readings_every_s,
+                                  .filter_every_s = args.filter_every_s,
+                                  .from_first_sample = args.from_first_sample};
   return [rom, spec, mesh, meta, options, calibration, source,
-          every_s](const std::vector<std::string>& columns) {
+          live](const std::vector<std::string>& columns) {
     std::vector<std::string> sensors = options.sensors;
     if (sensors.empty())
       sensors = studies::readable_sensors(rom->twin.outputs, mesh.get(), meta->sensors, columns,
@@ -145,20 +147,25 @@ Binder observed_model(const CompensateArgs& args) {
         studies::sensor_readout(rom->twin, mesh.get(), meta->sensors, sensors, source);
     const solvers::ObserverSetup setup =
         observer_setup(options, rom->twin, *spec, sensors, readout.rows, calibration.get());
-    auto observer = std::make_shared<solvers::LiveObserver>(
-        rom->twin.model.system, *spec, setup, sensors, columns, "speed_rpm",
-        options.drift_readings_every_s, every_s);
+    auto observer = std::make_shared<solvers::LiveObserver>(rom->twin.model.system, *spec, setup,
+                                                            sensors, columns, "speed_rpm", live);
     // The stream's temperatures are in degC and its drifts in um (the measured-data format), the
     // observer's in K and m. The observer refers to the system and the case: they live as long
     // as it.
     auto si = std::make_shared<Eigen::VectorXd>();
-    const auto next = [observer, rom, spec, si](double t,
-                                                const Eigen::VectorXd& v) -> const core::LiveStep& {
+    const bool from_first = live.from_first_sample;
+    const auto next = [observer, rom, spec, si, from_first](
+                          double t, const Eigen::VectorXd& v) -> const core::LiveStep& {
       *si = v;
       for (int c : observer->sensor_columns()) (*si)(c) += core::kCelsiusOffset;
       for (int c : observer->drift_columns())
         if (c >= 0) (*si)(c) *= 1e-6;
-      return observer->next(t, *si);
+      try {
+        return observer->next(t, *si);
+      } catch (const core::DataError& e) {  // a first sample on a clock's time
+        throw core::DataError(std::string(e.what()) +
+                              (from_first ? "" : " (--time-from-first-sample)"));
+      }
     };
     return BoundModel{setup.target_names, next};
   };
@@ -182,7 +189,7 @@ BoundModel bound_to_header(const Binder& bind, io::LineReader& reader, const std
 /// the last prediction repeated). The output is written when the input pauses, per line, or when
 /// 64 KiB are held, as far as its reader takes it without waiting; lines its reader has fallen
 /// behind on are dropped, and the next line says how many.
-void predictions(io::LineReader& reader, const BoundModel& model,
+void predictions(io::LineReader& reader, const std::string& in_name, const BoundModel& model,
                  const std::vector<std::string>& columns, io::BufferedWriter& output,
                  bool per_line) {
   Eigen::VectorXd values(static_cast<Eigen::Index>(columns.size()));
@@ -191,12 +198,18 @@ void predictions(io::LineReader& reader, const BoundModel& model,
   Eigen::VectorXd last_sigma = last;
   const auto write_held = [&] { return output.write_ready(); };
   std::string_view line;
-  while (reader.next(line, write_held)) {
+  for (long long number = 2; reader.next(line, write_held); ++number) {
     if (line.empty()) continue;
     double time = 0.0;
     std::string status = "malformed";
     if (io::parsed_sample(line, time, values)) {
-      const core::LiveStep& step = model.next(time, values);
+      const core::LiveStep& step = [&]() -> const core::LiveStep& {
+        try {
+          return model.next(time, values);
+        } catch (const core::DataError& e) {
+          throw core::DataError(in_name + ": line " + std::to_string(number) + ": " + e.what());
+        }
+      }();
       if (step.status != core::SampleStatus::late) {
         last = step.predicted;
         last_sigma = step.sigma;
@@ -232,7 +245,7 @@ int compensate_command(const CompensateArgs& args) {
   output.text = io::output_header(model.targets);
   output.flush();
   // 3. Sample by sample.
-  predictions(reader, model, columns, output, args.flush || ::isatty(out.fd()));
+  predictions(reader, in.name(), model, columns, output, args.flush || ::isatty(out.fd()));
   return 0;
 }
 

@@ -413,6 +413,12 @@ Command compensate_line(CLI::App& cli) {
                    "every sample)")
       ->check(non_negative_number())
       ->needs(compensate_rom);
+  compensate
+      ->add_flag("--time-from-first-sample", compensate_args.from_first_sample,
+                 "with --rom: the stream's first sample is the model's t = 0, a cold start at the "
+                 "initial temperature, whatever its time_s (a clock's time); default: time_s is "
+                 "the time since the run's start, as in a recorded run")
+      ->needs(compensate_rom);
   // The observer's options need a reduced model: with a fitted model they would be ignored.
   const std::size_t before_observer = compensate->get_options().size();
   add_observer_options(*compensate, compensate_args.observer);

@@ -7,9 +7,12 @@
 # Prints lines/s for a file read to its end (--in FILE --until-eof), for a pipe on standard input,
 # and for a pipe with --flush (a write per line), each the best of three.
 # Then the physics observer (compensate --rom): ROM_LINES (default 20000) samples at 1 kHz of the
-# five sensors T17, T18, T16, T53, T54 and the speed through the reduced model of
-# cases/sb1_coarse.toml (built with reduce --quick-validation into OUT_DIR/rom unless there),
-# read from a file to its end, best of three; ROM_LINES=0 skips it.
+# sensors ROM_SENSORS (default T17,T18,T16,T53,T54) and the speed through the reduced model of
+# ROM_CASE (default cases/sb1_coarse.toml; built with reduce --quick-validation into
+# OUT_DIR/rom_<case> unless there), read from a file to its end with the default 1 s filter period,
+# beside the same stream's first tenth with every sample assimilated and a 10-line stream (the
+# start: case, mesh check, model), each best of three; ROM_LINES=0 skips it. GM-1:
+#   ROM_CASE=cases/gm1_coarse.toml ROM_SENSORS=R08,R02,R05,R04 bench/compensate_throughput.sh
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${THERMOTWIN:-$here/build/thermotwin}
@@ -69,20 +72,50 @@ cmp -s "$out/live.csv" "$out/live_pipe.csv" && cmp -s "$out/live.csv" "$out/live
 echo "statuses: $(cut -d, -f6 "$out/live.csv" | sort | uniq -c | tr '\n' ' ')"
 rom_lines=${ROM_LINES:-20000}
 [ "$rom_lines" -gt 0 ] || exit 0
-if [ ! -f "$out/rom/reduced_model.json" ]; then
-  "$bin" reduce "$here/cases/sb1_coarse.toml" --out "$out/rom" --quick-validation --quiet
+rom_case=${ROM_CASE:-$here/cases/sb1_coarse.toml}
+rom_sensors=${ROM_SENSORS:-T17,T18,T16,T53,T54}
+rom_dir="$out/rom_$(basename "$rom_case" .toml)"
+if [ ! -f "$rom_dir/reduced_model.json" ]; then
+  "$bin" reduce "$rom_case" --out "$rom_dir" --quick-validation --quiet
 fi
-awk -v n="$rom_lines" 'BEGIN {
-  print "time_s,speed_rpm,T17,T18,T16,T53,T54";
-  for (i = 0; i < n; i++) {
-    t = i * 0.001;
-    printf "%.3f,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", t, (i % 6000 < 4000) ? 4000 : 0,
-      20 + 0.0001 * i + 0.01 * sin(t), 20 + 0.00005 * i, 20 + 0.00008 * i, 20 + 0.00002 * i,
-      20 + 0.00001 * i
-  }
-}' > "$out/stream_rom.csv"
-rom_run() { "$bin" compensate --rom "$out/rom" --in "$out/stream_rom.csv" --until-eof --out "$out/live_rom.csv"; }
+# The speed switches between 4000 and 0 rpm every 4 and 2 s, with +-10 rpm of noise on every
+# sample (a read-back speed): the filter period's time mean takes it.
+rom_stream() {  # rom_stream LINES FILE
+  awk -v n="$1" -v sensors="$rom_sensors" 'BEGIN {
+    srand(7);
+    k = split(sensors, s, ",");
+    printf "time_s,speed_rpm";
+    for (j = 1; j <= k; j++) printf ",%s", s[j];
+    printf "\n";
+    for (i = 0; i < n; i++) {
+      t = i * 0.001;
+      printf "%.3f,%.1f", t, ((i % 6000 < 4000) ? 4000 : 0) + (rand() - 0.5) * 20;
+      for (j = 1; j <= k; j++) printf ",%.4f", 20 + 0.0001 * i / j + 0.01 * sin(t * j);
+      printf "\n";
+    }
+  }' > "$2"
+}
+rom_stream "$rom_lines" "$out/stream_rom.csv"
+# The filter's reference: every sample assimilated, on a tenth of the samples.
+every_lines=$(( rom_lines / 10 > 10 ? rom_lines / 10 : 10 ))
+rom_stream "$every_lines" "$out/stream_rom_every.csv"
+rom_stream 10 "$out/stream_rom_start.csv"
+rom_run() { "$bin" compensate --rom "$rom_dir" --in "$out/stream_rom.csv" --until-eof --out "$out/live_rom.csv"; }
+every_run() { "$bin" compensate --rom "$rom_dir" --filter-every-s 0 --in "$out/stream_rom_every.csv" --until-eof --out "$out/live_rom_every.csv"; }
+start_run() { "$bin" compensate --rom "$rom_dir" --in "$out/stream_rom_start.csv" --until-eof --out /dev/null; }
 t=$(best rom_run)
-printf '%-5s %d lines in %.3f s: %.0f lines/s\n' "rom" "$rom_lines" "$t" \
-  "$(/usr/bin/python3 -c "print($rom_lines / $t)")"
+t_every=$(best every_run)
+t_start=$(best start_run)
+/usr/bin/python3 - "$rom_lines" "$t" "$every_lines" "$t_every" "$t_start" "$(basename "$rom_case")" <<'PY'
+import sys
+n, ne = int(sys.argv[1]), int(sys.argv[3])
+t, te, t0 = float(sys.argv[2]), float(sys.argv[4]), float(sys.argv[5])
+case = sys.argv[6]
+rate = n / max(t - t0, 1e-9)
+rate_every = ne / max(te - t0, 1e-9)
+print(f"rom   {case}: {n} lines in {t:.3f} s ({n / t:.0f} lines/s with the start of {t0:.3f} s), "
+      f"{rate:.0f} samples/s after it: {rate / 1000:.1f} times 1 kHz")
+print(f"rom   {case}, every sample assimilated (--filter-every-s 0): {ne} lines in {te:.3f} s, "
+      f"{rate_every:.0f} samples/s after the start; the 1 s period is {rate / rate_every:.1f} times faster")
+PY
 echo "statuses (rom): $(awk -F, 'NR > 1 { print $NF }' "$out/live_rom.csv" | sort | uniq -c | tr '\n' ' ')"

@@ -1,15 +1,24 @@
 #include "solvers/observer_live.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
 #include "solvers/loads.hpp"
 
 namespace tt::solvers {
 
 namespace {
+
+/// v in the shortest fixed-point form that reads back as v (a clock's time without an exponent).
+std::string shown(double v) {
+  char text[400];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v, std::chars_format::fixed);
+  return ec == std::errc() ? std::string(text, end) : std::to_string(v);
+}
 
 int column_of(const std::string& name, const std::vector<std::string>& columns, const char* what) {
   const auto it = std::find(columns.begin(), columns.end(), name);
@@ -25,12 +34,14 @@ int column_of(const std::string& name, const std::vector<std::string>& columns, 
 LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
                            const ObserverSetup& setup, const std::vector<std::string>& sensors,
                            const std::vector<std::string>& columns, const std::string& speed_column,
-                           double drift_every_s, double filter_every_s)
+                           const LiveOptions& options)
     : spec_(std::make_unique<core::CaseSpec>(declared)),
       target_names_(setup.target_names),
-      every_s_(filter_every_s) {
-  if (!(filter_every_s >= 0) || !std::isfinite(filter_every_s))
-    throw core::SolverError("live observer: a filter period of " + std::to_string(filter_every_s) +
+      every_s_(options.filter_every_s),
+      from_first_(options.from_first_sample) {
+  const double drift_every_s = options.drift_every_s;
+  if (!(every_s_ >= 0) || !std::isfinite(every_s_))
+    throw core::SolverError("live observer: a filter period of " + std::to_string(every_s_) +
                             " s; expected a finite number >= 0");
   if (static_cast<Eigen::Index>(sensors.size()) != setup.sensor_rows.rows())
     throw core::SolverError("live observer: " + std::to_string(sensors.size()) +
@@ -66,10 +77,12 @@ LiveObserver::LiveObserver(const ReducedThermalSystem& system, const core::CaseS
 
 LiveObserver::~LiveObserver() = default;
 
-const core::LiveStep& LiveObserver::next(double time,
+const core::LiveStep& LiveObserver::next(double stream_time,
                                          const Eigen::Ref<const Eigen::VectorXd>& values) {
   step_.held.clear();
-  if (!std::isfinite(time) || (started_ && !(time > last_time_)) || time < 0) {
+  double time = stream_time - origin_;  // the model's time (the origin is set at the first sample)
+  if (!std::isfinite(time) || (started_ && !(time > last_time_)) ||
+      (!started_ && !from_first_ && time < 0)) {
     step_.status = started_ ? core::SampleStatus::late : core::SampleStatus::waiting;
     return step_;
   }
@@ -78,6 +91,10 @@ const core::LiveStep& LiveObserver::next(double time,
     step_.held.push_back(speed_column_);
     step_.status = core::SampleStatus::waiting;
     return step_;
+  }
+  if (!started_) {
+    start_at(stream_time);
+    time = stream_time - origin_;
   }
   // The period so far: the speed held since the last sample, then this sample's readings.
   if (started_) speed_integral_ += held_speed_ * (time - last_time_);
@@ -103,6 +120,18 @@ const core::LiveStep& LiveObserver::next(double time,
   last_time_ = time;
   step_.status = step_.held.empty() ? core::SampleStatus::ok : core::SampleStatus::held;
   return step_;
+}
+
+void LiveObserver::start_at(double time) {
+  origin_ = from_first_ ? time : 0;
+  const double steps = (time - origin_) / spec_->thermal.step;
+  if (steps > static_cast<double>(core::limits::kTimeSteps))
+    throw core::DataError(
+        "the first sample is at time_s = " + shown(time) +
+        ": the model starts at t = 0 at the machine's initial temperature and would march " +
+        std::to_string(static_cast<long long>(steps)) + " steps of " + shown(spec_->thermal.step) +
+        " s to it (more than " + std::to_string(core::limits::kTimeSteps) +
+        "); a clock's time is not a run's: take the first sample as t = 0");
 }
 
 void LiveObserver::assimilate(double time, const Eigen::Ref<const Eigen::VectorXd>& values,

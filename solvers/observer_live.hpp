@@ -19,22 +19,32 @@
 
 namespace tt::solvers {
 
+/// How a LiveObserver reads its stream beside the filter's own setup.
+struct LiveOptions {
+  /// > 0: the columns named after the setup's targets (in m) are read as drift readings on a
+  /// probe cycle of this period [s] (ProbeCycle), tested as observe tests them (DriftReadingTest)
+  double drift_every_s = 0;
+  /// the filter period [s]: a sample at least this long after the last assimilation (or with a
+  /// drift reading due) is assimilated, with the mean of the readings since (each sensor's mean
+  /// is one reading of its sigma); 0: every sample
+  double filter_every_s = 0;
+  /// the first sample read is t = 0 of the model (a cold start there), whatever its time_s says;
+  /// false: time_s is the time since the model's t = 0, as a recorded run's is
+  bool from_first_sample = false;
+};
+
 class LiveObserver {
  public:
   /// `declared`: the case (sinks, sources, films, feed axis, initial temperature); its duty cycle
   /// is the stream's. `sensors`: the setup's sensors (ids), in its order; columns: the stream's
   /// columns after time_s. Throws DataError naming the first column it reads (a sensor, or
   /// `speed_column`) that `columns` lacks, and the columns the stream has.
-  /// `drift_every_s` > 0: the columns named after the setup's targets (in m) are read as drift
-  /// readings on a probe cycle (ProbeCycle), tested as observe tests them (DriftReadingTest);
-  /// throws DataError when no column is named after a target.
-  /// `filter_every_s`: the filter period [s]; a sample at least this long after the last
-  /// assimilation (or with a drift reading due) is assimilated, with the mean of the readings
-  /// since (each sensor's mean is one reading of its sigma); 0: every sample.
+  /// With drift readings (options.drift_every_s > 0), throws DataError when no column is named
+  /// after a target.
   LiveObserver(const ReducedThermalSystem& system, const core::CaseSpec& declared,
                const ObserverSetup& setup, const std::vector<std::string>& sensors,
                const std::vector<std::string>& columns, const std::string& speed_column,
-               double drift_every_s = 0, double filter_every_s = 0);
+               const LiveOptions& options = {});
   ~LiveObserver();
   LiveObserver(const LiveObserver&) = delete;
   LiveObserver& operator=(const LiveObserver&) = delete;
@@ -45,7 +55,9 @@ class LiveObserver {
   /// period's mean, the speed held). Predicted drift and sigma per target [m] (the setup's
   /// targets); recalibrate once the observer raised it; faulty: the columns of the sensors
   /// whose offset test raised a fault (HeldBeyondMonitor); between assimilations, the last
-  /// assimilation's.
+  /// assimilation's. Throws DataError when the first sample is so late that the model would march
+  /// more than core::limits::kTimeSteps steps to it (a clock's time, not a run's: read it with
+  /// from_first_sample).
   const core::LiveStep& next(double time, const Eigen::Ref<const Eigen::VectorXd>& values);
 
   const std::vector<std::string>& target_names() const { return target_names_; }
@@ -65,6 +77,8 @@ class LiveObserver {
   std::vector<int> sensor_columns_, drift_columns_;
   int speed_column_ = -1;
   std::vector<std::string> target_names_;
+  /// The model's origin at the first sample read (its stream time): that time, or 0.
+  void start_at(double time);
   void assimilate(double time, const Eigen::Ref<const Eigen::VectorXd>& values, bool drift_due);
 
   double every_s_ = 0;
@@ -76,7 +90,9 @@ class LiveObserver {
   double held_speed_ = 0;  /// the last speed read, >= 0 [rpm]
   Eigen::VectorXd readings_;
   core::LiveStep step_;
-  double last_time_ = 0, assimilated_time_ = 0;
+  double last_time_ = 0, assimilated_time_ = 0;  /// the model's times [s]
+  bool from_first_ = false;
+  double origin_ = 0;  /// the stream's time of the model's t = 0 [s]
   long long assimilations_ = 0;
   bool started_ = false;
 };

@@ -249,6 +249,33 @@ TEST(ObserveCli, OffsetRunRaisesRecalibrateAndBadSensorIsRefused) {
   EXPECT_NE(rt::read_text(cut_log).find("header refused: column 'T08' is missing"),
             std::string::npos)
       << rt::read_text(cut_log);
+  // A stream on a clock's time (Unix time) is refused at its first sample, naming the file, the
+  // line and the time, unless its first sample is taken as t = 0.
+  const fs::path clock = dir / "clock.csv";
+  {
+    std::ofstream f(clock);
+    f << "time_s,speed_rpm,T02\n1700000000,1000,20\n1700000060,1000,20.1\n";
+  }
+  EXPECT_NE(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
+                     "--in", clock.string(), "--until-eof", "--sensors", "T02"},
+                    {}, cut_log),
+            0);
+  EXPECT_NE(rt::read_text(cut_log).find(clock.string() +
+                                        ": line 2: the first sample is at time_s = 1700000000"),
+            std::string::npos)
+      << rt::read_text(cut_log);
+  EXPECT_NE(rt::read_text(cut_log).find("--time-from-first-sample"), std::string::npos);
+  const fs::path from_first = dir / "clock_out.csv";
+  EXPECT_EQ(rt::run({"compensate", "--rom", rom.string(), "--case", rt::kCoarseCase.string(),
+                     "--in", clock.string(), "--until-eof", "--sensors", "T02",
+                     "--time-from-first-sample", "--out", from_first.string()},
+                    {}, cut_log),
+            0)
+      << rt::read_text(cut_log);
+  const auto clock_rows = tt::test::csv_rows(from_first);
+  ASSERT_EQ(clock_rows.size(), 2u);
+  EXPECT_EQ(clock_rows[1].at("time_s"), "1700000060");
+  EXPECT_EQ(clock_rows[1].at("status"), "ok");
   // 4. A sensor the model does not name: refused, naming it; nothing written.
   const fs::path bad = dir / "bad", bad_log = dir / "bad.log";
   EXPECT_NE(rt::run({"observe", rt::kCoarseCase.string(), "--rom", rom.string(), "--data",

@@ -871,7 +871,7 @@ TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
   const StreamedRun s = streamed_run(s_->clean, s_->spec, s_->twin, set);
   // A filter period shorter than the samples' spacing: one sample per period.
   solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
-                             "speed_rpm", 0, 1.0);
+                             "speed_rpm", {.filter_every_s = 1.0});
   double worst = 0;
   for (Eigen::Index i = 0; i < s.run.time.size(); ++i) {
     const core::LiveStep& step = live.next(s.run.time(i), s.values(i, i));
@@ -887,6 +887,33 @@ TEST_F(Observer, AStreamThroughTheLiveObserverIsTheRecordedRun) {
                core::DataError);
 }
 
+TEST_F(Observer, AStreamOnAClocksTimeStartsAtItsFirstSampleWhenAsked) {
+  // The run's times on a clock (Unix time): read as the time since the model's start, the first
+  // sample would be 54 years in, refused naming its time; with from_first_sample the first sample
+  // is t = 0 and the stream gives the recorded run.
+  const solvers::ObserverSetup set = setup(default_noise());
+  const StreamedRun s = streamed_run(s_->clean, s_->spec, s_->twin, set);
+  const double clock = 1.7e9;
+  solvers::LiveObserver since_start(s_->twin.model.system, s.declared, set, kSensors, s.columns,
+                                    "speed_rpm");
+  try {
+    since_start.next(clock + s.run.time(0), s.values(0, 0));
+    ADD_FAILURE() << "a first sample at a clock's time was marched to";
+  } catch (const core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("the first sample is at time_s = 1700000000"),
+              std::string::npos)
+        << e.what();
+  }
+  solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
+                             "speed_rpm", {.from_first_sample = true});
+  ASSERT_EQ(s.run.time(0), 0);
+  double worst = 0;
+  for (Eigen::Index i = 0; i < s.run.time.size(); ++i)
+    worst =
+        std::max(worst, step_gap(live.next(clock + s.run.time(i), s.values(i, i)), s.offline, i));
+  EXPECT_LE(worst, 1e-12 * s.offline.drift.cwiseAbs().maxCoeff());
+}
+
 TEST_F(Observer, ADenseStreamIsAssimilatedOncePerFilterPeriod) {
   // Five samples per recorded interval, the filter period the interval: four inside it carry the
   // interval's closing reading and the speed held over it, the fifth (at the recorded time) the
@@ -900,7 +927,7 @@ TEST_F(Observer, ADenseStreamIsAssimilatedOncePerFilterPeriod) {
   for (Eigen::Index i = 2; i < s.run.time.size(); ++i)
     ASSERT_NEAR(s.run.time(i) - s.run.time(i - 1), spacing, 1e-9) << "sample " << i;
   solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
-                             "speed_rpm", 0, spacing);
+                             "speed_rpm", {.filter_every_s = spacing});
   double worst = 0;
   long long samples = 0;
   for (Eigen::Index i = 0; i < s.run.time.size(); ++i) {
