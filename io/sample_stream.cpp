@@ -225,6 +225,7 @@ bool LineReader::next(std::string_view& line, const std::function<bool()>& befor
 }
 
 std::vector<std::string> stream_columns(std::string_view header, const std::string& origin) {
+  if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // a UTF-8 byte-order mark
   std::vector<std::string> fields;
   std::size_t start = 0;
   for (;;) {

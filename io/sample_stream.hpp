@@ -112,8 +112,9 @@ class LineReader {
   bool eof_ = false;
 };
 
-/// The columns after time_s of a stream's header line. Throws DataError naming `origin` when the
-/// first column is not time_s, or a column name is empty or repeated.
+/// The columns after time_s of a stream's header line (after a UTF-8 byte-order mark, which a
+/// spreadsheet may write). Throws DataError naming `origin` when the first column is not time_s,
+/// or a column name is empty or repeated.
 std::vector<std::string> stream_columns(std::string_view header, const std::string& origin);
 
 /// One sample line: false when it does not have 1 + values.size() fields. Otherwise time [s] (NaN

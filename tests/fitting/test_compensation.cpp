@@ -324,6 +324,9 @@ TEST(Compensation, FitJsonOfTheNetworkOrWithBadTermsIsRefusedNamingWhy) {
 TEST(Compensation, StreamLinesParseEmptyAndTextCellsAsMissing) {
   EXPECT_EQ(tt::io::stream_columns("time_s,speed_rpm,T07,dx\r", "s"),
             (std::vector<std::string>{"speed_rpm", "T07", "dx"}));
+  // A spreadsheet's UTF-8 byte-order mark before the header, as the measured-data reader takes it.
+  EXPECT_EQ(tt::io::stream_columns("\xEF\xBB\xBFtime_s,T07", "s"),
+            (std::vector<std::string>{"T07"}));
   EXPECT_THROW(tt::io::stream_columns("t,T07", "s"), tt::core::DataError);
   EXPECT_THROW(tt::io::stream_columns("time_s,T07,T07", "s"), tt::core::DataError);
   Eigen::VectorXd v(3);
