@@ -10,9 +10,11 @@
 # sensors ROM_SENSORS (default T17,T18,T16,T53,T54) and the speed through the reduced model of
 # ROM_CASE (default cases/sb1_coarse.toml; built with reduce --quick-validation into
 # OUT_DIR/rom_<case> unless there), read from a file to its end with the default 1 s filter period,
-# beside the same stream's first tenth with every sample assimilated and a 10-line stream (the
-# start: case, mesh check, model), each best of three; ROM_LINES=0 skips it. GM-1:
-#   ROM_CASE=cases/gm1_coarse.toml ROM_SENSORS=R08,R02,R05,R04 bench/compensate_throughput.sh
+# beside the same stream's first ROM_EVERY_LINES samples (default a tenth) with every sample
+# assimilated and a 10-line stream (the start: case, mesh check, model), each best of three;
+# ROM_LINES=0 skips it. GM-1 (every sample there costs about 70 ms):
+#   ROM_CASE=cases/gm1_coarse.toml ROM_SENSORS=R08,R02,R05,R04 ROM_EVERY_LINES=600 \
+#     bench/compensate_throughput.sh
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=${THERMOTWIN:-$here/build/thermotwin}
@@ -96,8 +98,8 @@ rom_stream() {  # rom_stream LINES FILE
   }' > "$2"
 }
 rom_stream "$rom_lines" "$out/stream_rom.csv"
-# The filter's reference: every sample assimilated, on a tenth of the samples.
-every_lines=$(( rom_lines / 10 > 10 ? rom_lines / 10 : 10 ))
+# The filter's reference: every sample assimilated, on ROM_EVERY_LINES samples (a tenth).
+every_lines=${ROM_EVERY_LINES:-$(( rom_lines / 10 > 10 ? rom_lines / 10 : 10 ))}
 rom_stream "$every_lines" "$out/stream_rom_every.csv"
 rom_stream 10 "$out/stream_rom_start.csv"
 rom_run() { "$bin" compensate --rom "$rom_dir" --in "$out/stream_rom.csv" --until-eof --out "$out/live_rom.csv"; }
