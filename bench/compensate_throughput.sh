@@ -113,8 +113,12 @@ import sys
 n, ne = int(sys.argv[1]), int(sys.argv[3])
 t, te, t0 = float(sys.argv[2]), float(sys.argv[4]), float(sys.argv[5])
 case = sys.argv[6]
-rate = n / max(t - t0, 1e-9)
 rate_every = ne / max(te - t0, 1e-9)
+if t - t0 <= 0.05 * t:
+    print(f"rom   {case}: {n} lines in {t:.3f} s, the start alone {t0:.3f} s: the samples' cost is "
+          f"within the start's spread; give more ROM_LINES")
+    sys.exit(0)
+rate = n / (t - t0)
 print(f"rom   {case}: {n} lines in {t:.3f} s ({n / t:.0f} lines/s with the start of {t0:.3f} s), "
       f"{rate:.0f} samples/s after it: {rate / 1000:.1f} times 1 kHz")
 print(f"rom   {case}, every sample assimilated (--filter-every-s 0): {ne} lines in {te:.3f} s, "
