@@ -216,6 +216,12 @@ core::CaseSpec case_for_run(const core::CaseSpec& declared, const io::MeasuredRu
   if (run.time.size() < 2)
     throw core::DataError("measured run '" + run.run + "': " + std::to_string(run.time.size()) +
                           " samples; expected at least 2");
+  try {
+    solvers::check_first_sample_time(run.time(0), declared.thermal.step);
+  } catch (const core::DataError& e) {
+    throw core::DataError("measured run '" + run.run + "' (" + (run.folder / "data.csv").string() +
+                          "): " + e.what());
+  }
   const Eigen::Index col = it - run.inputs.begin();
   core::CaseSpec spec = declared;
   spec.duty_cycle.segments.clear();

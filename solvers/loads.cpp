@@ -1,6 +1,7 @@
 #include "solvers/loads.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -134,6 +135,22 @@ void extend_duty_cycle(core::DutyCycle& cycle, double t, double speed_rpm) {
     cycle.segments.push_back({0.0, v});
   else if (v != cycle.segments.back().speed_rpm)
     cycle.segments.push_back({t, v});
+}
+
+void check_first_sample_time(double t, double step) {
+  const double steps = t / step;
+  if (!(steps > static_cast<double>(core::limits::kTimeSteps))) return;
+  char text[400];
+  const auto shown = [&text](double v) {
+    const auto [end, ec] = std::to_chars(text, text + sizeof text, v, std::chars_format::fixed);
+    return ec == std::errc() ? std::string(text, end) : std::to_string(v);
+  };
+  throw core::DataError("the first sample is at time_s = " + shown(t) +
+                        ": the model starts at t = 0 at the machine's initial temperature and "
+                        "would march " +
+                        std::to_string(static_cast<long long>(steps)) + " steps of " + shown(step) +
+                        " s to it (more than " + std::to_string(core::limits::kTimeSteps) +
+                        "); a clock's time is not a run's: time_s counts from the run's start");
 }
 
 namespace {

@@ -46,6 +46,12 @@ double next_switch(const core::CaseSpec& spec, double t);
 /// reading), a negative speed is 0, a missing (non-finite) one keeps the last; end becomes t.
 void extend_duty_cycle(core::DutyCycle& cycle, double t, double speed_rpm);
 
+/// Throws DataError when a run's first sample, at time t [s], lies more than
+/// core::limits::kTimeSteps steps of `step` [s] after t = 0, where a duty cycle read from samples
+/// starts and the machine is at its initial temperature: a clock's time (Unix time, a logger's time
+/// since power-on), not the time since the run's start, which would be marched to for hours.
+void check_first_sample_time(double t, double step);
+
 /// Step end times t_1 < ... < t_N = end: every switch is a step end; between switches the steps
 /// are equal and no longer than `max_step`. Throws SolverError beyond core::limits::kTimeSteps.
 std::vector<double> time_grid(const core::CaseSpec& spec, double max_step);

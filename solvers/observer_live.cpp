@@ -1,24 +1,15 @@
 #include "solvers/observer_live.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <limits>
 
 #include "core/errors.hpp"
-#include "core/limits.hpp"
 #include "solvers/loads.hpp"
 
 namespace tt::solvers {
 
 namespace {
-
-/// v in the shortest fixed-point form that reads back as v (a clock's time without an exponent).
-std::string shown(double v) {
-  char text[400];
-  const auto [end, ec] = std::to_chars(text, text + sizeof text, v, std::chars_format::fixed);
-  return ec == std::errc() ? std::string(text, end) : std::to_string(v);
-}
 
 int column_of(const std::string& name, const std::vector<std::string>& columns, const char* what) {
   const auto it = std::find(columns.begin(), columns.end(), name);
@@ -124,14 +115,7 @@ const core::LiveStep& LiveObserver::next(double stream_time,
 
 void LiveObserver::start_at(double time) {
   origin_ = from_first_ ? time : 0;
-  const double steps = (time - origin_) / spec_->thermal.step;
-  if (steps > static_cast<double>(core::limits::kTimeSteps))
-    throw core::DataError(
-        "the first sample is at time_s = " + shown(time) +
-        ": the model starts at t = 0 at the machine's initial temperature and would march " +
-        std::to_string(static_cast<long long>(steps)) + " steps of " + shown(spec_->thermal.step) +
-        " s to it (more than " + std::to_string(core::limits::kTimeSteps) +
-        "); a clock's time is not a run's: take the first sample as t = 0");
+  check_first_sample_time(time - origin_, spec_->thermal.step);
 }
 
 void LiveObserver::assimilate(double time, const Eigen::Ref<const Eigen::VectorXd>& values,

@@ -904,6 +904,18 @@ TEST_F(Observer, AStreamOnAClocksTimeStartsAtItsFirstSampleWhenAsked) {
               std::string::npos)
         << e.what();
   }
+  // A recorded run on a clock's time: refused where its duty cycle is read (observe, calibrate),
+  // naming its data.csv and the time.
+  io::MeasuredRun on_clock = s.run;
+  on_clock.time.array() += clock;
+  try {
+    calibration::case_for_run(s_->spec, on_clock);
+    ADD_FAILURE() << "a recorded run on a clock's time was read";
+  } catch (const core::DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("data.csv): the first sample is at time_s = 1700000000"),
+              std::string::npos)
+        << e.what();
+  }
   solvers::LiveObserver live(s_->twin.model.system, s.declared, set, kSensors, s.columns,
                              "speed_rpm", {.from_first_sample = true});
   ASSERT_EQ(s.run.time(0), 0);
