@@ -157,6 +157,8 @@ struct CompensateArgs {
   bool flush = false;         /// flush after every line (always on a terminal)
   /// output held for a reader that falls behind before lines are dropped [MiB]
   double max_behind_mib = 16.0;
+  /// MODEL=STREAM: the stream's column STREAM read as the model's MODEL (a sensor or an input)
+  std::vector<std::string> columns;
 };
 
 /// observe CASE --rom DIR --data RUN --out DIR: the physics observer on a measured run

@@ -4,7 +4,7 @@
 //   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [--filter-every-s S]
 //                         [observer options])
 //                         [--in FILE [--until-eof | --idle-s S]] [--out FILE] [--flush]
-//                         [--poll-ms MS] [--max-behind-mib M]
+//                         [--poll-ms MS] [--max-behind-mib M] [--column MODEL=STREAM ...]
 // Input: CSV lines in the measured-data format (docs/measured-data.md): a header time_s,<ids...>,
 // then one sample per line; on standard input (to its end) or from FILE, followed as it grows.
 // Output (stdout or FILE): time_s, <target>_predicted_um, <target>_sigma_um per target, status.
@@ -13,7 +13,7 @@
 //    reduced model checked against its case and mesh (as observe does).
 // 2. The stream's header bound to the model by name (fitting::Compensator, or
 //    solvers::LiveObserver on the sensors and speed_rpm): a column the model reads that the header
-//    lacks refuses the stream, naming it.
+//    lacks refuses the stream, naming it; --column reads a stream's column under the model's name.
 // 3. Sample by sample: parse, step the model (the observer once per filter period), write one
 //    line; output is buffered and written when the input pauses, per line with --flush or on a
 //    terminal, never waiting for its reader: lines beyond --max-behind-mib are dropped, and the
@@ -171,15 +171,59 @@ Binder observed_model(const CompensateArgs& args) {
   };
 }
 
-/// The stream's header read and the model bound to its columns; `columns` gets them.
+/// --column MODEL=STREAM, each as (the model's name, the stream's column). Throws DataError
+/// naming a value that is not of that form.
+std::vector<std::pair<std::string, std::string>> column_aliases(
+    const std::vector<std::string>& given) {
+  std::vector<std::pair<std::string, std::string>> aliases;
+  for (const std::string& a : given) {
+    const std::size_t eq = a.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == a.size() || a.find('=', eq + 1) != a.npos)
+      throw core::DataError("compensate: --column '" + a +
+                            "': expected MODEL=STREAM, the name the model reads and the stream's "
+                            "column, e.g. speed_rpm=spindle_rpm");
+    aliases.emplace_back(a.substr(0, eq), a.substr(eq + 1));
+  }
+  return aliases;
+}
+
+/// The stream's columns as the model reads them: each aliased column renamed. Throws DataError
+/// naming the stream when an alias's column is not in it, or its name already is.
+std::vector<std::string> model_columns(
+    std::vector<std::string> columns,
+    const std::vector<std::pair<std::string, std::string>>& aliases, const std::string& in_name) {
+  const std::vector<std::string> stream = columns;
+  for (const auto& [name, column] : aliases) {
+    const auto it = std::find(stream.begin(), stream.end(), column);
+    if (it == stream.end()) {
+      std::string listed;
+      for (const std::string& c : stream) listed += (listed.empty() ? "" : ", ") + c;
+      throw core::DataError(in_name + ": --column " + name + "=" + column +
+                            ": the stream has no "
+                            "column '" +
+                            column + "'; it has " + listed);
+    }
+    if (std::find(stream.begin(), stream.end(), name) != stream.end())
+      throw core::DataError(in_name + ": --column " + name + "=" + column +
+                            ": the stream has a column '" + name +
+                            "' already; read one of the two");
+    columns[static_cast<std::size_t>(it - stream.begin())] = name;
+  }
+  return columns;
+}
+
+/// The stream's header read and the model bound to its columns, read as `aliases` say;
+/// `columns` gets the stream's own names.
 BoundModel bound_to_header(const Binder& bind, io::LineReader& reader, const std::string& in_name,
+                           const std::vector<std::pair<std::string, std::string>>& aliases,
                            std::vector<std::string>& columns) {
   std::string_view line;
   if (!reader.next(line, {}))
     throw core::DataError(in_name + ": no header line; expected time_s and the sensor ids");
   columns = io::stream_columns(line, in_name);
+  const std::vector<std::string> read_as = model_columns(columns, aliases, in_name);
   try {
-    return bind(columns);
+    return bind(read_as);
   } catch (const core::DataError& e) {
     throw core::DataError(in_name + ": header refused: " + e.what());
   }
@@ -227,7 +271,8 @@ void predictions(io::LineReader& reader, const std::string& in_name, const Bound
 }  // namespace
 
 int compensate_command(const CompensateArgs& args) {
-  // 1. The model.
+  // 1. The model, and the stream's columns it reads under other names.
+  const auto aliases = column_aliases(args.columns);
   const Binder bind = args.rom.empty() ? fitted_model(args.model) : observed_model(args);
   // 2. The stream, its header bound to the model (the output is opened only then).
   const io::StreamFd in = io::StreamFd::reading(args.in);
@@ -238,7 +283,7 @@ int compensate_command(const CompensateArgs& args) {
   stop_on_signals();
   io::LineReader reader(in.fd(), in.name(), follow, &stop_requested);
   std::vector<std::string> columns;
-  const BoundModel model = bound_to_header(bind, reader, in.name(), columns);
+  const BoundModel model = bound_to_header(bind, reader, in.name(), aliases, columns);
   const io::StreamFd out = io::StreamFd::writing(args.out);
   io::BufferedWriter output(out.fd(), out.name(),
                             static_cast<std::size_t>(args.max_behind_mib * (1 << 20)));

@@ -336,7 +336,7 @@ Command calibrate_line(CLI::App& cli) {
 }
 
 /// compensate's input and output stream options: --in, --out, --until-eof, --idle-s, --poll-ms,
-/// --flush, --max-behind-mib.
+/// --flush, --max-behind-mib, --column.
 void add_stream_options(CLI::App& compensate, CompensateArgs& compensate_args) {
   auto* compensate_in = compensate.add_option(
       "--in", compensate_args.in, "CSV samples (default: standard input); followed as it grows");
@@ -365,6 +365,10 @@ void add_stream_options(CLI::App& compensate, CompensateArgs& compensate_args) {
                   "its reader; beyond this the lines not yet written are dropped and the next "
                   "line's status says dropped:N (default 16)")
       ->check(positive_number());
+  compensate.add_option("--column", compensate_args.columns,
+                        "MODEL=STREAM: read the stream's column STREAM as the model's sensor or "
+                        "input MODEL (a logger's own names, e.g. speed_rpm=spindle_rpm); "
+                        "repeatable. Statuses name the stream's columns");
 }
 
 /// `compensate --model FIT.json | --rom DIR`.

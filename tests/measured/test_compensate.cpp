@@ -141,6 +141,40 @@ TEST(Compensate, ReplayedRunGivesTheOfflinePredictions) {
   EXPECT_EQ(expect_offline_predictions(live, f), 2 * 330);
 }
 
+TEST(Compensate, ALoggersOwnColumnNamesAreReadAsTheModelsWhenMapped) {
+  // The held-out run with a logger's names for sensor a and the speed: refused as it is, naming
+  // the column the model reads; read with --column under the model's names, the offline
+  // predictions. A mapping to a column the stream lacks, or onto one it has, or not of the form
+  // MODEL=STREAM, is refused naming it, and nothing is written.
+  const Fitted& f = fitted();
+  std::string text = read_text(f.test_run / "data.csv");
+  const std::string header = text.substr(0, text.find('\n'));
+  ASSERT_EQ(header, "time_s,speed_rpm,a,b,c,p,q");
+  const fs::path renamed = f.dir / "logger.csv", live = f.dir / "logger_live.csv";
+  std::ofstream(renamed) << "time_s,spindle,ch_a,b,c,p,q" << text.substr(header.size());
+  const fs::path log = f.dir / "logger.log";
+  const std::vector<std::string> base{"compensate", "--model",        (f.fit / "fit.json").string(),
+                                      "--in",       renamed.string(), "--until-eof",
+                                      "--out",      live.string()};
+  EXPECT_NE(run(base, {}, log), 0);
+  EXPECT_NE(read_text(log).find("column 'a' is missing"), std::string::npos) << read_text(log);
+  std::vector<std::string> mapped = base;
+  mapped.insert(mapped.end(), {"--column", "a=ch_a", "--column", "speed_rpm=spindle"});
+  ASSERT_EQ(run(mapped, {}, log), 0) << read_text(log);
+  EXPECT_EQ(expect_offline_predictions(live, f), 2 * 330);
+  for (const auto& [alias, message] :
+       {std::pair<std::string, std::string>{"a=nope", "the stream has no column 'nope'"},
+        {"b=ch_a", "the stream has a column 'b' already"},
+        {"a", "expected MODEL=STREAM"}}) {
+    std::vector<std::string> bad = base;
+    bad.insert(bad.end(), {"--column", alias});
+    fs::remove(live);
+    EXPECT_NE(run(bad, {}, log), 0) << alias;
+    EXPECT_NE(read_text(log).find(message), std::string::npos) << read_text(log);
+    EXPECT_FALSE(fs::exists(live)) << alias;
+  }
+}
+
 TEST(Compensate, FollowsAGrowingFileAndHoldsABlankCell) {
   const Fitted& f = fitted();
   std::istringstream data(read_text(f.test_run / "data.csv"));
