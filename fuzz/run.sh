@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs one fuzz target for a while on its seed corpus plus the corpus it has grown so far.
-#   fuzz/run.sh case|measured|surface [SECONDS=3600] [BUILD_DIR=build-fuzz]
+#   fuzz/run.sh case|measured|surface|stream [SECONDS=3600] [BUILD_DIR=build-fuzz]
 # Findings go to BUILD_DIR/artifacts/<name>/, the log to BUILD_DIR/fuzz_<name>.log. Inputs that
 # found bugs are copied by hand to fuzz/regressions/<name>/ (tests/reliability replays them).
 set -euo pipefail
@@ -10,7 +10,8 @@ case "$name" in
   case) target=fuzz_case_reader; dict=fuzz/case.dict ;;
   measured) target=fuzz_measured_data; dict=fuzz/measured.dict ;;
   surface) target=fuzz_surface_reader; dict="" ;;
-  *) echo "usage: fuzz/run.sh case|measured|surface [SECONDS] [BUILD_DIR]" >&2; exit 2 ;;
+  stream) target=fuzz_sample_stream; dict="" ;;
+  *) echo "usage: fuzz/run.sh case|measured|surface|stream [SECONDS] [BUILD_DIR]" >&2; exit 2 ;;
 esac
 mkdir -p "$build/corpus/$name" "$build/artifacts/$name"
 # 10 s per input is a hang; 2 GB is a leak or an unbounded allocation.
