@@ -29,6 +29,7 @@
 #include "app/commands.hpp"
 #include "app/observer_options.hpp"
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "core/units.hpp"
 #include "fitting/compensation.hpp"
 #include "io/case_reader.hpp"
@@ -195,14 +196,10 @@ std::vector<std::string> model_columns(
   const std::vector<std::string> stream = columns;
   for (const auto& [name, column] : aliases) {
     const auto it = std::find(stream.begin(), stream.end(), column);
-    if (it == stream.end()) {
-      std::string listed;
-      for (const std::string& c : stream) listed += (listed.empty() ? "" : ", ") + c;
+    if (it == stream.end())
       throw core::DataError(in_name + ": --column " + name + "=" + column +
-                            ": the stream has no "
-                            "column '" +
-                            column + "'; it has " + listed);
-    }
+                            ": the stream has no column '" + column + "'; it has " +
+                            core::joined(stream));
     if (std::find(stream.begin(), stream.end(), name) != stream.end())
       throw core::DataError(in_name + ": --column " + name + "=" + column +
                             ": the stream has a column '" + name +

@@ -6,18 +6,12 @@
 
 #include "app/cli_numbers.hpp"
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "io/reports.hpp"
 #include "io/sigma_calibration_io.hpp"
 
 namespace tt::app {
 namespace {
-
-/// "a,b,c".
-std::string comma_joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& s : names) out += (out.empty() ? "" : ",") + s;
-  return out;
-}
 
 /// One value per name from an option: one value for all, or one each.
 Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<std::string>& names,
@@ -26,8 +20,9 @@ Eigen::VectorXd per_name(const std::vector<double>& values, const std::vector<st
   if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
   if (values.size() == names.size()) return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
   throw core::DataError(option + ": " + std::to_string(values.size()) + " values for " +
-                        std::to_string(names.size()) + " " + what + " (" + comma_joined(names) +
-                        "); expected one value for all or one per " + what + " in that order");
+                        std::to_string(names.size()) + " " + what + " (" +
+                        core::joined(names, ",") + "); expected one value for all or one per " +
+                        what + " in that order");
 }
 
 /// --expansion-relative-sigma per material of the set-up; none when every value is 0. DataError
@@ -118,13 +113,13 @@ void apply_sigma_calibration(const ObserverOptions& o, const io::SigmaCalibratio
         "--sigma-calibration " + file +
         ": give it or --drift-sigma-scale / --probed-drift-sigma-scale, not both");
   if (f.sensors != sensors)
-    throw core::DataError(file + ": sensors = " + comma_joined(f.sensors) +
+    throw core::DataError(file + ": sensors = " + core::joined(f.sensors, ",") +
                           ": calibrated for other " + "sensors than the ones read here (" +
-                          comma_joined(sensors) + "); calibrate again with these (--sensors)");
+                          core::joined(sensors, ",") + "); calibrate again with these (--sensors)");
   if (f.targets != setup.target_names)
-    throw core::DataError(file + ": targets = " + comma_joined(f.targets) +
+    throw core::DataError(file + ": targets = " + core::joined(f.targets, ",") +
                           ": calibrated on another reduced model (its targets are " +
-                          comma_joined(setup.target_names) + ")");
+                          core::joined(setup.target_names, ",") + ")");
   if (o.drift_readings_every_s > 0 && f.probe_every_s &&
       *f.probe_every_s != o.drift_readings_every_s)
     throw core::DataError(file + ": probe_cycle.every_s = " + std::to_string(*f.probe_every_s) +

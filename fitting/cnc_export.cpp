@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "core/units.hpp"
 #include "fitting/compensation.hpp"
 
@@ -234,8 +235,7 @@ Eigen::MatrixXd basis_states(const CncModel& model, const std::vector<std::strin
   needed.insert(needed.end(), model.features.input_names.begin(), model.features.input_names.end());
   for (const std::string& name : needed)
     if (std::find(columns.begin(), columns.end(), name) == columns.end()) {
-      std::string listed;
-      for (const std::string& c : columns) listed += (listed.empty() ? "" : ", ") + c;
+      const std::string listed = core::joined(columns);
       throw core::DataError("column '" + name + "' is missing: the exported models read '" + name +
                             "'; the samples have " + (listed.empty() ? "none" : listed));
     }

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "io/atomic_dir.hpp"
 
 namespace tt::io {
@@ -41,12 +42,6 @@ bool parsed_number(std::string_view cell, double& value) {
   if (cell.empty()) return false;
   const auto result = std::from_chars(cell.data(), cell.data() + cell.size(), value);
   return result.ec == std::errc() && result.ptr == cell.data() + cell.size();
-}
-
-std::string joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (const auto& name : names) text += (text.empty() ? "" : ", ") + name;
-  return text;
 }
 
 /// The file's text without a UTF-8 byte order mark.
@@ -118,7 +113,7 @@ int CsvTable::column_index(const std::string& name) const {
     if (header[c] == name) return static_cast<int>(c);
   }
   throw core::DataError(
-      core::located(source, 0, "no column '" + name + "'; columns are: " + joined(header)));
+      core::located(source, 0, "no column '" + name + "'; columns are: " + core::joined(header)));
 }
 
 Eigen::VectorXd CsvTable::column(const std::string& name) const {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "core/units.hpp"
 #include "io/atomic_dir.hpp"
 #include "io/reports.hpp"
@@ -145,10 +146,9 @@ std::string um_text(double metres) {
   return out.str();
 }
 
+/// The names joined by ", ", or "none".
 std::string joined(const std::vector<std::string>& names) {
-  std::string text;
-  for (std::size_t i = 0; i < names.size(); ++i) text += (i ? ", " : "") + names[i];
-  return text.empty() ? "none" : text;
+  return names.empty() ? "none" : core::joined(names);
 }
 
 /// "E_z [µm] = 1.2 + 3.4·dT[t1] − …" for a linear model; a summary line for PPR.

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/errors.hpp"
+#include "core/text.hpp"
 #include "solvers/loads.hpp"
 
 namespace tt::solvers {
@@ -14,8 +15,7 @@ namespace {
 int column_of(const std::string& name, const std::vector<std::string>& columns, const char* what) {
   const auto it = std::find(columns.begin(), columns.end(), name);
   if (it != columns.end()) return static_cast<int>(it - columns.begin());
-  std::string listed;
-  for (const std::string& c : columns) listed += (listed.empty() ? "" : ", ") + c;
+  const std::string listed = core::joined(columns);
   throw core::DataError("column '" + name + "' is missing: the observer reads " + what + " '" +
                         name + "'; the stream has " + (listed.empty() ? "none" : listed));
 }

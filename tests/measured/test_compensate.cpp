@@ -96,6 +96,14 @@ const Fitted& fitted() {
   return f;
 }
 
+/// The lines of a text file, without their line breaks.
+std::vector<std::string> lines_of(const fs::path& file) {
+  std::istringstream text(read_text(file));
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(text, l);) lines.push_back(l);
+  return lines;
+}
+
 /// compensation.csv's predicted_um keyed by (target, time_s).
 std::map<std::pair<std::string, double>, double> offline(const Fitted& f) {
   std::map<std::pair<std::string, double>, double> out;
@@ -177,9 +185,7 @@ TEST(Compensate, ALoggersOwnColumnNamesAreReadAsTheModelsWhenMapped) {
 
 TEST(Compensate, FollowsAGrowingFileAndHoldsABlankCell) {
   const Fitted& f = fitted();
-  std::istringstream data(read_text(f.test_run / "data.csv"));
-  std::vector<std::string> lines;
-  for (std::string l; std::getline(data, l);) lines.push_back(l);
+  const std::vector<std::string> lines = lines_of(f.test_run / "data.csv");
   const fs::path growing = f.dir / "growing.csv", live = f.dir / "followed.csv";
   {
     std::ofstream out(growing);
@@ -247,9 +253,7 @@ TEST(Compensate, AReaderThatFallsBehindCostsLinesNotThePace) {
   // the 0.25 MiB it may hold were full (about 4 000 lines). The reader then gets whole lines,
   // each gap said by the line after it (dropped:N), and written and dropped lines add up.
   const Fitted& f = fitted();
-  std::istringstream data(read_text(f.test_run / "data.csv"));
-  std::vector<std::string> lines;
-  for (std::string l; std::getline(data, l);) lines.push_back(l);
+  const std::vector<std::string> lines = lines_of(f.test_run / "data.csv");
   const fs::path stream = f.dir / "long.csv", fifo = f.dir / "slow_reader.fifo";
   const int samples = 200000;
   {
