@@ -38,15 +38,20 @@ FeatureMap feature_map(const ModelSpec& spec, const Group& group, const std::vec
 
 using Body = std::variant<LinearFit, PprModel, torchnet::Network>;
 
-/// Samples between two entries of a network window: window_span_s over (window_steps − 1), in
-/// units of the median sampling interval of the groups.
-int window_stride(const NetworkSettings& settings, const std::vector<Group>& groups) {
+/// The median interval between consecutive rows of the groups [s]; 0 with fewer than two rows.
+double median_interval(const std::vector<Group>& groups) {
   std::vector<double> dt;
   for (const Group& g : groups)
     for (Eigen::Index i = 1; i < g.time.size(); ++i) dt.push_back(g.time(i) - g.time(i - 1));
-  if (dt.empty() || !(settings.window_span_s > 0.0)) return 1;
+  if (dt.empty()) return 0.0;
   std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  const double median = dt[dt.size() / 2];
+  return dt[dt.size() / 2];
+}
+
+/// Samples between two entries of a network window: window_span_s over (window_steps − 1), in
+/// units of the median sampling interval.
+int window_stride(const NetworkSettings& settings, double median) {
+  if (!(median > 0.0) || !(settings.window_span_s > 0.0)) return 1;
   const double entries = std::max(1, settings.options.window_steps - 1);
   return std::max(1, static_cast<int>(std::lround(settings.window_span_s / entries / median)));
 }
@@ -285,7 +290,8 @@ std::vector<FittedModel> network_models(const ModelSpec& spec, const std::vector
   std::vector<FittedModel> models;
   for (int t : targets) models.push_back(unfitted_model(spec, groups, sensors, t));
   torchnet::NetworkOptions options = spec.network.options;
-  options.window_stride = window_stride(spec.network, groups);
+  options.sample_interval_s = median_interval(groups);
+  options.window_stride = window_stride(spec.network, options.sample_interval_s);
   const torchnet::Network network =
       network_fit(spec, options, models.front().features, groups, targets);
   int samples = 0;

@@ -198,6 +198,11 @@ void add_network(json& j, const FittedModel& model, const torchnet::Network& net
   j["output"] = model.output;  // of the network's outputs, the one this target reads
   j["window_steps"] = o.window_steps;
   j["window_stride_samples"] = o.window_stride;
+  if (o.sample_interval_s > 0.0) {
+    // The time between two entries of a window, for a stream sampled at another rate.
+    j["sample_interval_s"] = o.sample_interval_s;
+    j["window_spacing_s"] = o.window_stride * o.sample_interval_s;
+  }
   j["train_every_samples"] = o.train_every > 0 ? o.train_every : o.window_stride;
   j["input_mean_K"] = vector_json(net.input_mean());
   j["input_scale_K"] = vector_json(net.input_scale());

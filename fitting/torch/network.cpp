@@ -147,6 +147,7 @@ torch::jit::Module script_module(Net& net, const NetworkOptions& o, const Eigen:
   m.register_buffer("skip_b", float_tensor(skip.intercept));
   m.register_attribute("window_steps", c10::IntType::get(), o.window_steps);
   m.register_attribute("window_stride", c10::IntType::get(), o.window_stride);
+  m.register_attribute("sample_interval_s", c10::FloatType::get(), o.sample_interval_s);
   param("conv1_w", net->conv1->weight);
   param("conv1_b", net->conv1->bias);
   param("conv2_w", net->conv2->weight);
@@ -637,25 +638,84 @@ Network trained_network(const Sequences& fit_given, const Sequences& validation_
   return Network(impl);
 }
 
-Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
-                                       const std::vector<Eigen::MatrixXd>& windows) {
-  if (windows.empty()) return Eigen::MatrixXd(0, 0);
-  const Eigen::Index steps = windows.front().rows(), inputs = windows.front().cols();
-  for (const auto& w : windows)
-    if (w.rows() != steps || w.cols() != inputs)
-      throw core::DataError("TorchScript prediction on windows of different shapes; expected " +
-                            std::to_string(steps) + "x" + std::to_string(inputs) + " each");
+namespace {
+
+Eigen::VectorXd vector_of(const torch::Tensor& t) {
+  const torch::Tensor d = t.to(torch::kFloat64).contiguous().view(-1);
+  return Eigen::Map<const Eigen::VectorXd>(d.data_ptr<double>(), d.numel());
+}
+
+Eigen::MatrixXd matrix_of(const torch::Tensor& t) {
+  const torch::Tensor d = t.to(torch::kFloat64).contiguous();
+  Eigen::MatrixXd m(d.size(0), d.size(1));
+  for (int64_t i = 0; i < d.size(0); ++i)
+    for (int64_t j = 0; j < d.size(1); ++j) m(i, j) = d[i][j].item<double>();
+  return m;
+}
+
+/// The shape, standardisation and skip a file written by save_torchscript holds, into `n`.
+void read_script_buffers(Network::Impl& n, const std::string& name) {
+  const torch::jit::Module& m = n.script;
+  for (const char* key : {"in_mean", "in_scale", "out_mean", "out_scale", "skip_w", "skip_b",
+                          "window_steps", "window_stride"})
+    if (!m.hasattr(key))
+      throw core::DataError(name + ": a TorchScript module without '" + key +
+                            "': not a network thermotwin wrote (save_torchscript)");
+  n.options.window_steps = static_cast<int>(m.attr("window_steps").toInt());
+  n.options.window_stride = static_cast<int>(m.attr("window_stride").toInt());
+  // Files written before it was recorded: 0, not known.
+  if (m.hasattr("sample_interval_s"))
+    n.options.sample_interval_s = m.attr("sample_interval_s").toDouble();
+  n.options.threads = 1;
+  n.in_mean = vector_of(m.attr("in_mean").toTensor());
+  n.in_scale = vector_of(m.attr("in_scale").toTensor());
+  n.out_mean = vector_of(m.attr("out_mean").toTensor());
+  n.out_scale = vector_of(m.attr("out_scale").toTensor());
+  n.inputs = static_cast<int>(n.in_mean.size());
+  n.outputs = static_cast<int>(n.out_mean.size());
+  const torch::Tensor skip_w = m.attr("skip_w").toTensor();
+  if (n.inputs < 1 || n.outputs < 1 || n.in_scale.size() != n.inputs ||
+      n.out_scale.size() != n.outputs || skip_w.dim() != 2 || skip_w.size(0) != n.outputs ||
+      skip_w.size(1) != n.inputs || n.options.window_steps < 1 || n.options.window_stride < 1)
+    throw core::DataError(name + ": the network's buffers disagree on its shape (" +
+                          std::to_string(n.inputs) + " inputs, " + std::to_string(n.outputs) +
+                          " outputs, window " + std::to_string(n.options.window_steps) + ")");
+  LinearSkip skip{vector_of(m.attr("skip_b").toTensor()), matrix_of(skip_w), Eigen::VectorXd()};
+  // Zero buffers are the file's form of "no skip".
+  if (skip.intercept.any() || skip.weights.any()) n.skip = std::move(skip);
+  for (const auto& p : m.parameters()) {
+    const torch::Tensor flat = p.detach().contiguous().view(-1);
+    const float* d = flat.data_ptr<float>();
+    n.weights.insert(n.weights.end(), d, d + flat.numel());
+  }
+}
+
+}  // namespace
+
+Network loaded_network(const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file))
+    throw core::DataError(file.string() + ": no such network file");
+  auto impl = std::make_shared<Network::Impl>();
   TorchThreads threads(1);
-  torch::jit::Module module;
   try {
-    module = torch::jit::load(file.string());
+    impl->script = torch::jit::load(file.string());
+    impl->script.eval();
+    read_script_buffers(*impl, file.string());
   } catch (const c10::Error& e) {
     throw core::DataError(file.string() + ": not a TorchScript network (" +
                           e.what_without_backtrace() + ")");
   }
-  std::vector<float> x = raw_windows(windows);
-  return run_script(module, x, static_cast<int64_t>(windows.size()), static_cast<int>(steps),
-                    static_cast<int>(inputs));
+  return Network(impl);
+}
+
+Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
+                                       const std::vector<Eigen::MatrixXd>& windows) {
+  if (windows.empty()) return Eigen::MatrixXd(0, 0);
+  const Network network = loaded_network(file);
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(windows.size()), network.outputs());
+  for (std::size_t k = 0; k < windows.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) = network.window_prediction(windows[k]).transpose();
+  return out;
 }
 
 std::string parallel_info() {

@@ -25,6 +25,9 @@ struct NetworkOptions {
   int window_steps = 16;
   /// samples between two entries of a window
   int window_stride = 1;
+  /// the median interval between the rows trained on [s] (0: not known): with window_stride, the
+  /// time between two entries of a window, which a stream sampled at another rate needs
+  double sample_interval_s = 0.0;
   /// training and early-stopping windows end every this many samples (0: window_stride):
   /// neighbouring windows of a finely sampled run are nearly the same, and training on each one
   /// costs time without adding information
@@ -103,7 +106,8 @@ class Network {
   /// The network as TorchScript, with the standardisation inside: forward(x) takes a float32
   /// batch x window_steps x #inputs tensor in the training inputs' units and returns batch x
   /// #outputs in the outputs' units (the linear skip included: buffers skip_w, skip_b, zero
-  /// without one). Written to a temporary name and renamed.
+  /// without one); attributes window_steps, window_stride and sample_interval_s. Written to a
+  /// temporary name and renamed.
   void save_torchscript(const std::filesystem::path& file) const;
 
   int inputs() const;
@@ -136,8 +140,16 @@ Network trained_network(const Sequences& fit, const Sequences& validation,
                         const NetworkOptions& options,
                         const std::optional<LinearSkip>& skip = std::nullopt);
 
-/// Loads a file written by save_torchscript with torch::jit::load and runs it on windows (each
-/// window_steps x #inputs): #windows x #outputs. What another program does with the file.
+/// A network read back from a file written by save_torchscript (torch::jit::load): its window
+/// shape, standardisation and linear skip from the file's attributes and buffers, its predictions
+/// those of the network that was saved. Options other than window_steps, window_stride and
+/// sample_interval_s (0 in a file written before it was recorded) are defaults (threads 1); the
+/// training report is empty. Throws core::DataError naming the file when
+/// it is missing or not such a network.
+Network loaded_network(const std::filesystem::path& file);
+
+/// Loads a file written by save_torchscript and runs it on windows (each window_steps x #inputs):
+/// #windows x #outputs. What another program does with the file.
 Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
                                        const std::vector<Eigen::MatrixXd>& windows);
 
