@@ -147,6 +147,9 @@ struct CompensateArgs {
   /// with rom: the observer's period [s]: the samples of a period are assimilated as one reading
   /// (their mean), so a fast stream costs one covariance step per period; 0: every sample
   double filter_every_s = 1.0;
+  /// with model: a network is evaluated at a sample at least this long after its last
+  /// evaluation [s], its prediction held between; 0: every sample
+  double network_every_s = 1.0;
   /// with rom: the first sample is the model's t = 0 (a cold start there), whatever its time_s
   bool from_first_sample = false;
   std::filesystem::path in;   /// a CSV file, followed as it grows; empty: standard input

@@ -1,20 +1,22 @@
 // thermotwin compensate: live compensation from a fitted model, or from a reduced model through
 // the physics observer. Reads sensor samples as they arrive and writes, per sample, the predicted
 // thermal drift of every target with its uncertainty and a status.
-//   thermotwin compensate (--model FIT.json | --rom DIR [--case CASE] [--filter-every-s S]
-//                         [observer options])
+//   thermotwin compensate (--model FIT.json [--network-every-s S]
+//                          | --rom DIR [--case CASE] [--filter-every-s S] [observer options])
 //                         [--in FILE [--until-eof | --idle-s S]] [--out FILE] [--flush]
 //                         [--poll-ms MS] [--max-behind-mib M] [--column MODEL=STREAM ...]
 // Input: CSV lines in the measured-data format (docs/measured-data.md): a header time_s,<ids...>,
 // then one sample per line; on standard input (to its end) or from FILE, followed as it grows.
 // Output (stdout or FILE): time_s, <target>_predicted_um, <target>_sigma_um per target, status.
 // See docs/compensate.md for the statuses, the stop conditions and what is not covered.
-// 1. The model: the chosen model of each target from fit.json (io::read_deployed_models), or the
-//    reduced model checked against its case and mesh (as observe does).
+// 1. The model: the chosen model of each target from fit.json (io::read_deployed_models, a
+//    network from its TorchScript file beside it), or the reduced model checked against its case
+//    and mesh (as observe does).
 // 2. The stream's header bound to the model by name (fitting::Compensator, or
 //    solvers::LiveObserver on the sensors and speed_rpm): a column the model reads that the header
 //    lacks refuses the stream, naming it; --column reads a stream's column under the model's name.
-// 3. Sample by sample: parse, step the model (the observer once per filter period), write one
+// 3. Sample by sample: parse, step the model (the observer once per filter period, a network
+//    once per --network-every-s), write one
 //    line; output is buffered and written when the input pauses, per line with --flush or on a
 //    terminal, never waiting for its reader: lines beyond --max-behind-mib are dropped, and the
 //    next line's status says how many.
@@ -71,7 +73,7 @@ struct BoundModel {
 using Binder = std::function<BoundModel(const std::vector<std::string>&)>;
 
 /// fit.json's chosen models.
-Binder fitted_model(const std::filesystem::path& path) {
+Binder fitted_model(const std::filesystem::path& path, double network_every_s) {
   const std::vector<io::DeployedModel> deployed = io::read_deployed_models(path);
   std::vector<fitting::FittedModel> models;
   std::vector<std::string> targets;
@@ -81,8 +83,9 @@ Binder fitted_model(const std::filesystem::path& path) {
     targets.push_back(deployed[t].model.target_name);
     sigma(static_cast<Eigen::Index>(t)) = deployed[t].uncertainty;
   }
-  return [models, targets, sigma](const std::vector<std::string>& columns) {
-    auto compensator = std::make_shared<fitting::Compensator>(models, columns, sigma);
+  return [models, targets, sigma, network_every_s](const std::vector<std::string>& columns) {
+    auto compensator =
+        std::make_shared<fitting::Compensator>(models, columns, sigma, network_every_s);
     const auto next = [compensator](double t, const Eigen::VectorXd& v) -> const core::LiveStep& {
       return compensator->next(t, v);
     };
@@ -270,7 +273,8 @@ void predictions(io::LineReader& reader, const std::string& in_name, const Bound
 int compensate_command(const CompensateArgs& args) {
   // 1. The model, and the stream's columns it reads under other names.
   const auto aliases = column_aliases(args.columns);
-  const Binder bind = args.rom.empty() ? fitted_model(args.model) : observed_model(args);
+  const Binder bind =
+      args.rom.empty() ? fitted_model(args.model, args.network_every_s) : observed_model(args);
   // 2. The stream, its header bound to the model (the output is opened only then).
   const io::StreamFd in = io::StreamFd::reading(args.in);
   io::FollowOptions follow;

@@ -418,6 +418,13 @@ Command compensate_line(CLI::App& cli) {
       ->check(non_negative_number())
       ->needs(compensate_rom);
   compensate
+      ->add_option("--network-every-s", compensate_args.network_every_s,
+                   "with --model: a network (cnn_bigru_attention) is evaluated at a sample at "
+                   "least this long after its last evaluation [s] and its prediction held between "
+                   "(default 1; 0: every sample)")
+      ->check(non_negative_number())
+      ->needs(compensate_model);
+  compensate
       ->add_flag("--time-from-first-sample", compensate_args.from_first_sample,
                  "with --rom: the stream's first sample is the model's t = 0, a cold start at the "
                  "initial temperature, whatever its time_s (a clock's time); default: time_s is "

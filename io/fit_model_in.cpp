@@ -1,10 +1,13 @@
 #include "io/fit_model_in.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/errors.hpp"
 #include "core/units.hpp"
 #include "fitting/features.hpp"
+#include "fitting/torch/network.hpp"
 #include "io/fit_json_keys.hpp"
 
 namespace tt::io {
@@ -73,7 +76,8 @@ fitting::ModelSpec model_spec(const json& c, ModelKind kind, const Place& p,
   spec.use_inputs = settings.value("inputs", false);
   if (kind == ModelKind::ridge || kind == ModelKind::distributed_lag)
     spec.ridge_lambda = number_at(settings, "ridge_lambda", p, at + "settings.");
-  if (kind == ModelKind::distributed_lag) {
+  if (kind == ModelKind::distributed_lag ||
+      (kind == ModelKind::cnn_bigru_attention && settings.contains("time_constants_s"))) {
     const Eigen::VectorXd taus = vector_at(settings, "time_constants_s", p, at + "settings.");
     spec.time_constants.assign(taus.data(), taus.data() + taus.size());
     for (double tau : spec.time_constants)
@@ -133,14 +137,76 @@ fitting::LinearFit checked_linear(const json& c, const std::vector<std::string>&
   return fit;
 }
 
-fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::string& at) {
+/// `file`'s entries [m or K] against fit.json's `key` (in `scale` of them), to float32's
+/// precision: a file from another fit is refused.
+void require_same(const Eigen::VectorXd& file, const json& c, const std::string& key, double scale,
+                  const Place& p, const std::string& at, const std::filesystem::path& path) {
+  const Eigen::VectorXd given = vector_at(c, key, p, at, scale);
+  const double tolerance = 1e-5 * std::max(1.0, given.cwiseAbs().maxCoeff());
+  if (given.size() != file.size() || (given - file).cwiseAbs().maxCoeff() > tolerance)
+    throw core::DataError(p.at(at + key) + " does not match " + path.string() +
+                          ": the network file is from another fit; hint: give the fit.json it "
+                          "was written with");
+}
+
+/// The network of a cnn_bigru_attention model: its TorchScript file beside fit.json, checked
+/// against the shape and standardisation fit.json records; it holds the interval of the samples
+/// it was trained on, which with its stride sets the time between a window's entries.
+torchnet::Network checked_network(const json& c, fitting::FittedModel& m, const Place& p,
+                                  const std::string& at, const std::filesystem::path& dir) {
+  const std::string name = c.contains("file") && c["file"].is_string()
+                               ? c["file"].get<std::string>()
+                               : "network_" + p.target + ".pt";
+  const std::filesystem::path path = dir / name;
+  if (!std::filesystem::is_regular_file(path))
+    throw core::DataError(p.at(at + "kind") + " = 'cnn_bigru_attention': its weights, " +
+                          path.string() +
+                          ", are not there; hint: keep the network_<target>.pt files `fit` wrote "
+                          "beside fit.json");
+  const std::vector<std::string> expected = fitting::feature_names(m.features);
+  if (names_at(c, "inputs", p, at) != expected)
+    throw core::DataError(p.at(at + "inputs") + " = " + json(names_at(c, "inputs", p, at)).dump() +
+                          "; the model's sensors, inputs and time constants give " +
+                          json(expected).dump());
+  torchnet::Network net = torchnet::loaded_network(path);
+  const int steps = static_cast<int>(number_at(c, "window_steps", p, at));
+  const int stride = static_cast<int>(number_at(c, "window_stride_samples", p, at));
+  if (net.inputs() != static_cast<int>(expected.size()) || net.options().window_steps != steps ||
+      net.options().window_stride != stride)
+    throw core::DataError(path.string() + ": a network of " + std::to_string(net.inputs()) +
+                          " inputs on windows of " + std::to_string(net.options().window_steps) +
+                          " entries " + std::to_string(net.options().window_stride) +
+                          " samples apart; " + p.at(at) + " gives " +
+                          std::to_string(expected.size()) + ", " + std::to_string(steps) + " and " +
+                          std::to_string(stride) + ": the network file is from another fit");
+  require_same(net.input_mean(), c, "input_mean_K", 1.0, p, at, path);
+  require_same(net.output_mean(), c, "output_mean_um", um, p, at, path);
+  require_same(net.output_scale(), c, "output_scale_um", um, p, at, path);
+  m.output = static_cast<int>(number_at(c, "output", p, at));
+  if (m.output < 0 || m.output >= net.outputs())
+    throw core::DataError(p.at(at + "output") + " = " + std::to_string(m.output) + ": " +
+                          path.string() + " has " + std::to_string(net.outputs()) + " outputs");
+  const json& settings = c["settings"];
+  m.spec.network.options = net.options();
+  m.spec.network.window_span_s = settings.value("window_span_s", 0.0);
+  m.spec.network.options.sample_interval_s = net.options().sample_interval_s;
+  if (!(net.options().sample_interval_s > 0.0))
+    throw core::DataError(path.string() +
+                          ": the network does not record the interval of the samples it was "
+                          "trained on (a file written before compensate read networks), so the "
+                          "time between a window's entries is not known; hint: refit");
+  return net;
+}
+
+fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::string& at,
+                                     const std::optional<std::filesystem::path>& network_dir) {
   const json& kind_json = member(c, "kind", p, at);
   const ModelKind kind =
       kind_of(kind_json.is_string() ? kind_json.get<std::string>() : kind_json.dump(), p, at);
-  if (kind == ModelKind::cnn_bigru_attention)
+  if (kind == ModelKind::cnn_bigru_attention && !network_dir)
     throw core::DataError(p.at(at + "kind") +
-                          " = 'cnn_bigru_attention': compensate does not evaluate the network "
-                          "(its weights are in network_<target>.pt, not in fit.json); hint: refit "
+                          " = 'cnn_bigru_attention': the network is not evaluated here (its "
+                          "weights are in network_<target>.pt, not in fit.json); hint: refit "
                           "without --network, or use the linear, ridge, distributed_lag or "
                           "projection_pursuit kinds");
   fitting::FittedModel m;
@@ -148,18 +214,21 @@ fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::s
   m.spec = model_spec(c, kind, p, at);
   m.features = model_features(c, m.spec, p, at);
   const std::vector<std::string> expected = fitting::feature_names(m.features);
-  if (kind == ModelKind::projection_pursuit)
+  if (kind == ModelKind::cnn_bigru_attention)
+    m.body = checked_network(c, m, p, at, *network_dir);
+  else if (kind == ModelKind::projection_pursuit)
     m.body = checked_ppr(c, expected, p, at);
   else
     m.body = checked_linear(c, expected, p, at);
   return m;
 }
 
-DeployedModel deployed_model(const json& target, const Place& p) {
+DeployedModel deployed_model(const json& target, const Place& p,
+                             const std::optional<std::filesystem::path>& network_dir) {
   const json& chosen = member(target, "chosen", p, "");
   DeployedModel d;
-  d.model =
-      fitted_model_of(member(chosen, "coefficients", p, "chosen."), p, "chosen.coefficients.");
+  d.model = fitted_model_of(member(chosen, "coefficients", p, "chosen."), p, "chosen.coefficients.",
+                            network_dir);
   // The uncertainty: held-out residuals, test groups first.
   for (const char* groups : {"test", "validation"}) {
     if (!chosen.contains(groups) || !chosen[groups].contains("S_um")) continue;
@@ -182,7 +251,9 @@ DeployedModel deployed_model(const json& target, const Place& p) {
 
 }  // namespace
 
-std::vector<DeployedModel> deployed_models(const json& fit, const std::string& origin) {
+std::vector<DeployedModel> deployed_models(
+    const json& fit, const std::string& origin,
+    const std::optional<std::filesystem::path>& network_dir) {
   if (!fit.is_object() || !fit.contains("targets") || !fit["targets"].is_array() ||
       fit["targets"].empty())
     throw core::DataError(origin +
@@ -196,7 +267,7 @@ std::vector<DeployedModel> deployed_models(const json& fit, const std::string& o
     if (!name.is_string() || name.get<std::string>().empty())
       throw core::DataError(p.at("target") + " = " + name.dump() + ": expected a name");
     p.target = name.get<std::string>();
-    models.push_back(deployed_model(target, p));
+    models.push_back(deployed_model(target, p, network_dir));
     models.back().model.target = static_cast<int>(t);
   }
   return models;
@@ -204,7 +275,8 @@ std::vector<DeployedModel> deployed_models(const json& fit, const std::string& o
 
 fitting::FittedModel fitted_model_from_json(const json& coefficients, const std::string& origin,
                                             const std::string& target, const std::string& key) {
-  fitting::FittedModel m = fitted_model_of(coefficients, Place{origin, target}, key + ".");
+  fitting::FittedModel m =
+      fitted_model_of(coefficients, Place{origin, target}, key + ".", std::nullopt);
   m.target_name = target;
   return m;
 }
@@ -214,7 +286,7 @@ json read_fit_json(const std::filesystem::path& path) {
 }
 
 std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path) {
-  return deployed_models(read_fit_json(path), path.string());
+  return deployed_models(read_fit_json(path), path.string(), path.parent_path());
 }
 
 }  // namespace tt::io

@@ -1,11 +1,13 @@
 // The chosen model of each target read back from a fit.json that `thermotwin fit` or
 // `thermotwin fit --data` wrote (io/fitting_out.hpp's model_json), as a typed FittedModel that
 // fitting::predicted_error and fitting::Compensator evaluate. Linear kinds and projection pursuit
-// are read; the network kind is refused (its weights live in a TorchScript file, not in fit.json).
+// are read from fit.json; the network kind from its TorchScript file beside it
+// (network_<target>.pt), checked against what fit.json records of it.
 #pragma once
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,11 +28,14 @@ struct DeployedModel {
   std::string uncertainty_groups;
 };
 
-/// The chosen model of every target of a parsed fit.json; `origin` names the file in messages.
-/// Throws DataError naming the file, the target and the key for a missing or malformed key, a
-/// model kind that cannot be evaluated from fit.json (cnn_bigru_attention), or terms that do not
-/// match the model's sensors, inputs and time constants.
-std::vector<DeployedModel> deployed_models(const nlohmann::json& fit, const std::string& origin);
+/// The chosen model of every target of a parsed fit.json; `origin` names the file in messages;
+/// network_dir: where a network's TorchScript file is (nullopt: a network is refused). Throws
+/// DataError naming the file, the target and the key for a missing or malformed key, terms that do
+/// not match the model's sensors, inputs and time constants, or a network whose file is missing
+/// or from another fit.
+std::vector<DeployedModel> deployed_models(
+    const nlohmann::json& fit, const std::string& origin,
+    const std::optional<std::filesystem::path>& network_dir = std::nullopt);
 
 /// The model one model_json object describes (e.g. fit.json's axis.targets.<name>.coefficients),
 /// as deployed_models reads a target's chosen.coefficients; `origin`, `target` and `key` (the
@@ -42,8 +47,8 @@ fitting::FittedModel fitted_model_from_json(const nlohmann::json& coefficients,
 /// The parsed fit.json at `path`: IoError when it cannot be read, DataError when it is not JSON.
 nlohmann::json read_fit_json(const std::filesystem::path& path);
 
-/// deployed_models of the file at `path`; IoError when it cannot be read, DataError when it is
-/// not JSON.
+/// deployed_models of the file at `path`, its networks beside it; IoError when it cannot be read,
+/// DataError when it is not JSON.
 std::vector<DeployedModel> read_deployed_models(const std::filesystem::path& path);
 
 }  // namespace tt::io

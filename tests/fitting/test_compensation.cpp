@@ -18,11 +18,15 @@
 #include "io/fitting_out.hpp"
 #include "io/sample_stream.hpp"
 #include "synthetic.hpp"
+#include "tests/fitting/deployed.hpp"
 
 namespace {
 
 using namespace tt::fitting;
 using nlohmann::json;
+using tt::fitting::test::columns_of;
+using tt::fitting::test::fit_doc;
+using tt::fitting::test::sample_of;
 constexpr double um = 1e-6;
 constexpr double missing_value = std::numeric_limits<double>::quiet_NaN();
 
@@ -46,27 +50,6 @@ std::vector<Group> runs() {
     for (Eigen::Index i = 1; i < g.time.size(); ++i) g.time(i) += 7.0 * std::sin(0.3 * i);
   }
   return groups;
-}
-
-/// fit.json's form of one target's chosen model (io::model_json), with a test figure.
-json fit_doc(const FittedModel& model) {
-  json chosen{{"coefficients", tt::io::model_json(model)},
-              {"test", {{"S_um", {{"a", 0.3}, {"b", 0.4}}}}}};
-  return json{{"format", "thermotwin-fit/1"},
-              {"targets", json::array({{{"target", model.target_name}, {"chosen", chosen}}})}};
-}
-
-/// The group's columns as compensate's stream has them: sensors, then inputs.
-std::vector<std::string> columns_of(const Group& g) {
-  std::vector<std::string> c = g.sensor_names;
-  c.insert(c.end(), g.input_names.begin(), g.input_names.end());
-  return c;
-}
-
-Eigen::VectorXd sample_of(const Group& g, Eigen::Index i) {
-  Eigen::VectorXd v(g.temperature.cols() + g.inputs.cols());
-  v << g.temperature.row(i).transpose(), g.inputs.row(i).transpose();
-  return v;
 }
 
 /// The streamed predictions of a group [m], through fit.json and back.

@@ -1,16 +1,21 @@
 // The CNN-BiGRU-attention model kind (seed 004) on a short synthetic campaign: it learns a lagged
 // response better than a constant, gives the same weights and predictions twice for one seed,
 // round-trips through its TorchScript file, and is tried only with its own sensor sets; one network
-// trained on two targets at once (the patent's every-output model) serves both.
+// trained on two targets at once (the patent's every-output model) serves both; read back from
+// fit.json and its file, it is stepped live as compensate steps it.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "core/errors.hpp"
+#include "fitting/compensation.hpp"
 #include "fitting/models.hpp"
 #include "fitting/selection.hpp"
 #include "fitting/torch/network.hpp"
+#include "io/fit_model_in.hpp"
+#include "tests/fitting/deployed.hpp"
 #include "tests/fitting/synthetic.hpp"
 
 using namespace tt::fitting;
@@ -270,4 +275,136 @@ TEST(NetworkWithLinearSkip, ChoosesItsOwnStrengthOnlyOnAContinuousRun) {
   ASSERT_EQ(own.size(), 1);
   EXPECT_LT(own(0), 10.0);
   EXPECT_GE(own(0), 1e-6);
+}
+
+// The network live: fit.json's record of it and its TorchScript file read back and stepped
+// sample by sample by the compensator give the in-memory model's predictions.
+
+namespace {
+
+/// The campaign with a spindle speed that follows sensor 1's heat, read as an operating input.
+std::vector<Group> with_speed(std::vector<Group> groups) {
+  for (Group& g : groups) {
+    g.inputs = (increment(g, 0) * 400.0).array() + 1000.0;
+    g.input_names = {"speed_rpm"};
+  }
+  return groups;
+}
+
+/// A network with the parts compensate must carry: a lagged feature, an input, and a linear skip
+/// when asked (with one, the network may add next to nothing to the skip).
+FittedModel deployable_network(const std::vector<Group>& fit, bool skip) {
+  ModelSpec spec = small_network();
+  spec.network.linear_skip = skip;
+  spec.ridge_lambda = 1e-3;
+  spec.time_constants = {2400.0};
+  spec.use_inputs = true;
+  return fitted_model(spec, fit, {0, 1, 3}, 0);
+}
+
+/// A fresh directory under the build tree.
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::path(TT_BINARY_DIR) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+/// The DataError message deployed_models gives, or "" when it reads the document.
+std::string refusal(const nlohmann::json& doc, const std::filesystem::path& dir) {
+  try {
+    tt::io::deployed_models(doc, "fit.json", dir);
+  } catch (const tt::core::DataError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(NetworkCompensation, StreamedFromFitJsonAndItsFileGivesTheOfflinePredictions) {
+  const auto groups = with_speed(campaign(5, 91, lagged_truth, 0.1 * um, 4));
+  const FittedModel model = deployable_network(group_subset(groups, {0, 1, 2}), false);
+  const auto dir = fresh_dir("test_network_compensation");
+  std::get<tt::torchnet::Network>(model.body).save_torchscript(dir / "network_z.pt");
+  const auto deployed = tt::io::deployed_models(tt::fitting::test::fit_doc(model), "fit.json", dir);
+  ASSERT_EQ(deployed.size(), 1u);
+  const FittedModel& read = deployed[0].model;
+  const auto& net = std::get<tt::torchnet::Network>(read.body);
+  EXPECT_EQ(net.options().sample_interval_s, 60.0);
+  EXPECT_EQ(net.options().window_stride, 9);  // 3600 s over 7 spacings of 60 s, rounded
+  EXPECT_GT(std::get<tt::torchnet::Network>(model.body).report().best_epoch, 0);
+  EXPECT_EQ(read.features.time_constants, std::vector<double>{2400.0});
+  const Group& held_out = groups[4];
+  const Eigen::VectorXd offline = predicted_error(model, held_out);
+  ASSERT_GT(offline.cwiseAbs().maxCoeff(), 0.5 * um);
+  // Sample by sample: every sample evaluated, then once per half hour and held between.
+  for (const double every : {0.0, 1800.0}) {
+    SCOPED_TRACE(every);
+    Compensator c({read}, tt::fitting::test::columns_of(held_out), {}, every);
+    double evaluated = -1e300, held = 0.0;
+    int evaluations = 0;
+    for (Eigen::Index i = 0; i < held_out.time.size(); ++i) {
+      const LiveStep& s = c.next(held_out.time(i), tt::fitting::test::sample_of(held_out, i));
+      ASSERT_EQ(s.status, SampleStatus::ok);
+      if (held_out.time(i) - evaluated >= every) {
+        evaluated = held_out.time(i);
+        held = offline(i);
+        ++evaluations;
+      }
+      EXPECT_NEAR(s.predicted(0), held, 1e-4 * um) << "sample " << i;
+    }
+    EXPECT_EQ(evaluations, every > 0.0 ? 11 : static_cast<int>(held_out.time.size()));
+  }
+}
+
+TEST(NetworkCompensation, AWindowOfADenseStreamReadsItsPastAtTheTrainingSpacing) {
+  // A row linear in time is read back exactly by interpolation, wherever the entries fall; a
+  // stream 600 times denser than the rows kept holds one row per keep_every.
+  WindowHistory history(8, 540.0, 60.0);
+  const auto row = [](double t) { return Eigen::Vector2d(t, 3.0 - 2.0 * t); };
+  for (int i = 0; i <= 36000; ++i) {
+    const double t = 0.1 * i;
+    history.push(t, row(t));
+    if (i % 9001 != 0 && i != 36000) continue;
+    const Eigen::MatrixXd w = history.window();
+    ASSERT_EQ(w.rows(), 8);
+    for (int j = 0; j < 8; ++j) {
+      const double at = std::max(0.0, t - (7 - j) * 540.0);  // the first row before the start
+      EXPECT_NEAR(w(j, 0), row(at)(0), 1e-9) << "t " << t << " entry " << j;
+      EXPECT_NEAR(w(j, 1), row(at)(1), 1e-9) << "t " << t << " entry " << j;
+    }
+  }
+  EXPECT_LE(history.kept(), 7u * 9u + 2u);
+  EXPECT_THROW(WindowHistory(8, 0.0, 60.0), tt::core::DataError);
+}
+
+TEST(NetworkCompensation, AMissingOrForeignNetworkFileIsRefusedNamingIt) {
+  const auto groups = with_speed(campaign(5, 91, lagged_truth, 0.1 * um, 4));
+  const FittedModel model = deployable_network(group_subset(groups, {0, 1, 2}), true);
+  const auto dir = fresh_dir("test_network_compensation_refused");
+  const nlohmann::json doc = tt::fitting::test::fit_doc(model);
+  EXPECT_NE(refusal(doc, dir).find("network_z.pt"), std::string::npos) << refusal(doc, dir);
+  // The file of a network fitted on other runs.
+  const FittedModel other = deployable_network(group_subset(groups, {3, 4}), true);
+  std::get<tt::torchnet::Network>(other.body).save_torchscript(dir / "network_z.pt");
+  EXPECT_NE(refusal(doc, dir).find("another fit"), std::string::npos) << refusal(doc, dir);
+  std::get<tt::torchnet::Network>(model.body).save_torchscript(dir / "network_z.pt");
+  EXPECT_EQ(refusal(doc, dir), "");
+  EXPECT_TRUE(
+      std::get<tt::torchnet::Network>(tt::io::deployed_models(doc, "fit.json", dir)[0].model.body)
+          .linear_skip()
+          .has_value());
+  // Not a TorchScript file.
+  std::ofstream(dir / "network_z.pt") << "not a network\n";
+  EXPECT_NE(refusal(doc, dir).find("not a TorchScript network"), std::string::npos)
+      << refusal(doc, dir);
+  std::get<tt::torchnet::Network>(model.body).save_torchscript(dir / "network_z.pt");
+  // fit.json's record of another network's inputs.
+  nlohmann::json other_inputs = doc;
+  other_inputs["targets"][0]["chosen"]["coefficients"]["input_mean_K"][0] = 9.0;
+  EXPECT_NE(refusal(other_inputs, dir).find("input_mean_K does not match"), std::string::npos)
+      << refusal(other_inputs, dir);
+  // Where no directory is given (the CNC export), a network is not read.
+  EXPECT_THROW(tt::io::deployed_models(doc, "fit.json"), tt::core::DataError);
 }
