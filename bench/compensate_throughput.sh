@@ -15,9 +15,7 @@
 # ROM_LINES=0 skips it. GM-1 (every sample there costs about 70 ms):
 #   ROM_CASE=cases/gm1_coarse.toml ROM_SENSORS=R08,R02,R05,R04 ROM_EVERY_LINES=600 \
 #     bench/compensate_throughput.sh
-set -euo pipefail
-here=$(cd "$(dirname "$0")/.." && pwd)
-bin=${THERMOTWIN:-$here/build/thermotwin}
+source "$(dirname "$0")/common.sh"
 lines=${1:-1000000}
 out=${2:-$(mktemp -d)}
 mkdir -p "$out"
@@ -50,17 +48,6 @@ awk -v n="$lines" 'BEGIN {
       20 + 0.000002 * i, 19.5 + 0.05 * sin(t / 11), 0.001 * i, -0.0005 * i
   }
 }' > "$out/stream.csv"
-best() {  # best wall time [s] of three runs of "$@"
-  local b=""
-  for _ in 1 2 3; do
-    local s e
-    s=$(date +%s.%N)
-    "$@"
-    e=$(date +%s.%N)
-    b=$(/usr/bin/python3 -c "import sys; t=$e-$s; b='$b'; print(t if not b else min(t, float(b)))")
-  done
-  echo "$b"
-}
 file_run() { "$bin" compensate --model "$out/fit.json" --in "$out/stream.csv" --until-eof --out "$out/live.csv"; }
 pipe_run() { cat "$out/stream.csv" | "$bin" compensate --model "$out/fit.json" > "$out/live_pipe.csv"; }
 flush_run() { cat "$out/stream.csv" | "$bin" compensate --model "$out/fit.json" --flush > "$out/live_flush.csv"; }
@@ -97,31 +84,7 @@ rom_stream() {  # rom_stream LINES FILE
     }
   }' > "$2"
 }
-rom_stream "$rom_lines" "$out/stream_rom.csv"
 # The filter's reference: every sample assimilated, on ROM_EVERY_LINES samples (a tenth).
 every_lines=${ROM_EVERY_LINES:-$(( rom_lines / 10 > 10 ? rom_lines / 10 : 10 ))}
-rom_stream "$every_lines" "$out/stream_rom_every.csv"
-rom_stream 10 "$out/stream_rom_start.csv"
-rom_run() { "$bin" compensate --rom "$rom_dir" --in "$out/stream_rom.csv" --until-eof --out "$out/live_rom.csv"; }
-every_run() { "$bin" compensate --rom "$rom_dir" --filter-every-s 0 --in "$out/stream_rom_every.csv" --until-eof --out "$out/live_rom_every.csv"; }
-start_run() { "$bin" compensate --rom "$rom_dir" --in "$out/stream_rom_start.csv" --until-eof --out /dev/null; }
-t=$(best rom_run)
-t_every=$(best every_run)
-t_start=$(best start_run)
-/usr/bin/python3 - "$rom_lines" "$t" "$every_lines" "$t_every" "$t_start" "$(basename "$rom_case")" <<'PY'
-import sys
-n, ne = int(sys.argv[1]), int(sys.argv[3])
-t, te, t0 = float(sys.argv[2]), float(sys.argv[4]), float(sys.argv[5])
-case = sys.argv[6]
-rate_every = ne / max(te - t0, 1e-9)
-if t - t0 <= 0.05 * t:
-    print(f"rom   {case}: {n} lines in {t:.3f} s, the start alone {t0:.3f} s: the samples' cost is "
-          f"within the start's spread; give more ROM_LINES")
-    sys.exit(0)
-rate = n / (t - t0)
-print(f"rom   {case}: {n} lines in {t:.3f} s ({n / t:.0f} lines/s with the start of {t0:.3f} s), "
-      f"{rate:.0f} samples/s after it: {rate / 1000:.1f} times 1 kHz")
-print(f"rom   {case}, every sample assimilated (--filter-every-s 0): {ne} lines in {te:.3f} s, "
-      f"{rate_every:.0f} samples/s after the start; the 1 s period is {rate / rate_every:.1f} times faster")
-PY
-echo "statuses (rom): $(awk -F, 'NR > 1 { print $NF }' "$out/live_rom.csv" | sort | uniq -c | tr '\n' ' ')"
+echo "rom: $(basename "$rom_case")"
+period_and_every rom --filter-every-s "$rom_lines" "$every_lines" rom_stream "$out" --rom "$rom_dir"
