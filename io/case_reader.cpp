@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/csv_cells.hpp"
 #include "core/errors.hpp"
 #include "core/limits.hpp"
 
@@ -747,22 +748,20 @@ std::vector<core::DutyCycle::Segment> parse_duty_cycle_csv(const std::string& by
   auto csv_fail = [&](int line, const std::string& msg) -> void {
     throw CaseError(core::located(file.string(), line, msg + where));
   };
-  auto trim = [](std::string s) {
-    const auto b = s.find_first_not_of(" \t\r");
-    const auto e = s.find_last_not_of(" \t\r");
-    return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-  };
   std::vector<core::DutyCycle::Segment> out;
   std::string text;
   int line = 0;
   bool header = false;
   while (std::getline(in, text)) {
     ++line;
-    text = trim(text);
+    text = std::string(core::trimmed(text));
     if (text.empty() || text[0] == '#') continue;
-    const auto comma = text.find(',');
-    const std::string a = trim(text.substr(0, comma));
-    const std::string b = comma == std::string::npos ? std::string() : trim(text.substr(comma + 1));
+    std::size_t at = 0;
+    const std::string a(core::next_cell(text, at));
+    // The rest of the line is the second cell: a third cell makes it no number.
+    const std::string b(at == std::string::npos
+                            ? std::string_view()
+                            : core::cell_content(std::string_view(text).substr(at)));
     if (!header) {
       if (a != "time_s" || b != "speed_rpm")
         csv_fail(line, "header = \"" + text + "\": expected \"time_s,speed_rpm\"");
@@ -772,12 +771,11 @@ std::vector<core::DutyCycle::Segment> parse_duty_cycle_csv(const std::string& by
     double v[2];
     const std::string cells[2] = {a, b};
     for (int i = 0; i < 2; ++i) {
-      const char* first = cells[i].data();
-      const char* last = first + cells[i].size();
-      const auto r = std::from_chars(first, last, v[i]);
-      if (cells[i].empty() || r.ec != std::errc() || r.ptr != last || !std::isfinite(v[i]))
+      const std::optional<double> number = core::cell_number(cells[i]);
+      if (!number || !std::isfinite(*number))
         csv_fail(line, std::string(i ? "speed_rpm" : "time_s") + " = \"" + cells[i] +
                            "\": expected a finite number");
+      v[i] = *number;
     }
     if (out.empty() && v[0] != 0)
       csv_fail(line, "time_s = " + number_text(v[0]) + ": the first row must start at 0");

@@ -3,10 +3,12 @@
 #include <array>
 #include <charconv>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string_view>
 
+#include "core/csv_cells.hpp"
 #include "core/errors.hpp"
 #include "core/text.hpp"
 #include "io/atomic_dir.hpp"
@@ -17,31 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string_view trimmed(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
 std::vector<std::string_view> split_cells(std::string_view line) {
   std::vector<std::string_view> cells;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    cells.push_back(trimmed(line.substr(start, comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
+  for (std::size_t at = 0; at != std::string_view::npos;)
+    cells.push_back(core::next_cell(line, at));
   return cells;
-}
-
-/// The number in `cell`, or false when the whole cell is not one number.
-bool parsed_number(std::string_view cell, double& value) {
-  if (cell.starts_with('+')) cell.remove_prefix(1);
-  if (cell.empty()) return false;
-  const auto result = std::from_chars(cell.data(), cell.data() + cell.size(), value);
-  return result.ec == std::errc() && result.ptr == cell.data() + cell.size();
 }
 
 /// The file's text without a UTF-8 byte order mark.
@@ -65,10 +47,7 @@ std::vector<std::string> header_names(const std::vector<std::string_view>& cells
   std::vector<std::string> header;
   std::set<std::string> seen;
   for (std::size_t c = 0; c < cells.size(); ++c) {
-    std::string_view name = cells[c];
-    if (name.size() >= 2 && name.front() == '"' && name.back() == '"') {
-      name = trimmed(name.substr(1, name.size() - 2));
-    }
+    const std::string_view name = cells[c];
     if (name.empty()) {
       throw core::DataError(core::located(
           source, line_number,
@@ -95,14 +74,14 @@ void append_row(const std::vector<std::string_view>& cells, const CsvTable& tabl
                           std::to_string(table.header.size()) + " (one per header column)"));
   }
   for (std::size_t c = 0; c < cells.size(); ++c) {
-    double value = 0.0;
-    if (!parsed_number(cells[c], value)) {
+    const std::optional<double> number = core::cell_number(cells[c]);
+    if (!number) {
       throw core::DataError(core::located(
           table.source, line_number,
           "column " + std::to_string(c + 1) + " (" + table.header[c] + ") = '" +
               std::string(cells[c]) + "': expected a number; hint: write missing values as nan"));
     }
-    values.push_back(value);
+    values.push_back(*number);
   }
 }
 
@@ -133,7 +112,7 @@ void write_csv(const fs::path& path, const std::vector<std::string>& header,
   }
   for (const std::string& name : header) {
     if (name.empty() || name.find_first_of(",\"\r\n") != std::string::npos ||
-        trimmed(name) != name) {
+        core::trimmed(name) != name) {
       throw core::DataError(path.string() + ": CSV column name '" + name +
                             "': expected a non-empty name without commas, quotes, line breaks "
                             "or surrounding spaces; hint: use e.g. T02_degC");
@@ -166,7 +145,7 @@ CsvTable read_numeric_csv(const fs::path& path) {
   int line_number = 0;
   while (std::getline(lines, line)) {
     ++line_number;
-    const std::string_view content_view = trimmed(line);
+    const std::string_view content_view = core::trimmed(line);
     if (content_view.empty() || content_view.starts_with('#')) continue;
     const auto cells = split_cells(content_view);
     if (table.header.empty()) {

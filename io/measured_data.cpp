@@ -6,10 +6,12 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string_view>
 
+#include "core/csv_cells.hpp"
 #include "core/errors.hpp"
 #include "core/limits.hpp"
 #include "core/units.hpp"
@@ -339,13 +341,6 @@ MeasuredRun run_from_meta(const fs::path& file, const MeasuredReadLimits& limits
   return run;
 }
 
-std::string_view trimmed(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
 /// Streams data.csv line by line through a fixed buffer, so memory holds one chunk and the values.
 class LineReader {
  public:
@@ -412,10 +407,8 @@ std::vector<ColumnSlot> header_slots(const fs::path& file, std::string_view line
     expected[run.displacements[i].id] = {ColumnRole::probe, static_cast<int>(i)};
   std::vector<ColumnSlot> slots;
   std::map<std::string, int> seen;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    const std::string name(trimmed(line.substr(start, comma - start)));
+  for (std::size_t at = 0; at != std::string_view::npos;) {
+    const std::string name(core::next_cell(line, at));
     const int column = static_cast<int>(slots.size()) + 1;
     const std::string where = "column " + std::to_string(column) + " '" + name + "'";
     if (const auto it = seen.find(name); it != seen.end())
@@ -438,8 +431,6 @@ std::vector<ColumnSlot> header_slots(const fs::path& file, std::string_view line
     seen[name] = column;
     slots.push_back(it->second);
     names.push_back(name);
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
   }
   for (const auto& [name, slot] : expected)
     if (!seen.contains(name))
@@ -472,11 +463,11 @@ double cell_value(const fs::path& file, int number, const std::string& where, st
                   ColumnRole role, bool first_column) {
   double value = std::numeric_limits<double>::quiet_NaN();
   if (!cell.empty()) {
-    const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
-    const auto result = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    if (result.ec != std::errc() || result.ptr != digits.data() + digits.size() || digits.empty())
+    const std::optional<double> parsed = core::cell_number(cell);
+    if (!parsed)
       throw core::DataError(core::located(file.string(), number,
                                           where + ": '" + cell_text(cell) + "' is not a number"));
+    value = *parsed;
     if (!std::isfinite(value))
       throw core::DataError(
           core::located(file.string(), number,
@@ -500,15 +491,14 @@ double cell_value(const fs::path& file, int number, const std::string& where, st
 void append_row(const fs::path& file, int number, std::string_view line, const Columns& header,
                 double& last_time, std::vector<double>& values) {
   const std::size_t columns = header.slots.size();
-  std::size_t start = 0, column = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
+  std::size_t column = 0;
+  for (std::size_t at = 0; at != std::string_view::npos;) {
     if (column >= columns)
       throw core::DataError(core::located(file.string(), number,
                                           "column " + std::to_string(column + 1) +
                                               ": more cells than the " + std::to_string(columns) +
                                               " columns of the header"));
-    const std::string_view cell = trimmed(line.substr(start, comma - start));
+    const std::string_view cell = core::next_cell(line, at);
     const std::string where =
         "column " + std::to_string(column + 1) + " '" + header.names[column] + "'";
     const double value =
@@ -525,8 +515,6 @@ void append_row(const fs::path& file, int number, std::string_view line, const C
     }
     values.push_back(value);
     ++column;
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
   }
   if (column != columns)
     throw core::DataError(core::located(file.string(), number,
@@ -583,7 +571,7 @@ void read_samples(const fs::path& file, const MeasuredReadLimits& limits, Measur
   std::size_t rows = 0;
   double last_time = -std::numeric_limits<double>::infinity();
   while (reader.next(line)) {
-    if (trimmed(line).empty()) continue;
+    if (core::trimmed(line).empty()) continue;
     const int number = reader.line_number();
     if (++rows > limits.max_rows)
       throw core::DataError(core::located(file.string(), number,

@@ -13,9 +13,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <set>
 #include <thread>
 
+#include "core/csv_cells.hpp"
 #include "core/errors.hpp"
 
 namespace tt::io {
@@ -24,22 +26,10 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::string_view trimmed(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-    s.remove_suffix(1);
-  return s;
-}
-
 /// A cell as a finite number, else NaN (empty, text, nan, inf).
-double cell_value(std::string_view cell) {
-  cell = trimmed(cell);
-  if (cell.empty()) return nan;
-  if (cell.front() == '+') cell.remove_prefix(1);
-  double v = nan;
-  const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
-  if (ec != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v)) return nan;
-  return v;
+double cell_value(std::string_view content) {
+  const std::optional<double> v = core::cell_number(content);
+  return v && std::isfinite(*v) ? *v : nan;
 }
 
 void append_number(std::string& out, double v) {
@@ -227,13 +217,8 @@ bool LineReader::next(std::string_view& line, const std::function<bool()>& befor
 std::vector<std::string> stream_columns(std::string_view header, const std::string& origin) {
   if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // a UTF-8 byte-order mark
   std::vector<std::string> fields;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = header.find(',', start);
-    fields.emplace_back(trimmed(header.substr(start, comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
+  for (std::size_t at = 0; at != std::string_view::npos;)
+    fields.emplace_back(core::next_cell(header, at));
   if (fields.front() != "time_s")
     throw core::DataError(origin + ": header line 1 column 1 is '" + fields.front() +
                           "'; expected time_s (docs/measured-data.md)");
@@ -250,19 +235,17 @@ std::vector<std::string> stream_columns(std::string_view header, const std::stri
 }
 
 bool parsed_sample(std::string_view line, double& time, Eigen::Ref<Eigen::VectorXd> values) {
-  std::size_t start = 0;
+  std::size_t at = 0;
   const Eigen::Index n = values.size();
   for (Eigen::Index field = -1;; ++field) {
-    const std::size_t comma = line.find(',', start);
-    const double v = cell_value(line.substr(start, comma - start));
+    const double v = cell_value(core::next_cell(line, at));
     if (field < 0)
       time = v;
     else if (field < n)
       values(field) = v;
     else
       return false;
-    if (comma == std::string_view::npos) return field + 1 == n;
-    start = comma + 1;
+    if (at == std::string_view::npos) return field + 1 == n;
   }
 }
 

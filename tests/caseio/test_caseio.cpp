@@ -506,7 +506,8 @@ TEST_F(CaseFiles, MiniCaseParsesWithDefaultsFilled) {
 
 TEST_F(CaseFiles, EveryFeatureInMillimetresRoundTrips) {
   write("part.stl", "solid part\nendsolid part\n");
-  write("p1.csv", "time_s,speed_rpm\n0,1500\n30, 0\n# pause\n60,3000\n");
+  // A spreadsheet's quoted field is read as its content.
+  write("p1.csv", "time_s,speed_rpm\n0,1500\n\"30\", 0\n# pause\n60,3000\n");
   std::string text = replaced(mini_case, "length_unit = \"m\"", "length_unit = \"mm\"");
   text = replaced(text, "max = [0.1, 0.1, 0.1] } } ]",
                   "max = [100, 100, 100] } }, { surface = { file = \"part.stl\" } } ]\n"

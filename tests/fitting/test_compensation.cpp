@@ -322,6 +322,14 @@ TEST(Compensation, StreamLinesParseEmptyAndTextCellsAsMissing) {
   EXPECT_EQ(v(0), 2000.0);
   EXPECT_TRUE(std::isnan(v(1)));
   EXPECT_EQ(v(2), -1.25);
+  // A spreadsheet's quoted fields, names and numbers alike.
+  EXPECT_EQ(tt::io::stream_columns("\"time_s\",\"T07\", \"dx\"", "s"),
+            (std::vector<std::string>{"T07", "dx"}));
+  ASSERT_TRUE(tt::io::parsed_sample("\"14\",\"2.5\",\"\",\" 7 \"", t, v));
+  EXPECT_EQ(t, 14.0);
+  EXPECT_EQ(v(0), 2.5);
+  EXPECT_TRUE(std::isnan(v(1)));
+  EXPECT_EQ(v(2), 7.0);
   EXPECT_FALSE(tt::io::parsed_sample("13,1,2", t, v));
   EXPECT_FALSE(tt::io::parsed_sample("13,1,2,3,4", t, v));
 }

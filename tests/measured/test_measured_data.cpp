@@ -158,8 +158,10 @@ TEST_F(Measured, RejectsTimeThatDoesNotIncrease) {
 }
 
 TEST_F(Measured, RejectsTextInANumberCell) {
-  const auto m = rejection(kMeta, replaced(kCsv, "20.5,1.5", "20.5,1.5um"));
+  auto m = rejection(kMeta, replaced(kCsv, "20.5,1.5", "20.5,1.5um"));
   EXPECT_NE(m.find("data.csv:3: column 4 'dy': '1.5um' is not a number"), std::string::npos) << m;
+  m = rejection(kMeta, replaced(kCsv, "20.5,1.5", "\"warm\",1.5"));  // quoted, still text
+  EXPECT_NE(m.find("data.csv:3: column 3 'T07': 'warm' is not a number"), std::string::npos) << m;
 }
 
 TEST_F(Measured, RejectsNonFiniteNumbers) {
@@ -304,15 +306,19 @@ TEST_F(Measured, MissingFilesAreIoErrors) {
   EXPECT_THROW(read_measured_run(dir_), tt::core::IoError);
 }
 
-TEST_F(Measured, AcceptsCrlfBomBlankLinesAndUnevenSteps) {
+TEST_F(Measured, AcceptsCrlfBomBlankLinesUnevenStepsAndQuotedFields) {
+  // A spreadsheet's export quotes names and numbers alike; "" is an empty cell (missing).
   write_text(dir_ / "meta.json", kMeta);
   write_text(dir_ / "data.csv",
-             "\xEF\xBB\xBFtime_s, speed_rpm "
-             ",T07,dy,T10\r\n0,0,20,0,21\r\n\r\n0.5,+10,20,0,21\r\n7,10,20,-1e0,21");
+             "\xEF\xBB\xBF\"time_s\", speed_rpm "
+             ",\"T07\",dy,T10\r\n0,0,\"20.5\",0,21\r\n\r\n0.5,+10,20,\"\",21\r\n"
+             "7,10,20,\" -1e0 \",21");
   const auto run = read_measured_run(dir_, sb1_box());
   ASSERT_EQ(run.time.size(), 3);
   EXPECT_DOUBLE_EQ(run.time(2), 7.0);
+  EXPECT_DOUBLE_EQ(run.temperature(0, 0), 20.5 + 273.15);
   EXPECT_DOUBLE_EQ(run.input_values(1, 0), 10.0);
+  EXPECT_TRUE(std::isnan(run.displacement(1, 0)));
   EXPECT_NEAR(run.displacement(2, 0), -1e-6, 1e-20);
 }
 
