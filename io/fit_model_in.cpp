@@ -154,10 +154,12 @@ void require_same(const Eigen::VectorXd& file, const json& c, const std::string&
 /// it was trained on, which with its stride sets the time between a window's entries.
 torchnet::Network checked_network(const json& c, fitting::FittedModel& m, const Place& p,
                                   const std::string& at, const std::filesystem::path& dir) {
-  const std::string name = c.contains("file") && c["file"].is_string()
-                               ? c["file"].get<std::string>()
-                               : "network_" + p.target + ".pt";
-  const std::filesystem::path path = dir / name;
+  // The name fit writes; a target that is not a plain name would reach outside the directory.
+  if (p.target.find('/') != std::string::npos)
+    throw core::DataError(p.at(at + "kind") +
+                          " = 'cnn_bigru_attention': the target's name is not "
+                          "a plain name, so its network_<target>.pt cannot be beside fit.json");
+  const std::filesystem::path path = dir / ("network_" + p.target + ".pt");
   if (!std::filesystem::is_regular_file(path))
     throw core::DataError(p.at(at + "kind") + " = 'cnn_bigru_attention': its weights, " +
                           path.string() +
@@ -189,7 +191,6 @@ torchnet::Network checked_network(const json& c, fitting::FittedModel& m, const 
   const json& settings = c["settings"];
   m.spec.network.options = net.options();
   m.spec.network.window_span_s = settings.value("window_span_s", 0.0);
-  m.spec.network.options.sample_interval_s = net.options().sample_interval_s;
   if (!(net.options().sample_interval_s > 0.0))
     throw core::DataError(path.string() +
                           ": the network does not record the interval of the samples it was "
