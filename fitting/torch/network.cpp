@@ -625,10 +625,10 @@ Network trained_network(const Sequences& fit_given, const Sequences& validation_
         skip ? y_val.pow(2).mean().item<double>() : std::numeric_limits<double>::infinity();
     impl->report.validation_loss = restored_best(net, best, skip_only, impl->report);
     impl->weights = flat_parameters(net);
-    impl->script =
-        script_module(net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
-                      skip.value_or(LinearSkip{Eigen::VectorXd::Zero(outputs),
-                                               Eigen::MatrixXd::Zero(outputs, inputs)}));
+    impl->script = script_module(
+        net, o, impl->in_mean, impl->in_scale, impl->out_mean, impl->out_scale,
+        skip.value_or(LinearSkip{Eigen::VectorXd::Zero(outputs),
+                                 Eigen::MatrixXd::Zero(outputs, inputs), Eigen::VectorXd()}));
   } catch (const c10::Error& e) {
     throw core::DataError(std::string("network training failed in libtorch: ") +
                           e.what_without_backtrace());
