@@ -101,12 +101,19 @@ fitting::FeatureMap model_features(const json& c, const fitting::ModelSpec& spec
 }
 
 /// A projection pursuit model whose inputs are `expected`.
-fitting::PprModel checked_ppr(const json& c, const std::vector<std::string>& expected,
-                              const Place& p, const std::string& at) {
+/// fit.json's `inputs` of a model (projection pursuit, network) are `expected`, in order.
+void require_inputs(const json& c, const std::vector<std::string>& expected, const Place& p,
+                    const std::string& at) {
   const std::vector<std::string> inputs = names_at(c, "inputs", p, at);
   if (inputs != expected)
     throw core::DataError(p.at(at + "inputs") + " = " + json(inputs).dump() +
-                          "; the model's sensors and inputs give " + json(expected).dump());
+                          "; the model's sensors, inputs and time constants give " +
+                          json(expected).dump());
+}
+
+fitting::PprModel checked_ppr(const json& c, const std::vector<std::string>& expected,
+                              const Place& p, const std::string& at) {
+  require_inputs(c, expected, p, at);
   fitting::PprModel ppr = ppr_of(c, p, at);
   if (ppr.center.size() != static_cast<Eigen::Index>(expected.size()))
     throw core::DataError(p.at(at + "input_center_K") + " has " +
@@ -152,8 +159,9 @@ void require_same(const Eigen::VectorXd& file, const json& c, const std::string&
 /// The network of a cnn_bigru_attention model: its TorchScript file beside fit.json, checked
 /// against the shape and standardisation fit.json records; it holds the interval of the samples
 /// it was trained on, which with its stride sets the time between a window's entries.
-torchnet::Network checked_network(const json& c, fitting::FittedModel& m, const Place& p,
-                                  const std::string& at, const std::filesystem::path& dir) {
+torchnet::Network checked_network(const json& c, const std::vector<std::string>& expected,
+                                  fitting::FittedModel& m, const Place& p, const std::string& at,
+                                  const std::filesystem::path& dir) {
   // The name fit writes; a target that is not a plain name would reach outside the directory.
   if (p.target.find('/') != std::string::npos)
     throw core::DataError(p.at(at + "kind") +
@@ -165,11 +173,7 @@ torchnet::Network checked_network(const json& c, fitting::FittedModel& m, const 
                           path.string() +
                           ", are not there; hint: keep the network_<target>.pt files `fit` wrote "
                           "beside fit.json");
-  const std::vector<std::string> expected = fitting::feature_names(m.features);
-  if (names_at(c, "inputs", p, at) != expected)
-    throw core::DataError(p.at(at + "inputs") + " = " + json(names_at(c, "inputs", p, at)).dump() +
-                          "; the model's sensors, inputs and time constants give " +
-                          json(expected).dump());
+  require_inputs(c, expected, p, at);
   torchnet::Network net = torchnet::loaded_network(path);
   const int steps = static_cast<int>(number_at(c, "window_steps", p, at));
   const int stride = static_cast<int>(number_at(c, "window_stride_samples", p, at));
@@ -216,7 +220,7 @@ fitting::FittedModel fitted_model_of(const json& c, const Place& p, const std::s
   m.features = model_features(c, m.spec, p, at);
   const std::vector<std::string> expected = fitting::feature_names(m.features);
   if (kind == ModelKind::cnn_bigru_attention)
-    m.body = checked_network(c, m, p, at, *network_dir);
+    m.body = checked_network(c, expected, m, p, at, *network_dir);
   else if (kind == ModelKind::projection_pursuit)
     m.body = checked_ppr(c, expected, p, at);
   else

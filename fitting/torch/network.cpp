@@ -647,10 +647,8 @@ Eigen::VectorXd vector_of(const torch::Tensor& t) {
 
 Eigen::MatrixXd matrix_of(const torch::Tensor& t) {
   const torch::Tensor d = t.to(torch::kFloat64).contiguous();
-  Eigen::MatrixXd m(d.size(0), d.size(1));
-  for (int64_t i = 0; i < d.size(0); ++i)
-    for (int64_t j = 0; j < d.size(1); ++j) m(i, j) = d[i][j].item<double>();
-  return m;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  return Eigen::Map<const RowMajor>(d.data_ptr<double>(), d.size(0), d.size(1));
 }
 
 /// The shape, standardisation and skip a file written by save_torchscript holds, into `n`.

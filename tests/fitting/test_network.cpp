@@ -391,10 +391,17 @@ TEST(NetworkCompensation, AMissingOrForeignNetworkFileIsRefusedNamingIt) {
   EXPECT_NE(refusal(doc, dir).find("another fit"), std::string::npos) << refusal(doc, dir);
   std::get<tt::torchnet::Network>(model.body).save_torchscript(dir / "network_z.pt");
   EXPECT_EQ(refusal(doc, dir), "");
-  EXPECT_TRUE(
-      std::get<tt::torchnet::Network>(tt::io::deployed_models(doc, "fit.json", dir)[0].model.body)
-          .linear_skip()
-          .has_value());
+  // The skip read back from the file's buffers is the trained one (to float32).
+  const auto read = tt::io::deployed_models(doc, "fit.json", dir);
+  const auto& skip = std::get<tt::torchnet::Network>(read[0].model.body).linear_skip();
+  ASSERT_TRUE(skip.has_value());
+  const auto& trained = *std::get<tt::torchnet::Network>(model.body).linear_skip();
+  ASSERT_EQ(skip->weights.rows(), trained.weights.rows());
+  ASSERT_EQ(skip->weights.cols(), trained.weights.cols());
+  EXPECT_LE((skip->weights - trained.weights).cwiseAbs().maxCoeff(),
+            1e-6 * trained.weights.cwiseAbs().maxCoeff());
+  EXPECT_LE((skip->intercept - trained.intercept).cwiseAbs().maxCoeff(),
+            1e-6 * std::max(1e-9, trained.intercept.cwiseAbs().maxCoeff()));
   // Not a TorchScript file.
   std::ofstream(dir / "network_z.pt") << "not a network\n";
   EXPECT_NE(refusal(doc, dir).find("not a TorchScript network"), std::string::npos)
