@@ -10,6 +10,12 @@
 
 namespace tt::core {
 
+/// `text` without the UTF-8 byte-order mark a spreadsheet may write before a file's first cell.
+inline std::string_view without_byte_order_mark(std::string_view text) {
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  return text;
+}
+
 /// `text` without blanks (space, tab, CR) at either end.
 inline std::string_view trimmed(std::string_view text) {
   const auto first = text.find_first_not_of(" \t\r");

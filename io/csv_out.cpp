@@ -37,7 +37,7 @@ std::string file_text(const fs::path& path) {
   std::ostringstream content;
   content << in.rdbuf();
   std::string text = content.str();
-  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // UTF-8 byte order mark
+  text.erase(0, text.size() - core::without_byte_order_mark(text).size());
   return text;
 }
 

@@ -397,7 +397,7 @@ std::string cell_text(std::string_view cell) {
 /// The header's columns matched against meta.json's ids; every rejection names the column.
 std::vector<ColumnSlot> header_slots(const fs::path& file, std::string_view line,
                                      const MeasuredRun& run, std::vector<std::string>& names) {
-  if (line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);  // a UTF-8 byte-order mark
+  line = core::without_byte_order_mark(line);
   std::map<std::string, ColumnSlot, std::less<>> expected{{"time_s", {ColumnRole::time, 0}}};
   for (std::size_t i = 0; i < run.inputs.size(); ++i)
     expected[run.inputs[i]] = {ColumnRole::input, static_cast<int>(i)};

@@ -215,7 +215,7 @@ bool LineReader::next(std::string_view& line, const std::function<bool()>& befor
 }
 
 std::vector<std::string> stream_columns(std::string_view header, const std::string& origin) {
-  if (header.starts_with("\xEF\xBB\xBF")) header.remove_prefix(3);  // a UTF-8 byte-order mark
+  header = core::without_byte_order_mark(header);
   std::vector<std::string> fields;
   for (std::size_t at = 0; at != std::string_view::npos;)
     fields.emplace_back(core::next_cell(header, at));

@@ -101,6 +101,10 @@ TEST(Csv, CommentsBlankLinesAndCrLfAreAccepted) {
   ASSERT_EQ(table.rows.rows(), 2);
   EXPECT_EQ(table.rows(0, 1), 1.5);
   EXPECT_EQ(table.rows(1, 1), -20.0);
+  // A spreadsheet's UTF-8 byte-order mark before the header is not part of the first name.
+  write_text(dir / "bom.csv", "\xEF\xBB\xBFtime_s,dz_um\n0,1\n");
+  EXPECT_EQ(read_numeric_csv(dir / "bom.csv").header,
+            (std::vector<std::string>{"time_s", "dz_um"}));
 }
 
 TEST(Csv, BadInputsAreRejected) {
