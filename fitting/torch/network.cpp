@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "fitting/torch/engine.hpp"
 
 namespace tt::torchnet {
 
@@ -316,66 +317,17 @@ std::vector<float> raw_windows(const std::vector<Eigen::MatrixXd>& windows) {
 
 }  // namespace
 
-struct Network::Impl {
-  NetworkOptions options;
-  TrainingReport report;
-  int inputs = 0, outputs = 0;
-  Eigen::VectorXd in_mean, in_scale, out_mean, out_scale;
-  std::optional<LinearSkip> skip;
-  /// the trained network as TorchScript: the one inference path, in memory and on file
+/// A network the engine made: the TorchScript is its one inference path, in memory and on file.
+struct TorchNetwork final : Network::Impl {
   torch::jit::Module script;
-  std::vector<float> weights;
+
+  Eigen::MatrixXd prediction(const Eigen::MatrixXd& inputs) const override;
+  Eigen::VectorXd window_prediction(const Eigen::MatrixXd& window) const override;
+  void save_torchscript(const std::filesystem::path& file) const override;
 };
 
-Network::Network(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
-
-int Network::inputs() const {
-  return impl_->inputs;
-}
-int Network::outputs() const {
-  return impl_->outputs;
-}
-const NetworkOptions& Network::options() const {
-  return impl_->options;
-}
-const TrainingReport& Network::report() const {
-  return impl_->report;
-}
-Eigen::VectorXd Network::input_mean() const {
-  return impl_->in_mean;
-}
-Eigen::VectorXd Network::input_scale() const {
-  return impl_->in_scale;
-}
-Eigen::VectorXd Network::output_mean() const {
-  return impl_->out_mean;
-}
-Eigen::VectorXd Network::output_scale() const {
-  return impl_->out_scale;
-}
-const std::optional<LinearSkip>& Network::linear_skip() const {
-  return impl_->skip;
-}
-std::vector<float> Network::flat_weights() const {
-  return impl_->weights;
-}
-
-std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
-                                        const std::vector<Eigen::Index>& rows) {
-  std::vector<Eigen::MatrixXd> out;
-  out.reserve(rows.size());
-  for (Eigen::Index i : rows) {
-    Eigen::MatrixXd w(steps, inputs.cols());
-    for (int j = 0; j < steps; ++j)
-      w.row(j) = inputs.row(
-          std::max<Eigen::Index>(0, i - static_cast<Eigen::Index>(steps - 1 - j) * stride));
-    out.push_back(std::move(w));
-  }
-  return out;
-}
-
-Eigen::MatrixXd Network::prediction(const Eigen::MatrixXd& inputs) const {
-  const Impl& n = *impl_;
+Eigen::MatrixXd TorchNetwork::prediction(const Eigen::MatrixXd& inputs) const {
+  const TorchNetwork& n = *this;
   if (inputs.cols() != n.inputs || !inputs.allFinite())
     throw core::DataError("network prediction on " + std::to_string(inputs.cols()) +
                           " input columns (or a non-finite value); expected " +
@@ -389,8 +341,8 @@ Eigen::MatrixXd Network::prediction(const Eigen::MatrixXd& inputs) const {
   return run_script(n.script, x, inputs.rows(), n.options.window_steps, n.inputs);
 }
 
-Eigen::VectorXd Network::window_prediction(const Eigen::MatrixXd& window) const {
-  const Impl& n = *impl_;
+Eigen::VectorXd TorchNetwork::window_prediction(const Eigen::MatrixXd& window) const {
+  const TorchNetwork& n = *this;
   if (window.rows() != n.options.window_steps || window.cols() != n.inputs)
     throw core::DataError("network window of " + std::to_string(window.rows()) + "x" +
                           std::to_string(window.cols()) + "; expected " +
@@ -400,11 +352,11 @@ Eigen::VectorXd Network::window_prediction(const Eigen::MatrixXd& window) const 
   return run_script(n.script, x, 1, n.options.window_steps, n.inputs).row(0).transpose();
 }
 
-void Network::save_torchscript(const std::filesystem::path& file) const {
+void TorchNetwork::save_torchscript(const std::filesystem::path& file) const {
   const std::filesystem::path part = file.string() + ".part";
   try {
-    TorchThreads threads(impl_->options.threads);
-    impl_->script.save(part.string());
+    TorchThreads threads(options.threads);
+    script.save(part.string());
   } catch (const c10::Error& e) {
     std::filesystem::remove(part);
     throw core::DataError(file.string() +
@@ -570,6 +522,9 @@ std::vector<float> flat_parameters(Net& net) {
 
 }  // namespace
 
+// The engine's functions, which the loader calls through EngineFunctions (engine.hpp).
+namespace engine {
+
 Network trained_network(const Sequences& fit_given, const Sequences& validation_given,
                         const NetworkOptions& o, const std::optional<LinearSkip>& skip) {
   require_options(o);
@@ -587,7 +542,7 @@ Network trained_network(const Sequences& fit_given, const Sequences& validation_
   const Sequences fit = skip ? residual(fit_given, *skip) : fit_given;
   const Sequences validation = skip ? residual(validation_given, *skip) : validation_given;
 
-  auto impl = std::make_shared<Network::Impl>();
+  auto impl = std::make_shared<TorchNetwork>();
   impl->options = o;
   impl->inputs = inputs;
   impl->outputs = outputs;
@@ -652,7 +607,7 @@ Eigen::MatrixXd matrix_of(const torch::Tensor& t) {
 }
 
 /// The shape, standardisation and skip a file written by save_torchscript holds, into `n`.
-void read_script_buffers(Network::Impl& n, const std::string& name) {
+void read_script_buffers(TorchNetwork& n, const std::string& name) {
   const torch::jit::Module& m = n.script;
   for (const char* key : {"in_mean", "in_scale", "out_mean", "out_scale", "skip_w", "skip_b",
                           "window_steps", "window_stride"})
@@ -693,7 +648,7 @@ void read_script_buffers(Network::Impl& n, const std::string& name) {
 Network loaded_network(const std::filesystem::path& file) {
   if (!std::filesystem::is_regular_file(file))
     throw core::DataError(file.string() + ": no such network file");
-  auto impl = std::make_shared<Network::Impl>();
+  auto impl = std::make_shared<TorchNetwork>();
   TorchThreads threads(1);
   try {
     impl->script = torch::jit::load(file.string());
@@ -721,4 +676,15 @@ std::string parallel_info() {
   return at::get_parallel_info();
 }
 
+}  // namespace engine
+
 }  // namespace tt::torchnet
+
+extern "C" __attribute__((visibility("default"))) const tt::torchnet::EngineFunctions*
+tt_torchnet_engine() {
+  namespace e = tt::torchnet::engine;
+  static const tt::torchnet::EngineFunctions functions{
+      tt::torchnet::engine_abi, &e::trained_network, &e::loaded_network, &e::torchscript_prediction,
+      &e::parallel_info};
+  return &functions;
+}

@@ -1,5 +1,8 @@
 // The gantry patent's CNN-BiGRU-attention thermal-error network (seed 004), on libtorch, behind a
-// plain C++ interface: nothing outside fitting/torch/ includes a torch header.
+// plain C++ interface: nothing outside fitting/torch/ includes a torch header. libtorch lives in
+// the engine, a module of its own (libthermotwin_torch.so, network.cpp) that the functions below
+// load on their first call (engine_loader.cpp): a command that fits or runs no network does not
+// pay libtorch's start, about a second of static initialisation.
 // Structure: standardised input windows -> two 1-D convolutions (ReLU) -> max pooling by 2 ->
 // batch normalisation -> two-layer bidirectional GRU -> dot-product attention over the feature
 // dimension of the last GRU output -> one fully connected layer to every output at once; with a
@@ -11,11 +14,13 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tt::torchnet {
@@ -98,6 +103,9 @@ struct TrainingReport {
 /// A trained network; copies share the (immutable) weights.
 class Network {
  public:
+  struct Impl;
+  explicit Network(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
   /// #samples x #outputs: at each sample the prediction from the window ending there (entries
   /// before the first sample repeat the first row). inputs: #samples x #inputs.
   Eigen::MatrixXd prediction(const Eigen::MatrixXd& inputs) const;
@@ -124,12 +132,65 @@ class Network {
   /// Every weight in a fixed order: for comparing two trainings.
   std::vector<float> flat_weights() const;
 
-  struct Impl;
-  explicit Network(std::shared_ptr<const Impl> impl);
-
  private:
   std::shared_ptr<const Impl> impl_;
 };
+
+/// What a network is: its shape, standardisation and weights here, its TorchScript in the engine,
+/// which runs it through the three calls below. Only the engine makes one.
+struct Network::Impl {
+  NetworkOptions options;
+  TrainingReport report;
+  int inputs = 0, outputs = 0;
+  Eigen::VectorXd in_mean, in_scale, out_mean, out_scale;
+  std::optional<LinearSkip> skip;
+  std::vector<float> weights;
+
+  virtual ~Impl() = default;
+  virtual Eigen::MatrixXd prediction(const Eigen::MatrixXd& inputs) const = 0;
+  virtual Eigen::VectorXd window_prediction(const Eigen::MatrixXd& window) const = 0;
+  virtual void save_torchscript(const std::filesystem::path& file) const = 0;
+};
+
+inline Eigen::MatrixXd Network::prediction(const Eigen::MatrixXd& inputs) const {
+  return impl_->prediction(inputs);
+}
+inline Eigen::VectorXd Network::window_prediction(const Eigen::MatrixXd& window) const {
+  return impl_->window_prediction(window);
+}
+inline void Network::save_torchscript(const std::filesystem::path& file) const {
+  impl_->save_torchscript(file);
+}
+inline int Network::inputs() const {
+  return impl_->inputs;
+}
+inline int Network::outputs() const {
+  return impl_->outputs;
+}
+inline const NetworkOptions& Network::options() const {
+  return impl_->options;
+}
+inline const TrainingReport& Network::report() const {
+  return impl_->report;
+}
+inline Eigen::VectorXd Network::input_mean() const {
+  return impl_->in_mean;
+}
+inline Eigen::VectorXd Network::input_scale() const {
+  return impl_->in_scale;
+}
+inline Eigen::VectorXd Network::output_mean() const {
+  return impl_->out_mean;
+}
+inline Eigen::VectorXd Network::output_scale() const {
+  return impl_->out_scale;
+}
+inline const std::optional<LinearSkip>& Network::linear_skip() const {
+  return impl_->skip;
+}
+inline std::vector<float> Network::flat_weights() const {
+  return impl_->weights;
+}
 
 /// Trains on the windows of `fit` and stops early on those of `validation`; with no validation
 /// sequences the last fifth of each fitting group's windows validates (and is not trained on).
@@ -154,8 +215,19 @@ Eigen::MatrixXd torchscript_prediction(const std::filesystem::path& file,
                                        const std::vector<Eigen::MatrixXd>& windows);
 
 /// The window ending at each of the rows `rows` of `inputs` (window_steps x #inputs each).
-std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
-                                        const std::vector<Eigen::Index>& rows);
+inline std::vector<Eigen::MatrixXd> windows_at(const Eigen::MatrixXd& inputs, int steps, int stride,
+                                               const std::vector<Eigen::Index>& rows) {
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(rows.size());
+  for (Eigen::Index i : rows) {
+    Eigen::MatrixXd w(steps, inputs.cols());
+    for (int j = 0; j < steps; ++j)
+      w.row(j) = inputs.row(
+          std::max<Eigen::Index>(0, i - static_cast<Eigen::Index>(steps - 1 - j) * stride));
+    out.push_back(std::move(w));
+  }
+  return out;
+}
 
 /// libtorch's report of its threading backend and thread counts, for benchmark records.
 std::string parallel_info();
