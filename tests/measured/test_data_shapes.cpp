@@ -258,11 +258,13 @@ TEST(DataShapes, DaysAsRunsWithHeldOutDays) {
     EXPECT_NEAR(cal["models"][channel]["baseline_choice"]["validation_rms_um"].get<double>(),
                 s["validation_rms_um"].get<double>(), 1e-6 * s["validation_rms_um"].get<double>());
   }
-  for (const auto& [channel, c] : cal["after"]["channels"].items())
-    if (c["worse_than_before"].get<bool>())
+  for (const auto& [channel, c] : cal["after"]["channels"].items()) {
+    if (c["worse_than_before"].get<bool>()) {
       EXPECT_NE(std::find(cal["after_worse_than_before_on_test"].begin(),
                           cal["after_worse_than_before_on_test"].end(), channel),
                 cal["after_worse_than_before_on_test"].end());
+    }
+  }
   for (const auto& e : cal["effects"]) {
     EXPECT_GE(e["null_fraction"].get<double>(), 0.0);
     EXPECT_GT(e["heldout_gain_t"].get<double>(), 2.0);
@@ -316,8 +318,9 @@ TEST(DataShapes, NoCompensationIsChosenWhenNothingBeatsIt) {
       groups, pool, {}, 0, {{all, none}, {all, fitting::ModelSpec{}}, {all, lagged}});
   EXPECT_EQ(e.model.spec.kind, fitting::ModelKind::no_compensation);
   EXPECT_EQ(e.selection.none, 0);
-  if (e.selection.lowest != e.selection.none)
+  if (e.selection.lowest != e.selection.none) {
     EXPECT_LE(e.selection.gain_over_none, e.selection.gain_over_none_standard_error);
+  }
   // A channel the temperatures explain gets the model of the lowest held-out mean square, which
   // beats no compensation by more than a standard error.
   const auto cycles = fitting::segment_groups(
@@ -352,6 +355,8 @@ TEST(DataShapes, ClaimThresholdIsNeverNegative) {
       fitting::residual_study(blocks.segments, 1, fitting::baseline_of(choice.model), options);
   for (const auto& step : study.steps)
     for (const auto& e : step)
-      if (std::isfinite(e.null_fraction)) EXPECT_GE(e.null_fraction, 0.0);
+      if (std::isfinite(e.null_fraction)) {
+        EXPECT_GE(e.null_fraction, 0.0);
+      }
   for (const auto& e : study.effects) EXPECT_GT(e.gain_t, options.min_gain_t);
 }
