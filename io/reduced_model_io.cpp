@@ -27,7 +27,7 @@ core::CaseSpec machine_only(core::CaseSpec s) {
   s.source = "/machine.toml";  // the resolved TOML names its source on its first line
   s.name = "machine";
   s.seed = 1;
-  s.duty_cycle = core::DutyCycle{{{0.0, 0.0}}, 1.0};
+  s.duty_cycle = core::DutyCycle{{{0.0, 0.0}}, 1.0, {}};
   for (auto& seg : s.feed_axis.segments)
     seg = {0.0, s.feed_axis.segments.front().from, s.feed_axis.segments.front().from, 0.0};
   if (!s.feed_axis.segments.empty()) s.feed_axis.segments.resize(1);
