@@ -3,12 +3,6 @@
 // network.hpp's free functions. Torch-free: both sides include it.
 #pragma once
 
-#include <Eigen/Dense>
-#include <filesystem>
-#include <optional>
-#include <string>
-#include <vector>
-
 #include "fitting/torch/network.hpp"
 
 namespace tt::torchnet {
@@ -19,14 +13,13 @@ inline constexpr int engine_abi = 1;
 /// The module's one exported symbol: extern "C" const EngineFunctions* tt_torchnet_engine().
 inline constexpr const char* engine_entry = "tt_torchnet_engine";
 
+/// network.hpp's free functions, as the engine defines them: the types are those declarations'.
 struct EngineFunctions {
   int abi;
-  Network (*trained_network)(const Sequences& fit, const Sequences& validation,
-                             const NetworkOptions& options, const std::optional<LinearSkip>& skip);
-  Network (*loaded_network)(const std::filesystem::path& file);
-  Eigen::MatrixXd (*torchscript_prediction)(const std::filesystem::path& file,
-                                            const std::vector<Eigen::MatrixXd>& windows);
-  std::string (*parallel_info)();
+  decltype(&::tt::torchnet::trained_network) trained_network;
+  decltype(&::tt::torchnet::loaded_network) loaded_network;
+  decltype(&::tt::torchnet::torchscript_prediction) torchscript_prediction;
+  decltype(&::tt::torchnet::parallel_info) parallel_info;
 };
 
 }  // namespace tt::torchnet

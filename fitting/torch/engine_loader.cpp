@@ -46,15 +46,16 @@ const EngineFunctions* loaded_engine() {
     using Entry = const EngineFunctions* (*)();
     const auto entry = reinterpret_cast<Entry>(dlsym(handle, engine_entry));
     const EngineFunctions* functions = entry ? entry() : nullptr;
-    if (functions == nullptr || functions->abi != engine_abi) {
-      why += "\n  " + place.string() + ": not this build's engine (" +
-             (functions ? "table version " + std::to_string(functions->abi) + ", expected " +
-                              std::to_string(engine_abi)
-                        : std::string("no ") + engine_entry) +
-             ")";
-      continue;  // left loaded: unloading a library that started libtorch is not safe
+    // A module that is not this build's engine is left loaded: unloading a library that may have
+    // started libtorch is not safe.
+    if (functions == nullptr) {
+      why += "\n  " + place.string() + ": not this build's engine (no " + engine_entry + ")";
+    } else if (functions->abi != engine_abi) {
+      why += "\n  " + place.string() + ": not this build's engine (table version " +
+             std::to_string(functions->abi) + ", expected " + std::to_string(engine_abi) + ")";
+    } else {
+      return functions;
     }
-    return functions;
   }
   throw core::IoError("the network needs its libtorch engine " + std::string(TT_TORCH_ENGINE_NAME) +
                       ", which could not be loaded:" + why +
